@@ -1,0 +1,290 @@
+"""Characters: who the face belongs to, as MakeHuman macro and face-shape weights.
+
+A :class:`Character` is plain parameters; :func:`character_offsets` turns them
+into base-mesh offsets (``base + offsets`` is that person's neutral face).
+
+Macro weighting (MakeHuman / MPFB scheme, ``targets/macrodetails/macro.json``):
+each macro factor is a piecewise-linear partition of unity over its anchors —
+
+- gender 0 (female) … 1 (male): weights (1-g, g) on female/male;
+- age in years, mapped to MakeHuman's slider by its anchors 1 y → 0, 11 y → 0.1875,
+  25 y → 0.5, 90 y → 1, then split over baby/child/young/old;
+- muscle and weight 0 … 1 (0.5 is average): split over min/average/max;
+- ethnicity: african, asian, caucasian weights normalised to sum to 1.
+
+Target ``{race}-{gender}-{age}`` gets race·gender·age; target
+``universal-{gender}-{age}-{muscle}-{weight}`` gets gender·age·muscle·weight —
+products of the factor weights, exactly as MakeHuman combines them. The
+MakeHuman expression units exist per ethnicity; they are mixed by the same
+ethnicity weights (:func:`ethnic_mix`).
+
+Face-shape sliders are named after the target files without their direction:
+``"nose/nose-hump": 0.4`` applies ``nose/nose-hump-incr`` at 0.4, −0.4 applies
+``nose/nose-hump-decr``. Sided sliders may be given once for both sides
+(``"eyes/eye-bag"`` drives ``l-eye-bag`` and ``r-eye-bag``).
+
+Examples
+--------
+>>> macro_weights(Character(gender=1.0, age=25))["caucasian-male-young"]
+0.3333333333333333
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field, replace
+from functools import lru_cache
+from importlib import resources
+from typing import Mapping
+
+import numpy as np
+import yaml
+
+ETHNICITIES = ("african", "asian", "caucasian")
+#: Age anchors: MakeHuman slider value ↔ years.
+AGE_ANCHORS = ((0.0, 1.0), (0.1875, 11.0), (0.5, 25.0), (1.0, 90.0))
+AGE_NAMES = ("baby", "child", "young", "old")
+LEVEL_NAMES = {"muscle": ("minmuscle", "averagemuscle", "maxmuscle"), "weight": ("minweight", "averageweight", "maxweight")}
+FACE_SHAPE_FOLDERS = ("head", "nose", "mouth", "chin", "cheek", "eyes", "eyebrows", "forehead", "ears", "neck")
+#: Which end of a slider pair is negative.
+_NEGATIVE_ENDS = ("decr", "down", "in", "backward", "concave", "compress")
+_POSITIVE_ENDS = ("incr", "up", "out", "forward", "convex", "uncompress")
+COLOR_KEYS = ("skin", "lips", "brows", "iris", "lashes", "sclera", "pupil", "teeth", "tongue", "mouth_interior", "eyelid", "cheek")
+
+
+class CharacterError(ValueError):
+    """A character name or parameter is not valid."""
+
+
+@dataclass(frozen=True)
+class Character:
+    """A person's identity parameters.
+
+    Parameters
+    ----------
+    gender : float
+        0 female … 1 male.
+    age : float
+        Years, 1 … 90.
+    african, asian, caucasian : float
+        Ethnicity mix (normalised; all zero means equal thirds).
+    muscle, weight : float
+        0 … 1, 0.5 average.
+    face : mapping
+        Face-shape sliders, ``{"nose/nose-hump": 0.4, ...}``, each in [-1, 1].
+    colors : mapping
+        Colour overrides, ``{"iris": "#3b6ea5", ...}``; keys in :data:`COLOR_KEYS`.
+    name : str
+        Preset name, or "" for a custom character.
+    """
+
+    gender: float = 0.5
+    age: float = 25.0
+    african: float = 0.0
+    asian: float = 0.0
+    caucasian: float = 1.0
+    muscle: float = 0.5
+    weight: float = 0.5
+    face: Mapping[str, float] = field(default_factory=dict)
+    colors: Mapping[str, str] = field(default_factory=dict)
+    name: str = ""
+    description: str = ""
+
+    def __post_init__(self):
+        for key in ("gender", "muscle", "weight", "african", "asian", "caucasian"):
+            value = getattr(self, key)
+            if not 0.0 <= float(value) <= 1.0:
+                raise CharacterError(f"character parameter {key!r} must be in [0, 1], got {value}")
+        if not 1.0 <= float(self.age) <= 90.0:
+            raise CharacterError(f"character parameter 'age' must be in years from 1 to 90, got {self.age}")
+        for key, value in self.face.items():
+            if not -1.0 <= float(value) <= 1.0:
+                raise CharacterError(f"face-shape slider {key!r} must be in [-1, 1], got {value}")
+        for key in self.colors:
+            if key not in COLOR_KEYS:
+                raise CharacterError(f"unknown colour {key!r}; choose from {', '.join(COLOR_KEYS)}")
+        object.__setattr__(self, "face", dict(self.face))
+        object.__setattr__(self, "colors", dict(self.colors))
+
+    @property
+    def ethnicity(self) -> dict[str, float]:
+        """Ethnicity weights normalised to sum to 1."""
+        raw = np.array([self.african, self.asian, self.caucasian], float)
+        raw = raw / raw.sum() if raw.sum() > 0 else np.full(3, 1 / 3)
+        return dict(zip(ETHNICITIES, raw.tolist()))
+
+    def with_(self, **changes) -> "Character":
+        """A copy with some parameters changed (``face``/``colors`` are merged)."""
+        if "face" in changes:
+            changes["face"] = {**self.face, **changes["face"]}
+        if "colors" in changes:
+            changes["colors"] = {**self.colors, **changes["colors"]}
+        return replace(self, **changes)
+
+
+# ------------------------------------------------------------ macro weights
+
+
+def age_slider(years: float) -> float:
+    """MakeHuman's age slider value (0 … 1) for an age in years."""
+    values, years_at = zip(*AGE_ANCHORS)
+    return float(np.interp(years, years_at, values))
+
+
+def _split(value: float, anchors: tuple[float, ...], names: tuple[str, ...]) -> dict[str, float]:
+    """Piecewise-linear partition of unity of ``value`` over anchored names."""
+    weights = dict.fromkeys(names, 0.0)
+    value = min(max(value, anchors[0]), anchors[-1])
+    for i in range(len(anchors) - 1):
+        lo, hi = anchors[i], anchors[i + 1]
+        if value <= hi:
+            t = (value - lo) / (hi - lo)
+            weights[names[i]] += 1.0 - t
+            weights[names[i + 1]] += t
+            break
+    return weights
+
+
+def macro_weights(character: Character) -> dict[str, float]:
+    """Weight of every macro target (name without ``macrodetails/``) for ``character``."""
+    gender = {"female": 1.0 - character.gender, "male": character.gender}
+    age = _split(age_slider(character.age), tuple(a for a, _ in AGE_ANCHORS), AGE_NAMES)
+    muscle = _split(character.muscle, (0.0, 0.5, 1.0), LEVEL_NAMES["muscle"])
+    weight = _split(character.weight, (0.0, 0.5, 1.0), LEVEL_NAMES["weight"])
+    out: dict[str, float] = {}
+    for g, wg in gender.items():
+        for a, wa in age.items():
+            for race, wr in character.ethnicity.items():
+                out[f"{race}-{g}-{a}"] = wr * wg * wa
+            for m, wm in muscle.items():
+                for w, ww in weight.items():
+                    out[f"universal-{g}-{a}-{m}-{w}"] = wg * wa * wm * ww
+    return {k: v for k, v in out.items() if v > 1e-6}
+
+
+def face_shape_weights(face: Mapping[str, float], available: set[str]) -> dict[str, float]:
+    """Target weights for face-shape sliders; raises for unknown slider names."""
+    out: dict[str, float] = {}
+    for slider, value in face.items():
+        folder, _, stem = slider.partition("/")
+        if folder not in FACE_SHAPE_FOLDERS or not stem:
+            raise CharacterError(f"unknown face-shape slider {slider!r}; names look like 'nose/nose-hump'")
+        stems = [stem] if f"{folder}/{stem}" in available or _ends(folder, stem, available) else [
+            s for s in (f"l-{stem}", f"r-{stem}") if _ends(folder, s, available)
+        ]
+        if not stems:
+            raise CharacterError(f"unknown face-shape slider {slider!r}; `facsim characters --sliders` lists them")
+        for s in stems:
+            if f"{folder}/{s}" in available:  # one-ended slider (e.g. head/head-oval)
+                if value < 0:
+                    raise CharacterError(f"face-shape slider {slider!r} only goes from 0 to 1")
+                out[f"{folder}/{s}"] = float(value)
+                continue
+            neg, pos = _ends(folder, s, available)
+            out[f"{folder}/{s}-{pos if value >= 0 else neg}"] = abs(float(value))
+    return out
+
+
+def _ends(folder: str, stem: str, available: set[str]):
+    for neg, pos in zip(_NEGATIVE_ENDS, _POSITIVE_ENDS):
+        if f"{folder}/{stem}-{neg}" in available and f"{folder}/{stem}-{pos}" in available:
+            return neg, pos
+    return None
+
+
+def slider_names(available) -> list[str]:
+    """Every face-shape slider the data offers (sided ones also without l-/r-)."""
+    names = set()
+    for target in available:
+        folder, _, file = target.partition("/")
+        if folder not in FACE_SHAPE_FOLDERS:
+            continue
+        stem = re.sub(r"-(%s)$" % "|".join(_NEGATIVE_ENDS + _POSITIVE_ENDS), "", file)
+        names.add(f"{folder}/{stem}")
+        names.add(f"{folder}/{re.sub(r'^[lr]-', '', stem)}")
+    return sorted(names)
+
+
+def ethnic_mix(character: Character) -> dict[str, float]:
+    """Ethnicity weights, used to mix per-ethnicity expression units."""
+    return character.ethnicity
+
+
+def character_weights(character: Character, available: set[str]) -> dict[str, float]:
+    """All target weights (macro + face shape) for ``character``."""
+    weights = {f"macrodetails/{k}": v for k, v in macro_weights(character).items()}
+    weights.update(face_shape_weights(character.face, available))
+    return weights
+
+
+def apply_targets(base: np.ndarray, data, weights: Mapping[str, float]) -> np.ndarray:
+    """``base + Σ w·target`` over named targets of ``data`` (float32 copy)."""
+    out = np.array(base, np.float32, copy=True)
+    for name, w in weights.items():
+        idx, delta = data.target(name)
+        out[idx] += w * delta  # a target lists each vertex once
+    return out
+
+
+def character_offsets(character: Character, data) -> np.ndarray:
+    """Morphed base vertices (19158, 3) for ``character``."""
+    return apply_targets(data.base_vertices, data, character_weights(character, set(data.target_names)))
+
+
+# ------------------------------------------------------------------ presets
+
+
+@lru_cache(maxsize=1)
+def _preset_table() -> dict:
+    text = resources.files("facsim").joinpath("data/characters.yaml").read_text()
+    return yaml.safe_load(text)
+
+
+def preset_names() -> list[str]:
+    return list(_preset_table()["presets"])
+
+
+def preset(name: str) -> Character:
+    """The named preset character (see ``facsim/data/characters.yaml``)."""
+    table = _preset_table()["presets"]
+    if name not in table:
+        raise CharacterError(f"unknown character {name!r}; choose from {', '.join(table)} (or 'random:SEED')")
+    entry = dict(table[name])
+    return Character(name=name, **entry)
+
+
+def random_character(seed: int) -> Character:
+    """A seeded random adult: the same seed always gives the same person."""
+    rng = np.random.default_rng(seed)
+    mix = rng.dirichlet([0.6, 0.6, 0.6])
+    face = {
+        slider: float(np.clip(rng.normal(0.0, 0.2), -0.5, 0.5))
+        for slider in ("nose/nose-scale-horiz", "nose/nose-hump", "nose/nose-point-width", "mouth/mouth-scale-horiz",
+                       "mouth/mouth-lowerlip-volume", "chin/chin-width", "chin/chin-prominent", "cheek/cheek-bones",
+                       "eyes/eye-scale", "head/head-scale-horiz", "forehead/forehead-scale-vert", "eyebrows/eyebrows-angle")
+    }
+    return Character(
+        gender=float(np.clip(rng.integers(0, 2) + rng.normal(0.0, 0.08), 0, 1)),
+        age=float(rng.uniform(18, 80)),
+        african=float(mix[0]), asian=float(mix[1]), caucasian=float(mix[2]),
+        muscle=float(np.clip(rng.normal(0.5, 0.12), 0, 1)),
+        weight=float(np.clip(rng.normal(0.5, 0.15), 0, 1)),
+        face=face,
+        name=f"random:{seed}",
+    )
+
+
+def resolve_character(spec) -> Character:
+    """A Character from a preset name, ``"random:SEED"``, a mapping or a Character."""
+    if isinstance(spec, Character):
+        return spec
+    if isinstance(spec, Mapping):
+        return Character(**spec)
+    if spec is None:
+        return preset(_preset_table()["default"])
+    text = str(spec)
+    if text.startswith("random:") or text.startswith("random"):
+        seed = text.partition(":")[2] or "0"
+        if not seed.isdigit():
+            raise CharacterError(f"random characters are named 'random:SEED' with an integer seed, got {text!r}")
+        return random_character(int(seed))
+    return preset(text)

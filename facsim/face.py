@@ -1,0 +1,171 @@
+"""The user-facing face: a character, an engine and a renderer behind one object.
+
+Examples
+--------
+>>> face = Face("ava")                                    # doctest: +SKIP
+>>> image = face.render("6+12", view="three-quarter-left") # doctest: +SKIP
+>>> face.save("smile.png", "6+12C", size=512)             # doctest: +SKIP
+"""
+from __future__ import annotations
+
+from functools import cached_property, lru_cache
+
+import numpy as np
+
+from .assets import load_face_data
+from .character import Character, resolve_character
+from .expression import Activations, activations
+from .head import HeadModel, build_head
+
+ENGINES = ("registers", "muscle")
+#: Framing uses the skin above this height below the chin (dm), so a portrait
+#: shows the whole head with a little neck, the same in every frame.
+NECK_SHOWN = 0.45
+
+
+@lru_cache(maxsize=1)
+def load_head() -> HeadModel:
+    """The head model, built once per process from the cached face data."""
+    return build_head(load_face_data())
+
+
+def engine_class(name: str):
+    """The deformation engine class called ``name`` (imported lazily)."""
+    if name == "registers":
+        from .registers import RegisterEngine
+
+        return RegisterEngine
+    if name == "muscle":
+        from .muscle import MuscleEngine
+
+        return MuscleEngine
+    raise ValueError(f"unknown engine {name!r}; choose from {', '.join(ENGINES)}")
+
+
+def to_activations(expression, *, intensities: str = "hapfacs") -> Activations:
+    """Activations from a FACS string, an Expression, Activations or None (neutral)."""
+    if expression is None:
+        return Activations()
+    if isinstance(expression, Activations):
+        return expression
+    if isinstance(expression, str):
+        from .notation import parse
+
+        expression = parse(expression, intensities=intensities)
+    return activations(expression)
+
+
+class Face:
+    """A character's face: deform it with FACS, render it.
+
+    Parameters
+    ----------
+    character : str, mapping or Character
+        A preset name (``facsim characters``), ``"random:SEED"``, or parameters.
+    engine : {"registers", "muscle"}
+        How AUs move the face: HapFACS-style morph targets, or the muscle engine.
+    """
+
+    def __init__(self, character="ava", *, engine: str = "registers"):
+        self.character: Character = resolve_character(character)
+        self.head = load_head()
+        self.engine_name = engine
+        self._engine_class = engine_class(engine)
+        self._renderers: dict = {}
+
+    @cached_property
+    def data(self):
+        return load_face_data()
+
+    @cached_property
+    def base_positions(self) -> np.ndarray:
+        """The character's neutral base mesh (19158, 3)."""
+        from .character import character_offsets
+
+        return character_offsets(self.character, self.data)
+
+    @cached_property
+    def engine(self):
+        """The engine: a callable ``activations -> geometry positions``."""
+        return self._engine_class(self.head, self.data, self.character, self.base_positions)
+
+    @cached_property
+    def neutral(self) -> np.ndarray:
+        """Neutral geometry positions (N_geo, 3)."""
+        return self.head.positions(self.base_positions)
+
+    @cached_property
+    def appearance(self):
+        from .appearance import character_appearance
+
+        return character_appearance(self.character, self.head)
+
+    def deform(self, expression=None) -> np.ndarray:
+        """Geometry positions (N_geo, 3) showing ``expression`` (FACS string, Expression or Activations)."""
+        act = to_activations(expression)
+        return self.engine(act) if act else self.neutral
+
+    def camera(self, *, view: str = "front", yaw=None, pitch=None, projection="perspective", size=(512, 512), fov_deg=None):
+        """A camera framing this character's head and upper neck."""
+        from .camera import DEFAULT_FOV_DEG, frame_points
+
+        skin = self.neutral[self.head.skin]
+        chin = float(self.head.joint(self.base_positions, "joint-jaw")[1])
+        keep = skin[:, 1] > chin - NECK_SHOWN
+        width, height = size
+        return frame_points(skin[keep], view=view, yaw=yaw, pitch=pitch, projection=projection,
+                            fov_deg=fov_deg or DEFAULT_FOV_DEG, margin=0.06, aspect=width / height)
+
+    def renderer(self, size=(512, 512), *, antialias: int = 2, background=(1.0, 1.0, 1.0)):
+        """A renderer for this head (cached per size, anti-aliasing and background)."""
+        from .render import Renderer
+
+        key = (tuple(size), antialias, None if background is None else tuple(background))
+        if key not in self._renderers:
+            self._renderers[key] = Renderer(self.head.topology, size=tuple(size), antialias=antialias, background=background)
+        return self._renderers[key]
+
+    def render(self, expression=None, *, view: str = "front", yaw=None, pitch=None, size=512,
+               projection: str = "perspective", background=(1.0, 1.0, 1.0), antialias: int = 2,
+               positions=None, wrinkle=None) -> np.ndarray:
+        """Render ``expression`` to an (H, W, 4) uint8 RGBA image.
+
+        ``background=None`` gives a transparent background. ``positions`` renders
+        given geometry instead of deforming (e.g. from another engine).
+        """
+        size = _size_pair(size)
+        if positions is None:
+            positions = self.deform(expression)
+            wrinkle = getattr(self.engine, "last_wrinkle", None) if wrinkle is None else wrinkle
+        camera = self.camera(view=view, yaw=yaw, pitch=pitch, projection=projection, size=size)
+        return self.renderer(size, antialias=antialias, background=background).render(
+            np.asarray(positions, np.float32), appearance=self.appearance, camera=camera, wrinkle=wrinkle
+        )
+
+    def save(self, path, expression=None, **render_options) -> np.ndarray:
+        """Render and write a PNG atomically; returns the image."""
+        from .render import write_png
+
+        image = self.render(expression, **render_options)
+        write_png(path, image)
+        return image
+
+    def close(self) -> None:
+        for renderer in self._renderers.values():
+            renderer.close()
+        self._renderers.clear()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+def _size_pair(size) -> tuple[int, int]:
+    if isinstance(size, (int, np.integer)):
+        size = (int(size), int(size))
+    width, height = (int(v) for v in size)
+    if not (16 <= width <= 8192 and 16 <= height <= 8192):
+        raise ValueError(f"image size must be between 16 and 8192 pixels per side, got {width}x{height}")
+    return width, height
