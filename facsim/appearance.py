@@ -113,7 +113,7 @@ def paint_texture(head, blush: float) -> np.ndarray:
     cheeks = blush * cheek_density(positions)
     lips = _resize(data_masks["lips"].astype(np.float32) / 255, PAINT_SIZE)
     lids = _resize(data_masks["eyelids"].astype(np.float32) / 255, PAINT_SIZE)
-    paint = np.stack([brows, lips, lids, cheeks], axis=-1)[::-1]  # image order: row 0 is v = 1
+    paint = np.stack([brows, lips, lids, cheeks], axis=-1)  # GL order: row 0 is v = 0
     return np.ascontiguousarray(np.clip(paint * 255 + 0.5, 0, 255).astype(np.uint8))
 
 

@@ -248,8 +248,18 @@ def preset(name: str) -> Character:
     table = _preset_table()["presets"]
     if name not in table:
         raise CharacterError(f"unknown character {name!r}; choose from {', '.join(table)} (or 'random:SEED')")
-    entry = dict(table[name])
-    return Character(name=name, **entry)
+    return character_from_mapping({"name": name, **table[name]})
+
+
+def character_from_mapping(entry: Mapping) -> Character:
+    """A Character from plain parameters; ethnicities not given count as 0 when any is given."""
+    entry = dict(entry)
+    unknown = set(entry) - set(Character.__dataclass_fields__)
+    if unknown:
+        raise CharacterError(f"unknown character parameter(s) {', '.join(sorted(unknown))}")
+    if any(e in entry for e in ETHNICITIES):
+        entry = {**dict.fromkeys(ETHNICITIES, 0.0), **entry}
+    return Character(**entry)
 
 
 def random_character(seed: int) -> Character:
@@ -278,7 +288,7 @@ def resolve_character(spec) -> Character:
     if isinstance(spec, Character):
         return spec
     if isinstance(spec, Mapping):
-        return Character(**spec)
+        return character_from_mapping(spec)
     if spec is None:
         return preset(_preset_table()["default"])
     text = str(spec)

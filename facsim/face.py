@@ -142,6 +142,12 @@ class Face:
             np.asarray(positions, np.float32), appearance=self.appearance, camera=camera, wrinkle=wrinkle
         )
 
+    def start_animation(self) -> "Animation":
+        """A frame stepper for videos (engines with state apply only each frame's change)."""
+        if hasattr(self.engine, "reset"):
+            self.engine.reset()
+        return Animation(self.engine)
+
     def save(self, path, expression=None, **render_options) -> np.ndarray:
         """Render and write a PNG atomically; returns the image."""
         from .render import write_png
@@ -160,6 +166,18 @@ class Face:
 
     def __exit__(self, *exc):
         self.close()
+
+
+class Animation:
+    """Steps an engine frame by frame: ``positions, wrinkle = animation.step(activations)``."""
+
+    def __init__(self, engine):
+        self.engine = engine
+        self._stateful = hasattr(engine, "step")
+
+    def step(self, act: Activations):
+        positions = self.engine.step(act) if self._stateful else self.engine(act)
+        return positions, getattr(self.engine, "last_wrinkle", None)
 
 
 def _size_pair(size) -> tuple[int, int]:

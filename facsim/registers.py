@@ -28,6 +28,10 @@ from .expression import SIDES, Activations
 
 #: Half-width (dm) of the smooth left/right split of two-sided targets at the midline.
 MIDLINE_BLEND = 0.06
+#: One-sided targets may act across the midline (the lips are one piece) but not
+#: beyond this band (dm): the authored Face Units carry stray offsets on the far
+#: side (eyeBlinkLeft moves the right eye socket), which unilateral AUs must not show.
+SIDED_REACH = (0.05, 0.15)
 
 
 @lru_cache(maxsize=1)
@@ -58,9 +62,17 @@ def combine_registers(contributions: Iterable[tuple[float, float]]) -> float:
 class Column:
     """One morph direction: a target (or an ethnicity mix of one) on one side or both."""
 
-    target: str          # name after {Side}/{side}/{s} expansion; may hold {ethnicity}
+    pattern: str         # target name with {Side}/{side}/{s} (and maybe {ethnicity}) unexpanded
     side: str            # "left" or "right"
-    sided: bool          # a one-sided target; otherwise the ``side`` half of a two-sided one
+
+    @property
+    def target(self) -> str:
+        return _expand(self.pattern, self.side)[0]
+
+    @property
+    def sided(self) -> bool:
+        """A one-sided target; otherwise this column is the ``side`` half of a two-sided one."""
+        return _expand(self.pattern, self.side)[1]
 
 
 def _expand(pattern: str, side: str) -> tuple[str, bool]:
@@ -79,9 +91,10 @@ def register_weights(act: Activations) -> dict[Column, float]:
     table = register_table()["action_units"]
     contributions: dict[Column, list[tuple[float, float]]] = {}
     for (code, side), level in act:
+        if table.get(code, {}).get("direction") and side == "right" and act[code, "left"] == level:
+            continue  # a direction code given without a side (e.g. 30) moves to the left only
         for reg in table.get(code, {}).get("registers", []):
-            name, sided = _expand(reg["target"], side)
-            contributions.setdefault(Column(name, side, sided), []).append((level, float(reg["max"])))
+            contributions.setdefault(Column(reg["target"], side), []).append((level, float(reg["max"])))
     return {col: combine_registers(pairs) for col, pairs in contributions.items()}
 
 
@@ -108,14 +121,22 @@ class RegisterEngine:
         self._geo_of_base = np.full(len(data.base_vertices), -1, np.int64)
         self._geo_of_base[head.base_index] = np.arange(len(head.base_index))
         x = self.base_positions[head.base_index, 0]
-        t = np.clip((x + MIDLINE_BLEND) / (2 * MIDLINE_BLEND), 0, 1)
-        self._half = {"left": t * t * (3 - 2 * t), "right": 1 - t * t * (3 - 2 * t)}
+        self._half = _smoothstep(-MIDLINE_BLEND, MIDLINE_BLEND, x)
+        self._reach = _smoothstep(-SIDED_REACH[1], -SIDED_REACH[0], x)  # left-side targets
         self._columns: dict[Column, np.ndarray] = {}
         self._table = register_table()
         self.last_wrinkle = None  # this engine computes no skin compression
 
     def column(self, col: Column) -> np.ndarray:
-        """Offsets (N_base_geo, 3) of one column, mixed by ethnicity and split by side."""
+        """Offsets (N_base_geo, 3) of one column, mixed by ethnicity and split by side.
+
+        Right-side columns are the mirror images of the left ones: the authored
+        targets are a little asymmetric, and FACS stimuli must not be.
+        """
+        if col not in self._columns and col.side == "right":
+            left = self.column(Column(col.pattern, "left"))
+            mirror = self.head.mirror[: len(self.head.base_index)]
+            self._columns[col] = left[mirror] * np.array([-1.0, 1.0, 1.0], np.float32)
         if col not in self._columns:
             offsets = np.zeros((len(self.head.base_index), 3), np.float32)
             mixes = self.ethnicity.items() if "{ethnicity}" in col.target else [(None, 1.0)]
@@ -125,13 +146,12 @@ class RegisterEngine:
                 geo = self._geo_of_base[idx]
                 keep = geo >= 0
                 offsets[geo[keep]] += weight * delta[keep]
-            if not col.sided:
-                offsets *= self._half[col.side][:, None]
+            offsets *= (self._reach if col.sided else self._half)[:, None]
             self._columns[col] = offsets
         return self._columns[col]
 
     def __call__(self, act: Activations) -> np.ndarray:
-        base = self.neutral[: len(self.head.base_index)].copy()
+        base = self.base_positions[self.head.base_index]  # a copy (fancy indexing)
         for col, weight in register_weights(act).items():
             if weight:
                 base += weight * self.column(col)
@@ -166,12 +186,16 @@ class RegisterEngine:
         pivot = self.head.joint(self.base_positions, "joint-neck")
         blend = self._table["neck_blend"]
         height = self.neutral[:, 1] - pivot[1]
-        t = np.clip((height - blend["none_below"]) / (blend["full_above"] - blend["none_below"]), 0, 1)
-        weight = (t * t * (3 - 2 * t))[:, None]
+        weight = _smoothstep(blend["none_below"], blend["full_above"], height)[:, None]
         # Interpolate the rotation angle per vertex (not the moved positions), so the neck twists smoothly.
         rel = positions - pivot
         moved = Rotation.from_rotvec(weight * rotvec[None, :]).apply(rel) + pivot + weight * shift
         return moved.astype(np.float32)
+
+
+def _smoothstep(edge0: float, edge1: float, x: np.ndarray) -> np.ndarray:
+    t = np.clip((x - edge0) / (edge1 - edge0), 0, 1)
+    return (t * t * (3 - 2 * t)).astype(np.float32)
 
 
 def coverage() -> dict[int, str]:

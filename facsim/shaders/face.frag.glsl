@@ -1,0 +1,197 @@
+// Face fragment shader. One variant per region (render.py draws each region's faces with its
+// own program, so a fragment runs only its region's code: on llvmpipe both sides of a branch
+// cost, even when a uniform switches one off). Variants:
+//   REGION_SKIN (+ USE_UV, USE_WRINKLE), REGION_EYEBALL (+ USE_EYE), REGION_TEETH,
+//   REGION_TONGUE, REGION_MOUTH_INTERIOR, REGION_LASHES.
+// All colour uniforms are linear RGB (render.py linearises the appearance's sRGB colours).
+
+#include "common.glsl"
+
+in vec3 v_pos;
+in vec3 v_normal;
+in float v_occlusion;
+#ifdef USE_UV
+in vec2 v_uv;
+#endif
+#ifdef USE_EYE
+in vec3 v_eye;
+#endif
+#ifdef USE_WRINKLE
+in float v_wrinkle;
+#endif
+#ifdef USE_LASH
+in float v_lash;
+#endif
+
+out vec4 f_color;
+
+// Two-sided, winding-agnostic: the normal was computed from the same winding that decides
+// gl_FrontFacing, so flipping on back faces always yields the side facing the viewer.
+vec3 surface_normal() {
+    vec3 n = normalize(v_normal);
+    return gl_FrontFacing ? n : -n;
+}
+
+// Diffuse + ambient from the whole rig. `wrap` > 0 lets light bleed past the terminator per
+// channel (a cheap subsurface look when red wraps furthest). `occ` (ambient visibility)
+// dims the ambient, fill and rim fully and the key partly: there are no cast shadows, so
+// occlusion stands in for them in creases and sockets.
+const float KEY_OCCLUSION = 0.6;
+vec3 diffuse_light(vec3 n, vec3 wrap, float occ) {
+    vec3 k = clamp((dot(n, u_key_dir) + wrap) / (1.0 + wrap), 0.0, 1.0);
+    vec3 f = clamp((dot(n, u_fill_dir) + wrap) / (1.0 + wrap), 0.0, 1.0);
+    vec3 r = clamp((dot(n, u_rim_dir) + wrap) / (1.0 + wrap), 0.0, 1.0);
+    return k * u_key_col * mix(1.0, occ, KEY_OCCLUSION)
+         + (f * u_fill_col + r * u_rim_col + hemisphere(n)) * occ;
+}
+
+vec3 specular_light(vec3 n, vec3 v, float shininess) {
+    return blinn(n, u_key_dir, v, shininess) * u_key_col
+         + blinn(n, u_fill_dir, v, shininess) * u_fill_col
+         + blinn(n, u_rim_dir, v, shininess) * u_rim_col;
+}
+
+#ifdef REGION_SKIN
+uniform sampler2D u_paint;   // R brow hair density, G lips, B eyelids, A cheek blush
+uniform vec3 u_skin;
+uniform vec3 u_lips;
+uniform vec3 u_brows;
+uniform vec3 u_eyelid;
+uniform vec3 u_cheek;
+uniform float u_wrinkle_darken;
+
+// Brow hair: thin strokes whose coverage grows with the painted density. u_brow_frame maps
+// skin UV to stroke space (x along the hairs, one unit ~ a stroke length; y across, one unit
+// ~ a strand width); render.py's default fits hm08's UV layout. Where strands would be finer
+// than a pixel the pattern fades to its mean coverage, so it does not alias.
+uniform mat2 u_brow_frame;
+// Returns (coverage, strand shade) for the brow colour over skin.
+vec2 brow_hair(vec2 uv, float density) {
+    if (density <= 0.002) return vec2(0.0, 1.0);
+    vec2 p = u_brow_frame * uv;
+    p.y += 0.6 * sin(p.x * 1.3) + 1.5 * value_noise(p * vec2(0.4, 0.004), 0);
+    float n = 0.6 * value_noise(p, 0) + 0.4 * value_noise(p * vec2(2.3, 1.9) + 31.0, 0);
+    float threshold = 0.95 - 0.75 * density;
+    float aa = fwidth(n) + 0.05;
+    float strands = smoothstep(threshold - aa, threshold + aa, n);
+    float base = smoothstep(0.0, 0.5, density);
+    float detail = clamp(2.5 - 2.0 * fwidth(p.y), 0.0, 1.0);   // strands per pixel across
+    float cover = base * mix(0.75, 0.4 + 0.55 * strands, detail);
+    return vec2(cover, mix(1.0, 0.75 + 0.5 * n, detail));
+}
+#endif
+
+#ifdef REGION_EYEBALL
+uniform vec3 u_sclera;
+uniform vec3 u_iris;
+uniform vec3 u_pupil;
+// Radii as fractions of the eyeball radius, measured in the plane across the gaze axis
+// (length of eye_coord.xy on the front half): iris 6 mm and pupil 1.5 mm on a 12 mm eye.
+const float IRIS_RADIUS = 0.5;     // angular radius asin(0.5) = 30 degrees
+const float PUPIL_RADIUS = 0.125;
+const float LIMBUS_WIDTH = 0.22;   // fraction of the iris annulus darkened at its rim
+const int IRIS_FIBRES = 96;        // radial noise cells around the iris
+#endif
+
+#if defined(REGION_TEETH) || defined(REGION_TONGUE) || defined(REGION_MOUTH_INTERIOR) || defined(REGION_LASHES)
+uniform vec3 u_albedo;
+#endif
+
+#ifdef REGION_LASHES
+// Lashes are drawn last, blended. render.py puts each lash vertex's root-to-tip coordinate
+// (0 at the lid, 1 at the tip: distance from the nearest eyeball centre, normalised per lash
+// strip) in in_wrinkle's slot. Strands are a stripe pattern along world x (the lid line in
+// the head's frame) whose strands end at random lengths, so the lash strips read as tapering
+// hairs rather than a dark band.
+const float LASH_STRANDS_PER_DM = 300.0;
+#endif
+
+void main() {
+    vec3 n = surface_normal();
+    vec3 v = normalize(u_cam_pos - v_pos);
+    float occ = clamp(v_occlusion, 0.0, 1.0);
+    float alpha = 1.0;
+    vec3 radiance;
+
+#ifdef REGION_SKIN
+    vec4 paint = texture(u_paint, v_uv);
+    // Faint mottling at two scales so large areas are not a flat plastic colour.
+    float mottle = 0.6 * value_noise(v_uv * 150.0, 0) + 0.4 * value_noise(v_uv * 600.0 + 17.0, 0);
+    vec3 albedo = u_skin * (1.0 + vec3(0.07, 0.09, 0.09) * (mottle - 0.5));
+    albedo = mix(albedo, u_cheek, paint.a);
+    albedo = mix(albedo, u_eyelid, paint.b);
+    albedo = mix(albedo, u_lips, paint.g);
+    vec2 brow = brow_hair(v_uv, paint.r);
+    float hair = brow.x;
+    albedo = mix(albedo, u_brows * brow.y, hair);
+    float cavity = 1.0;
+#ifdef USE_WRINKLE
+    cavity = 1.0 - u_wrinkle_darken * clamp(v_wrinkle, 0.0, 1.0);
+#endif
+    vec3 wrap = vec3(0.45, 0.22, 0.16) * (1.0 - hair);
+    vec3 diffuse = diffuse_light(n, wrap, occ) * albedo;
+    // Broad, low sheen on skin; a tighter, stronger one on the (wet) lips; none on hair.
+    float ndv = max(dot(n, v), 0.0);
+    float fres = schlick(0.028, ndv);
+    float lips = paint.g;
+    vec3 spec = specular_light(n, v, mix(18.0, 70.0, lips)) * mix(0.9, 2.2, lips)
+              + specular_light(n, v, 120.0) * 0.25 * (1.0 - lips);
+    radiance = (diffuse + spec * fres * (1.0 - hair) * occ) * cavity;
+#endif
+
+#ifdef REGION_EYEBALL
+    vec3 e = normalize(v_eye);
+    float r = length(e.xy);
+    float front = step(0.0, e.z);
+    float aa = max(fwidth(r), 1e-4);
+    float iris_mask = front * (1.0 - smoothstep(IRIS_RADIUS - aa, IRIS_RADIUS + aa, r));
+    float pupil_mask = front * (1.0 - smoothstep(PUPIL_RADIUS - aa, PUPIL_RADIUS + aa, r));
+    float t = clamp((r - PUPIL_RADIUS) / (IRIS_RADIUS - PUPIL_RADIUS), 0.0, 1.0);
+    float turns = (atan(e.y, e.x) / (2.0 * PI) + 0.5) * float(IRIS_FIBRES);
+    float fibre = 0.6 * value_noise(vec2(turns, t * 5.0), IRIS_FIBRES)
+                + 0.4 * value_noise(vec2(turns * 0.5, t * 11.0 + 7.0), IRIS_FIBRES / 2);
+    vec3 iris = u_iris * (0.55 + 0.9 * fibre);
+    iris *= mix(1.3, 1.0, smoothstep(0.15, 0.45, t));                // lighter collarette
+    iris *= mix(1.0, 0.35, smoothstep(1.0 - LIMBUS_WIDTH, 1.0, t));  // dark limbal ring
+    iris = mix(iris, u_pupil, pupil_mask);
+    float theta = acos(clamp(e.z, -1.0, 1.0));
+    vec3 sclera = u_sclera * mix(vec3(1.0), vec3(1.0, 0.80, 0.78), smoothstep(0.9, 1.7, theta));
+    vec3 albedo = mix(sclera, iris, iris_mask);
+    // The lids shade the top of the eyeball; the world normal's height is a stand-in.
+    float lid_shade = 1.0 - 0.3 * smoothstep(0.0, 0.6, n.y);
+    vec3 diffuse = diffuse_light(n, vec3(0.1), occ) * albedo * lid_shade;
+    // Wet surface: crisp catch-lights (cornea) plus a broader sheen.
+    vec3 spec = specular_light(n, v, 1600.0) * 0.35 + specular_light(n, v, 150.0) * 0.08;
+    radiance = diffuse + spec * schlick(0.04, max(dot(n, v), 0.0)) * 8.0 * occ;
+#endif
+
+#ifdef REGION_TEETH
+    vec3 spec = specular_light(n, v, 60.0) * 0.12;
+    radiance = diffuse_light(n, vec3(0.15), 1.0) * u_albedo + spec;
+#endif
+
+#ifdef REGION_TONGUE
+    vec3 spec = specular_light(n, v, 35.0) * 0.08;
+    radiance = diffuse_light(n, vec3(0.3, 0.15, 0.1), 1.0) * u_albedo + spec;
+#endif
+
+#ifdef REGION_MOUTH_INTERIOR
+    // Mostly hidden and in the mouth's own shadow: dim, a little wet.
+    vec3 spec = specular_light(n, v, 30.0) * 0.04;
+    radiance = diffuse_light(n, vec3(0.3, 0.1, 0.1), 1.0) * u_albedo * 0.55 + spec;
+#endif
+
+#ifdef REGION_LASHES
+    radiance = diffuse_light(n, vec3(0.5), occ) * u_albedo;
+    float t = clamp(v_lash, 0.0, 1.0);
+    float x = v_pos.x * LASH_STRANDS_PER_DM;
+    float strand = value_noise(vec2(x, 0.0), 0);
+    float threshold = mix(0.3, 0.95, pow(t, 0.6));
+    float aa = fwidth(strand) + 0.05;
+    float hairs = smoothstep(threshold - aa, threshold + aa, strand);
+    float mean = clamp(0.9 - 0.9 * t, 0.0, 1.0) * 0.7;
+    alpha = mix(mean, hairs * (1.0 - 0.4 * t), clamp(2.0 - 2.0 * fwidth(x), 0.0, 1.0));
+#endif
+
+    f_color = vec4(finish(radiance).rgb, alpha);
+}

@@ -1,0 +1,47 @@
+// Face vertex shader. Variants (#defines from render.py): USE_UV, USE_EYE, USE_WRINKLE, USE_LASH.
+// Regions that ignore occlusion let the compiler drop it (render.py tolerates that).
+in vec3 in_pos;      // world position (decimetres)
+in vec3 in_normal;   // smooth world normal, computed on geometry vertices in numpy
+in float in_occlusion;  // ambient visibility 0..1 (1 = open sky), per geometry vertex
+#if defined(USE_WRINKLE) || defined(USE_LASH)
+in float in_wrinkle;  // skin: wrinkle amount; lashes: root-to-tip coordinate
+#endif
+#ifdef USE_WRINKLE
+out float v_wrinkle;
+#endif
+#ifdef USE_LASH
+out float v_lash;
+#endif
+#ifdef USE_UV
+in vec2 in_uv;
+out vec2 v_uv;
+#endif
+#ifdef USE_EYE
+in vec3 in_eye;      // direction from the eye centre in the eye's own frame, +Z = gaze
+out vec3 v_eye;
+#endif
+
+uniform mat4 u_view_proj;
+
+out vec3 v_pos;
+out vec3 v_normal;
+out float v_occlusion;
+
+void main() {
+    v_pos = in_pos;
+    v_normal = in_normal;
+    v_occlusion = in_occlusion;
+#ifdef USE_WRINKLE
+    v_wrinkle = in_wrinkle;
+#endif
+#ifdef USE_LASH
+    v_lash = in_wrinkle;
+#endif
+#ifdef USE_UV
+    v_uv = in_uv;
+#endif
+#ifdef USE_EYE
+    v_eye = in_eye;
+#endif
+    gl_Position = u_view_proj * vec4(in_pos, 1.0);
+}

