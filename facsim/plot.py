@@ -17,7 +17,8 @@ from pathlib import Path
 import numpy as np
 
 from facsim.catalogue import INTENSITY_TABLES, catalogue
-from facsim.timeline import Timeline, _atomic_write, frame_times, intensity_curves
+from facsim.atomic import atomic_write
+from facsim.timeline import Timeline, frame_times, intensity_curves
 
 #: File types :func:`plot_timeline` writes, by suffix.
 PLOT_FORMATS = {".png": "png", ".svg": "svg"}
@@ -127,4 +128,4 @@ def plot_timeline(timeline: Timeline, path: str | os.PathLike, *, fps: float | N
                   title="L/R = character's left/right" if sided else None, title_fontsize=7)
     else:
         ax.text(0.5, 0.5, "no action units", transform=ax.transAxes, ha="center", color="0.5")
-    return _atomic_write(path, lambda tmp: fig.savefig(tmp, format=fmt))
+    return atomic_write(path, lambda tmp: fig.savefig(tmp, format=fmt))

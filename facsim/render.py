@@ -82,14 +82,21 @@ AA_METHODS = ("msaa", "ssaa")
 HM08_BROW_UV_FRAME = ((0.0, 80.0), (1600.0, 0.0))
 
 _SHADER_DIR = Path(__file__).with_name("shaders")
-_REGION_DEFINES = {
+#: Draw groups in drawing order, each with its shader variant's #defines. Skin triangles
+#: under painted brows get the brow-hair code; others skip it (on llvmpipe a skipped branch
+#: still costs, so variants are cheaper than branches). Lashes are blended, hence last.
+_PASSES = {
     "skin": ("REGION_SKIN", "USE_UV", "USE_WRINKLE"),
+    "skin_brows": ("REGION_SKIN", "USE_UV", "USE_WRINKLE", "USE_BROWS"),
     "mouth_interior": ("REGION_MOUTH_INTERIOR",),
     "teeth": ("REGION_TEETH",),
     "tongue": ("REGION_TONGUE",),
     "eyeball": ("REGION_EYEBALL", "USE_EYE"),
     "lashes": ("REGION_LASHES", "USE_LASH"),
 }
+#: Groups drawn with back faces culled (closed, outward-wound after _fix_winding); the rest
+#: are two-sided (teeth bands, lash cards, the inside of the mouth).
+_CULLED = ("skin", "skin_brows", "eyeball")
 _SINGLE_COLOR = {"mouth_interior": "mouth_interior", "teeth": "teeth", "tongue": "tongue",
                  "lashes": "lashes"}
 
@@ -594,12 +601,17 @@ class Renderer:
         default, :data:`HM08_BROW_UV_FRAME`, fits hm08's raw UV layout; if you rescale the
         UVs (``u' = (u - u0) / (u1 - u0)``), divide column 0 by ``1/(u1 - u0)``, i.e.
         multiply it by ``u1 - u0`` (and likewise column 1 for v).
+    cull_backfaces : bool
+        Skip skin and eyeball triangles facing away (about 1.5x faster). Needs those
+        surfaces closed (cap the neck); the winding is checked on the first frame and
+        flipped if the mesh is wound clockwise. ``False`` draws everything two-sided.
     """
 
     def __init__(self, topology: RenderTopology, *, size=512, antialias: int = 4,
                  aa_method: str = "msaa", background=(0.5, 0.5, 0.5),
                  lighting: Lighting | None = None, wrinkle_depth: float = 0.012,
-                 wrinkle_darken: float = 0.3, brow_uv_frame=HM08_BROW_UV_FRAME):
+                 wrinkle_darken: float = 0.3, brow_uv_frame=HM08_BROW_UV_FRAME,
+                 cull_backfaces: bool = True):
         if not isinstance(topology, RenderTopology):
             raise TypeError(f"topology must be a RenderTopology, got {type(topology).__name__}")
         if aa_method not in AA_METHODS:
@@ -627,16 +639,19 @@ class Renderer:
             raise ValueError(f"antialias (supersampling factor) must be 1..4, got {antialias}")
         self.antialias = antialias
 
-        # Static geometry: normals operator on geometry vertices, faces sorted by region.
+        self.cull_backfaces = bool(cull_backfaces)
+
+        # Static geometry: the normals operator on geometry vertices; triangles are drawn in
+        # groups, one shader variant per group (see _PASSES), skin split by brow coverage.
         self._n_geo = topology.n_geo
+        self._faces = topology.faces.copy()
         self._geo_faces = np.ascontiguousarray(topology.geo_faces)
         self._normal_op = normal_operator(self._geo_faces, self._n_geo)
-        face_region = topology.face_regions()
-        order = np.argsort(face_region, kind="stable")
-        counts = np.bincount(face_region, minlength=len(REGIONS))
-        starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
-        self._draws = [(REGIONS[i], int(starts[i]), int(counts[i]))
-                       for i in range(len(REGIONS)) if counts[i]]
+        self._face_region = topology.face_regions()
+        self._face_uv = topology.uv[topology.faces]             # (M, 3, 2) for brow coverage
+        self._brow_faces = np.zeros(len(self._faces), dtype=bool)
+        self._winding_checked = False
+        self._draws: list[tuple[str, int, int]] = []
         # Per-frame vertex data: position (3), normal (3), wrinkle, occlusion = 32 bytes.
         self._geo_buffer = np.zeros((self._n_geo, 8), dtype=np.float32)
         self._render_buffer = np.zeros((topology.n_render, 8), dtype=np.float32)
@@ -647,7 +662,7 @@ class Renderer:
                                else np.zeros(0, dtype=np.int64))
 
         try:
-            self._setup_gl(topology, topology.faces[order])
+            self._setup_gl(topology)
         except Exception:
             self._release_all()
             raise
@@ -658,32 +673,74 @@ class Renderer:
         self._gl_objects.append(obj)
         return obj
 
-    def _setup_gl(self, topology: RenderTopology, sorted_faces: np.ndarray) -> None:
+    def _program(self, name: str):
+        """The compiled variant for a draw group, compiled on first use."""
+        if name in self._programs:
+            return self._programs[name], self._vaos[name]
+        ctx = self._ctx
+        defines = dict.fromkeys(_PASSES[name], "")
+        prog = self._track(ctx.program(
+            vertex_shader=_shader_source("face.vert.glsl", defines),
+            fragment_shader=_shader_source("face.frag.glsl", defines)))
+        vao = self._track(ctx.vertex_array(
+            prog, [(self._vbo_dynamic, "3f 3f 1f 1f", "in_pos", "in_normal", "in_wrinkle",
+                    "in_occlusion"),
+                   (self._vbo_static, "2f 3f", "in_uv", "in_eye")],
+            index_buffer=self._ibo, index_element_size=4, skip_errors=True))
+        _set_uniform(prog, "u_paint", 0)
+        _set_uniform(prog, "u_wrinkle_darken", self.wrinkle_darken)
+        try:
+            prog["u_brow_frame"].write(self.brow_uv_frame.T.astype(np.float32).tobytes())
+        except KeyError:
+            pass
+        self._programs[name], self._vaos[name] = prog, vao
+        if self._appearance is not None:
+            self._set_colors(name, self._appearance)
+        return prog, vao
+
+    def _rebuild_draws(self) -> None:
+        """Sort the triangles into draw groups and upload the index buffer."""
+        names = list(_PASSES)
+        group = np.array([names.index(REGIONS[r]) for r in range(len(REGIONS))])[self._face_region]
+        group[self._brow_faces & (self._face_region == 0)] = names.index("skin_brows")
+        order = np.argsort(group, kind="stable")
+        self._ibo.write(np.ascontiguousarray(self._faces[order]).tobytes())
+        counts = np.bincount(group, minlength=len(names))
+        starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+        self._draws = [(names[i], int(starts[i]), int(counts[i]))
+                       for i in range(len(names)) if counts[i]]
+        for name, _, _ in self._draws:
+            self._program(name)
+
+    def _fix_winding(self, p: np.ndarray) -> None:
+        """Make skin and eyeballs wound counter-clockwise seen from outside (for culling).
+
+        Decided once, on the first frame: a mesh's orientation does not change with
+        deformation. Shading does not depend on it (normals follow the winding and the
+        shaders face them toward the viewer); only back-face culling does.
+        """
+        skin = self._face_region == 0
+        if skin.any() and _orientation(p, self._geo_faces[skin]) < 0:
+            self._faces = np.ascontiguousarray(self._faces[:, ::-1])
+            self._geo_faces = np.ascontiguousarray(self._geo_faces[:, ::-1])
+        eye_region = REGIONS.index("eyeball")
+        for piece in self._eyes:
+            sel = (self._face_region == eye_region) & np.isin(self._geo_faces[:, 0], piece)
+            if sel.any() and _orientation(p, self._geo_faces[sel]) < 0:
+                self._faces[sel] = self._faces[sel][:, ::-1]
+                self._geo_faces[sel] = self._geo_faces[sel][:, ::-1]
+        self._winding_checked = True
+
+    def _setup_gl(self, topology: RenderTopology) -> None:
         ctx = self._ctx
         static = np.concatenate([topology.uv, topology.eye_coord], axis=1).astype(np.float32)
         self._vbo_static = self._track(ctx.buffer(static.tobytes()))
         self._vbo_dynamic = self._track(ctx.buffer(reserve=self._render_buffer.nbytes,
                                                    dynamic=True))
-        self._ibo = self._track(ctx.buffer(np.ascontiguousarray(sorted_faces).tobytes()))
+        self._ibo = self._track(ctx.buffer(reserve=self._faces.nbytes))
         self._programs, self._vaos = {}, {}
-        vert, frag = "face.vert.glsl", "face.frag.glsl"
-        for region, _, _ in self._draws:
-            defines = dict.fromkeys(_REGION_DEFINES[region], "")
-            prog = self._track(ctx.program(vertex_shader=_shader_source(vert, defines),
-                                           fragment_shader=_shader_source(frag, defines)))
-            vao = self._track(ctx.vertex_array(
-                prog, [(self._vbo_dynamic, "3f 3f 1f 1f", "in_pos", "in_normal", "in_wrinkle",
-                        "in_occlusion"),
-                       (self._vbo_static, "2f 3f", "in_uv", "in_eye")],
-                index_buffer=self._ibo, index_element_size=4, skip_errors=True))
-            self._programs[region], self._vaos[region] = prog, vao
-            _set_uniform(prog, "u_paint", 0)
-            _set_uniform(prog, "u_wrinkle_darken", self.wrinkle_darken)
-            try:
-                prog["u_brow_frame"].write(self.brow_uv_frame.T.astype(np.float32).tobytes())
-            except KeyError:
-                pass
         self._paint_tex = None
+        self._rebuild_draws()
 
         w, h = self.size
         if self.aa_method == "msaa":
@@ -734,18 +791,27 @@ class Renderer:
             tex.write(paint.tobytes())
         tex.build_mipmaps()  # an input texture, never rendered into: mipmaps are safe here
         tex.filter = (ctx.LINEAR_MIPMAP_LINEAR, ctx.LINEAR)
-        colors = {k: tuple(float(x) for x in srgb_to_linear(v))
-                  for k, v in appearance.colors.items()}
-        for region, prog in self._programs.items():
-            if region == "skin":
-                for name in ("skin", "lips", "brows", "eyelid", "cheek"):
-                    _set_uniform(prog, f"u_{name}", colors[name])
-            elif region == "eyeball":
-                for name in ("sclera", "iris", "pupil"):
-                    _set_uniform(prog, f"u_{name}", colors[name])
-            else:
-                _set_uniform(prog, "u_albedo", colors[_SINGLE_COLOR[region]])
         self._appearance = appearance
+        for name in self._programs:
+            self._set_colors(name, appearance)
+        brows = (np.zeros(len(self._faces), dtype=bool) if appearance.paint is None
+                 else _faces_touching(self._face_uv, appearance.paint[..., 0] > 0))
+        if not np.array_equal(brows, self._brow_faces):
+            self._brow_faces = brows
+            self._rebuild_draws()
+
+    def _set_colors(self, name: str, appearance: Appearance) -> None:
+        prog = self._programs[name]
+        colors = appearance.colors
+        lin = lambda key: tuple(float(x) for x in srgb_to_linear(colors[key]))  # noqa: E731
+        if name.startswith("skin"):
+            for key in ("skin", "lips", "brows", "eyelid", "cheek"):
+                _set_uniform(prog, f"u_{key}", lin(key))
+        elif name == "eyeball":
+            for key in ("sclera", "iris", "pupil"):
+                _set_uniform(prog, f"u_{key}", lin(key))
+        else:
+            _set_uniform(prog, "u_albedo", lin(_SINGLE_COLOR[name]))
 
     # -- per frame -----------------------------------------------------------------------
     def render(self, positions: np.ndarray, *, appearance: Appearance, camera: Camera,
@@ -804,6 +870,9 @@ class Renderer:
             occ = occ[: self._n_geo]
             if not np.isfinite(occ).all():
                 raise ValueError("occlusion contains NaN or infinity")
+        if not self._winding_checked:
+            self._fix_winding(p)
+            self._rebuild_draws()
         self._update_vertices(p, w_geo, occ)
         if appearance is not self._appearance:
             self._upload_appearance(appearance)
@@ -854,15 +923,21 @@ class Renderer:
             fbo.clear(*self.background, 1.0, depth=1.0)
         if self._paint_tex is not None:
             self._paint_tex.use(0)
-        for region, first, count in self._draws:
-            if region == "lashes":  # last (REGIONS order): blended strands, no depth writes
+        ctx.front_face = "ccw"
+        for name, first, count in self._draws:
+            if name == "lashes":  # drawn last (_PASSES order): blended strands, no depth writes
                 ctx.enable(ctx.BLEND)
                 ctx.blend_func = (ctx.SRC_ALPHA, ctx.ONE_MINUS_SRC_ALPHA,
                                   ctx.ONE, ctx.ONE_MINUS_SRC_ALPHA)
                 fbo.depth_mask = False
-            self._vaos[region].render(ctx.TRIANGLES, vertices=3 * count, first=3 * first)
+            if self.cull_backfaces and name in _CULLED:
+                ctx.enable(ctx.CULL_FACE)
+                ctx.cull_face = "back"
+            else:
+                ctx.disable(ctx.CULL_FACE)
+            self._vaos[name].render(ctx.TRIANGLES, vertices=3 * count, first=3 * first)
         fbo.depth_mask = True
-        ctx.disable(ctx.BLEND)
+        ctx.disable(ctx.BLEND | ctx.CULL_FACE)
         if self._downsample is not None:
             self._out_fbo.use()
             ctx.disable(ctx.DEPTH_TEST)
@@ -910,6 +985,35 @@ class Renderer:
         state = "closed" if self._closed else "open"
         return (f"Renderer({self.topology.n_render} vertices, {len(self.topology.faces)} faces, "
                 f"size={self.size}, {self.aa_method} x{self.antialias}, {state})")
+
+
+def _orientation(p: np.ndarray, faces: np.ndarray) -> float:
+    """> 0 when the triangles' winding normals point away from their centroid (outward)."""
+    a, b, c = p[faces[:, 0]], p[faces[:, 1]], p[faces[:, 2]]
+    normals = np.cross(b - a, c - a)
+    centres = (a + b + c) / 3.0
+    area = np.linalg.norm(normals, axis=1)
+    centroid = (centres * area[:, None]).sum(0) / max(area.sum(), 1e-30)
+    return float(np.einsum("ij,ij->", centres - centroid, normals))
+
+
+def _faces_touching(face_uv: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """(M,) whether each triangle's UV bounding box covers any set texel of ``mask``.
+
+    ``mask`` is (H, W) in GL row order (row 0 = v = 0); a summed-area table answers each
+    box in four look-ups. Conservative: a box may hold set texels the triangle misses.
+    """
+    h, w = mask.shape
+    sat = np.zeros((h + 1, w + 1), dtype=np.int64)
+    sat[1:, 1:] = np.cumsum(np.cumsum(mask, axis=0), axis=1)
+    lo = face_uv.min(axis=1)
+    hi = face_uv.max(axis=1)
+    c0 = np.clip(np.floor(lo[:, 0] * w).astype(np.int64) - 1, 0, w)
+    c1 = np.clip(np.ceil(hi[:, 0] * w).astype(np.int64) + 1, 0, w)
+    r0 = np.clip(np.floor(lo[:, 1] * h).astype(np.int64) - 1, 0, h)
+    r1 = np.clip(np.ceil(hi[:, 1] * h).astype(np.int64) + 1, 0, h)
+    count = sat[r1, c1] - sat[r0, c1] - sat[r1, c0] + sat[r0, c0]
+    return count > 0
 
 
 def _unpremultiply(img: np.ndarray) -> None:

@@ -97,15 +97,15 @@ import difflib
 import json
 import math
 import os
-import tempfile
 from dataclasses import dataclass
 from functools import lru_cache
 from importlib import resources
 from pathlib import Path
-from typing import Any, Callable, Mapping, Sequence
+from typing import Any, Mapping, Sequence
 
 import numpy as np
 
+from facsim.atomic import atomic_write
 from facsim.catalogue import INTENSITY_TABLES, LETTERS, UnknownActionUnitError, info, intensity_of
 from facsim.easing import get_easing
 from facsim.expression import Activations, activations
@@ -1291,27 +1291,6 @@ def load_timeline(path: str | os.PathLike) -> Timeline:
         raise exc.in_file(path, line) from None
 
 
-def _atomic_write(path: str | os.PathLike, write: Callable[[Path], None]) -> Path:
-    """Call ``write(tmp)`` on a temporary file beside ``path``, then move it into place."""
-    path = Path(path)
-    if path.exists():
-        mode = path.stat().st_mode & 0o777
-    else:                                 # what open() would give: 0o666 less the umask
-        umask = os.umask(0)
-        os.umask(umask)
-        mode = 0o666 & ~umask
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".part")
-    os.close(fd)
-    try:
-        write(Path(tmp))
-        os.chmod(tmp, mode)               # mkstemp makes 0o600 files
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
-
-
 def save_timeline(timeline: Timeline, path: str | os.PathLike) -> Path:
     """Write a timeline as YAML or JSON (by suffix), atomically; returns the path.
 
@@ -1326,7 +1305,7 @@ def save_timeline(timeline: Timeline, path: str | os.PathLike) -> Path:
         text = yaml.safe_dump(data, sort_keys=False, default_flow_style=None, allow_unicode=True, width=100)
     else:
         text = json.dumps(data, indent=2, ensure_ascii=False) + "\n"
-    return _atomic_write(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
+    return atomic_write(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
 
 
 __all__ = [

@@ -14,14 +14,13 @@ Examples
 """
 from __future__ import annotations
 
-import os
-import shutil
 import sys
-import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
+
+from .atomic import commit, discard, temp_beside
 
 FORMATS = {".mp4": "mp4", ".m4v": "mp4", ".webm": "webm", ".gif": "gif"}
 
@@ -66,14 +65,11 @@ class VideoWriter:
         self.frames_written = 0
         self._encoder = None
         self._gif_frames: list = []
-        parent = (self.path if self.format == "png" and self.path.suffix == "" else self.path).parent
-        parent.mkdir(parents=True, exist_ok=True)
-        if self.format == "png":
-            self._tmp = Path(tempfile.mkdtemp(dir=parent, prefix=".facsim-frames-"))
-        else:
-            fd, tmp = tempfile.mkstemp(dir=parent, prefix=".facsim-", suffix=self.path.suffix)
-            os.close(fd)
-            self._tmp = Path(tmp)
+        if self.format == "png" and self.path.suffix:  # "frames.png" names the folder "frames"
+            self.path = self.path.with_suffix("")
+        if not self.path.parent.is_dir():
+            raise FileNotFoundError(f"folder {self.path.parent} does not exist")
+        self._tmp = temp_beside(self.path, directory=self.format == "png")
         self._closed = False
 
     def append(self, frame: np.ndarray) -> None:
@@ -121,15 +117,14 @@ class VideoWriter:
                 from PIL import Image
 
                 images = [Image.fromarray(f) for f in self._gif_frames]
+                # GIF delays are whole centiseconds: spread the rounding so the clip keeps its length.
+                ends = np.round(np.arange(1, len(images) + 1) * 100.0 / self.fps) * 10
+                durations = np.diff(np.concatenate([[0], ends])).astype(int).tolist()
                 images[0].save(self._tmp, format="GIF", save_all=True, append_images=images[1:],
-                               duration=1000.0 / self.fps, loop=0, optimize=False)
+                               duration=durations, loop=0, optimize=False)
             elif self._encoder is not None:
                 self._encoder.close()
-            target = self.path if not (self.format == "png" and self.path.suffix) else self.path.with_suffix("")
-            if self.format == "png" and target.exists():
-                shutil.rmtree(target)
-            os.replace(self._tmp, target)
-            return target
+            return commit(self._tmp, self.path)
         except BaseException:
             self.abort()
             raise
@@ -142,10 +137,7 @@ class VideoWriter:
                 self._encoder.close()
             except Exception:
                 pass
-        if self._tmp.is_dir():
-            shutil.rmtree(self._tmp, ignore_errors=True)
-        else:
-            self._tmp.unlink(missing_ok=True)
+        discard(self._tmp)
 
     def __enter__(self):
         return self

@@ -10,7 +10,7 @@ import yaml
 from facsim.expression import UNILATERAL_DEFAULT_SIDE, Activations
 from facsim.notation import parse
 from facsim.timeline import (
-    BLINK_AU, Blinks, Envelope, Hold, Segment, Timeline, TimelineError, Track, _atomic_write,
+    BLINK_AU, Blinks, Envelope, Hold, Segment, Timeline, TimelineError, Track,
     activation_curves, blink_times, frame_count, frame_times, intensity_curves, load_timeline, sample,
     sample_frames, save_timeline, stimulus_timeline, timeline_from_dict, timeline_schema, timeline_to_dict,
 )
@@ -361,19 +361,6 @@ def test_file_round_trip(tmp_path, suffix):
 def test_saved_files_validate_against_the_schema(tmp_path):
     path = save_timeline(timeline_from_dict(FULL), tmp_path / "t.json")
     jsonschema.validate(json.loads(path.read_text()), timeline_schema())
-
-
-def test_atomic_write_keeps_old_file_on_failure(tmp_path):
-    path = tmp_path / "t.yaml"
-    path.write_text("old")
-
-    def fail(tmp):
-        tmp.write_text("half")
-        raise RuntimeError("disk full")
-
-    with pytest.raises(RuntimeError):
-        _atomic_write(path, fail)
-    assert path.read_text() == "old" and [p.name for p in tmp_path.iterdir()] == ["t.yaml"]
 
 
 def test_schema_is_valid_draft_2020_12():

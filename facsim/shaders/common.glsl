@@ -18,28 +18,33 @@ uniform vec3 u_ground_col;  // hemispheric ambient, world -Y
 uniform float u_exposure;
 
 // ---- colour space -----------------------------------------------------------------------
+// Linear -> sRGB with square roots instead of pow (transcendentals are slow on llvmpipe);
+// within 0.6/255 of the exact curve above 0.0031, and exact (linear segment) below it.
 vec3 srgb_encode(vec3 c) {
     c = clamp(c, 0.0, 1.0);
-    return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(0.0031308, c));
+    vec3 s1 = sqrt(c);
+    vec3 s2 = sqrt(s1);
+    vec3 s3 = sqrt(s2);
+    vec3 curve = 0.662002687 * s1 + 0.684122060 * s2 - 0.323583601 * s3 - 0.0225411470 * c;
+    return mix(12.92 * c, curve, step(0.0031308, c));
 }
 
-// Identity up to 0.8, then a soft shoulder that reaches 1 asymptotically: highlights roll off
-// instead of clipping to flat white patches.
+// Identity up to 0.8, then a soft shoulder that approaches 1: highlights roll off instead of
+// clipping to flat white patches.
 vec3 tonemap(vec3 c) {
-    vec3 shoulder = 0.8 + 0.2 * (1.0 - exp(-(c - 0.8) / 0.2));
-    return mix(c, shoulder, step(0.8, c));
+    vec3 x = max(c - 0.8, 0.0) / 0.2;
+    return min(c, 0.8) + 0.2 * x / (1.0 + x);
 }
 
 // ---- hashing and noise (deterministic: the same inputs give the same image) ---------------
-uint pcg_hash(uint v) {
-    uint state = v * 747796405u + 2891336453u;
-    uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
-    return (word >> 22u) ^ word;
-}
-
+// A cheap integer hash of a lattice point to [0, 1) (a multiply-xorshift mix; ample for
+// visual noise and much cheaper than PCG on llvmpipe, where the fragment shader is the cost).
 float hash2(ivec2 p) {
-    uint h = pcg_hash(uint(p.x) * 1597334677u ^ pcg_hash(uint(p.y)));
-    return float(h) * (1.0 / 4294967295.0);
+    uint h = uint(p.x) * 0x8da6b343u + uint(p.y) * 0xd8163841u;
+    h ^= h >> 15u;
+    h *= 0x2c1b3c6du;
+    h ^= h >> 12u;
+    return float(h >> 8u) * (1.0 / 16777216.0);
 }
 
 // Value noise in [0, 1]; x wraps with integer period `period_x` (0 = no wrap).

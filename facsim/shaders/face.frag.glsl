@@ -1,7 +1,7 @@
 // Face fragment shader. One variant per region (render.py draws each region's faces with its
 // own program, so a fragment runs only its region's code: on llvmpipe both sides of a branch
 // cost, even when a uniform switches one off). Variants:
-//   REGION_SKIN (+ USE_UV, USE_WRINKLE), REGION_EYEBALL (+ USE_EYE), REGION_TEETH,
+//   REGION_SKIN (+ USE_UV, USE_WRINKLE, and USE_BROWS for triangles under painted brows), REGION_EYEBALL (+ USE_EYE), REGION_TEETH,
 //   REGION_TONGUE, REGION_MOUTH_INTERIOR, REGION_LASHES.
 // All colour uniforms are linear RGB (render.py linearises the appearance's sRGB colours).
 
@@ -64,6 +64,7 @@ uniform float u_wrinkle_darken;
 // skin UV to stroke space (x along the hairs, one unit ~ a stroke length; y across, one unit
 // ~ a strand width); render.py's default fits hm08's UV layout. Where strands would be finer
 // than a pixel the pattern fades to its mean coverage, so it does not alias.
+#ifdef USE_BROWS
 uniform mat2 u_brow_frame;
 // Returns (coverage, strand shade) for the brow colour over skin.
 vec2 brow_hair(vec2 uv, float density) {
@@ -79,6 +80,7 @@ vec2 brow_hair(vec2 uv, float density) {
     float cover = base * mix(0.75, 0.4 + 0.55 * strands, detail);
     return vec2(cover, mix(1.0, 0.75 + 0.5 * n, detail));
 }
+#endif
 #endif
 
 #ifdef REGION_EYEBALL
@@ -121,7 +123,11 @@ void main() {
     albedo = mix(albedo, u_cheek, paint.a);
     albedo = mix(albedo, u_eyelid, paint.b);
     albedo = mix(albedo, u_lips, paint.g);
+#ifdef USE_BROWS
     vec2 brow = brow_hair(v_uv, paint.r);
+#else
+    vec2 brow = vec2(0.0, 1.0);
+#endif
     float hair = brow.x;
     albedo = mix(albedo, u_brows * brow.y, hair);
     float cavity = 1.0;
@@ -134,8 +140,7 @@ void main() {
     float ndv = max(dot(n, v), 0.0);
     float fres = schlick(0.028, ndv);
     float lips = paint.g;
-    vec3 spec = specular_light(n, v, mix(18.0, 70.0, lips)) * mix(0.9, 2.2, lips)
-              + specular_light(n, v, 120.0) * 0.25 * (1.0 - lips);
+    vec3 spec = specular_light(n, v, mix(20.0, 70.0, lips)) * mix(1.0, 2.2, lips);
     radiance = (diffuse + spec * fres * (1.0 - hair) * occ) * cavity;
 #endif
 

@@ -1,0 +1,105 @@
+"""Videos: the right frames, sizes and rates, in every format, written atomically."""
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import imageio_ffmpeg
+import numpy as np
+import pytest
+from PIL import Image
+
+from facsim.timeline import stimulus_timeline
+from facsim.video import VideoWriter, animate, video_format
+
+
+def _read(path):
+    reader = imageio_ffmpeg.read_frames(str(path))
+    meta = next(reader)
+    w, h = meta["size"]
+    frames = [np.frombuffer(f, np.uint8).reshape(h, w, 3) for f in reader]
+    return meta, frames
+
+
+@pytest.fixture(scope="module")
+def short_clip():
+    """0.5 s of AU 12 + 26 rising and falling at 12 fps."""
+    return stimulus_timeline("12+26", onset=0.2, apex=0.1, offset=0.2, fps=12)
+
+
+@pytest.mark.parametrize("suffix", [".mp4", ".webm"])
+def test_video_has_the_timeline_frames_size_and_rate(tmp_path, face_of, short_clip, suffix):
+    out = tmp_path / f"clip{suffix}"
+    animate(short_clip, out, face=face_of("ava"), size=64, progress=False)
+    meta, frames = _read(out)
+    assert len(frames) == 6 and meta["size"] == (64, 64) and meta["fps"] == pytest.approx(12)
+    if suffix == ".mp4":
+        assert meta["codec"].startswith("h264") and meta["pix_fmt"].startswith("yuv420p")
+    diff = [np.abs(a.astype(int) - frames[0].astype(int)).mean() for a in frames]
+    assert diff[3] > diff[1] > 0.05 and diff[3] > diff[-1]  # rises to the apex, then falls
+    assert [p.name for p in tmp_path.iterdir()] == [out.name]
+
+
+def test_gif_and_png_sequences(tmp_path, face_of, short_clip):
+    gif = animate(short_clip, tmp_path / "clip.gif", face=face_of("ava"), size=48, progress=False)
+    with Image.open(gif) as im:
+        assert im.n_frames == 6 and im.size == (48, 48)
+        total = 0
+        for i in range(im.n_frames):
+            im.seek(i)
+            total += im.info["duration"]
+        assert total == pytest.approx(500, abs=10)  # 6 frames at 12 fps, in whole centiseconds
+    folder = animate(short_clip, tmp_path / "frames", face=face_of("ava"), size=48, progress=False)
+    names = sorted(p.name for p in folder.iterdir())
+    assert names == [f"frame_{i:05d}.png" for i in range(6)]
+
+
+def test_audio_track_is_muxed(tmp_path, face_of, short_clip):
+    wav = tmp_path / "tone.wav"
+    ffmpeg = imageio_ffmpeg.get_ffmpeg_exe()
+    subprocess.run([ffmpeg, "-v", "error", "-f", "lavfi", "-i", "sine=frequency=440:duration=1", str(wav)], check=True)
+    out = animate(short_clip, tmp_path / "talk.mp4", face=face_of("ava"), size=64, audio=wav, progress=False)
+    probe = subprocess.run([ffmpeg, "-i", str(out)], capture_output=True, text=True).stderr
+    assert "Audio: aac" in probe and "Video: h264" in probe
+
+
+def test_a_failed_render_leaves_nothing(tmp_path):
+    with pytest.raises(ValueError, match="frames must be"):
+        with VideoWriter(tmp_path / "x.mp4", 10) as writer:
+            writer.append(np.zeros((8, 8), np.uint8))
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("name, message", [("x.avi", "unknown video format"), ("x.mp4", "fps must be > 0")])
+def test_bad_outputs_are_refused(tmp_path, name, message):
+    with pytest.raises(ValueError, match=message):
+        VideoWriter(tmp_path / name, 0 if name.endswith("mp4") else 30)
+    assert video_format(tmp_path / "frames") == "png"
+
+
+def test_muscle_state_or_registers_reproduce_the_same_video(tmp_path, face_of, short_clip):
+    a = animate(short_clip, tmp_path / "a", face=face_of("ava"), size=48, progress=False)
+    b = animate(short_clip, tmp_path / "b", face=face_of("ava"), size=48, progress=False)
+    for fa, fb in zip(sorted(a.iterdir()), sorted(b.iterdir())):
+        assert np.array_equal(np.asarray(Image.open(fa)), np.asarray(Image.open(fb)))
+
+
+def test_cli_emotion_and_animate(tmp_path):
+    def run(*args):
+        return subprocess.run([sys.executable, "-m", "facsim.cli", *args], capture_output=True, text=True, cwd=tmp_path)
+    r = run("emotion", "surprise", "--intensity", "50%", "--onset", "0.2", "--apex", "0.1", "--offset", "0.2",
+            "--fps", "10", "--size", "48", "-o", "s.mp4", "--quiet", "--save-timeline", "s.yaml")
+    assert r.returncode == 0, r.stderr
+    assert len(_read(tmp_path / "s.mp4")[1]) == 5
+    r = run("animate", "s.yaml", "-o", "s.gif", "--size", "32", "--quiet")
+    assert r.returncode == 0, r.stderr
+    r = run("render", "--timeline", "s.yaml", "--time", "0.2", "-o", "apex.png", "--size", "32")
+    assert r.returncode == 0, r.stderr
+    r = run("plot", "s.yaml", "-o", "s.svg")
+    assert r.returncode == 0 and (tmp_path / "s.svg").read_text().startswith("<?xml")
+    (tmp_path / "bad.yaml").write_text("tracks:\n  - au: 12\n    start: 2\n    end: 1\n")
+    r = run("animate", "bad.yaml", "-o", "bad.mp4")
+    assert r.returncode == 2 and "tracks[0]" in r.stderr and "Traceback" not in r.stderr
+    assert not (tmp_path / "bad.mp4").exists()
+    r = run("render", "--timeline", "s.yaml", "--time", "9", "-o", "late.png")
+    assert r.returncode == 2 and "outside the timeline" in r.stderr
