@@ -106,13 +106,16 @@ def character_appearance(character: Character, head, *, blush: float | None = No
 def paint_texture(head, blush: float) -> np.ndarray:
     """(rows, cols, 4) uint8 paint in the head's normalised UV box: brows, lips, lids, blush."""
     data_masks = head.masks
-    positions = _resize(position_map(head), PAINT_SIZE)
-    brows = brow_density(positions)
-    cheeks = blush * cheek_density(positions)
+    # Densities are smooth at half the paint resolution; computing them there saves ~0.4 s.
+    positions = _resize(position_map(head), (PAINT_SIZE[0] // 2, PAINT_SIZE[1] // 2))
+    brows = _resize(brow_density(positions), PAINT_SIZE)
+    cheeks = _resize(blush * cheek_density(positions), PAINT_SIZE)
     lips = _resize(data_masks["lips"].astype(np.float32) / 255, PAINT_SIZE)
     lids = _resize(data_masks["eyelids"].astype(np.float32) / 255, PAINT_SIZE)
-    paint = np.stack([brows, lips, lids, cheeks], axis=-1)  # GL order: row 0 is v = 0
-    return np.ascontiguousarray(np.clip(paint * 255 + 0.5, 0, 255).astype(np.uint8))
+    paint = np.empty((*PAINT_SIZE, 4), np.uint8)  # GL order: row 0 is v = 0
+    for channel, mask in enumerate((brows, lips, lids, cheeks)):
+        paint[..., channel] = np.clip(mask * 255 + 0.5, 0, 255)
+    return paint
 
 
 def brow_density(positions: np.ndarray) -> np.ndarray:
@@ -151,15 +154,12 @@ def _smooth(edge0, edge1, x):
 
 def _resize(image: np.ndarray, size: tuple[int, int]) -> np.ndarray:
     """Bilinear resize of a (H, W[, C]) float array to ``size`` (rows, cols)."""
-    from scipy.ndimage import map_coordinates
+    from PIL import Image
 
     rows, cols = size
-    r = np.linspace(0, image.shape[0] - 1, rows)
-    c = np.linspace(0, image.shape[1] - 1, cols)
-    rr, cc = np.meshgrid(r, c, indexing="ij")
-    if image.ndim == 2:
-        return map_coordinates(image, [rr, cc], order=1).astype(np.float32)
-    return np.stack([map_coordinates(image[..., k], [rr, cc], order=1) for k in range(image.shape[2])], -1).astype(np.float32)
+    if image.ndim == 3:
+        return np.stack([_resize(image[..., k], size) for k in range(image.shape[2])], axis=-1)
+    return np.asarray(Image.fromarray(image.astype(np.float32), "F").resize((cols, rows), Image.BILINEAR))
 
 
 def position_map(head) -> np.ndarray:

@@ -21,6 +21,8 @@ ENGINES = ("registers", "muscle")
 #: Framing uses the skin above this height below the chin (dm), so a portrait
 #: shows the whole head with a little neck, the same in every frame.
 NECK_SHOWN = 0.45
+#: Bump when the occlusion bake changes, so cached bakes are redone.
+OCCLUSION_VERSION = 1
 
 
 @lru_cache(maxsize=1)
@@ -100,6 +102,31 @@ class Face:
 
         return character_appearance(self.character, self.head)
 
+    @cached_property
+    def occlusion(self) -> np.ndarray:
+        """Ambient visibility per vertex (1 open … 0 enclosed), baked once on the neutral face.
+
+        Sockets and creases change little with expression, so one bake per
+        character serves every frame; it is cached on disk by the character's parameters.
+        """
+        import hashlib
+
+        from .assets import cache_dir
+        from .atomic import atomic_write
+        from .render import bake_occlusion
+
+        key = hashlib.sha256(repr((OCCLUSION_VERSION, self.character.with_(name="", description="", colors={})))
+                             .encode()).hexdigest()[:16]
+        path = cache_dir() / "occlusion" / f"{key}.npy"
+        try:
+            return np.load(path)
+        except (OSError, ValueError):
+            pass
+        occlusion = bake_occlusion(self.head.topology, self.neutral)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        atomic_write(path, lambda tmp: tmp.write_bytes(_npy_bytes(occlusion)))
+        return occlusion
+
     def deform(self, expression=None) -> np.ndarray:
         """Geometry positions (N_geo, 3) showing ``expression`` (FACS string, Expression or Activations)."""
         act = to_activations(expression)
@@ -139,7 +166,8 @@ class Face:
             wrinkle = getattr(self.engine, "last_wrinkle", None) if wrinkle is None else wrinkle
         camera = self.camera(view=view, yaw=yaw, pitch=pitch, projection=projection, size=size)
         return self.renderer(size, antialias=antialias, background=background).render(
-            np.asarray(positions, np.float32), appearance=self.appearance, camera=camera, wrinkle=wrinkle
+            np.asarray(positions, np.float32), appearance=self.appearance, camera=camera, wrinkle=wrinkle,
+            occlusion=self.occlusion,
         )
 
     def start_animation(self) -> "Animation":
@@ -166,6 +194,14 @@ class Face:
 
     def __exit__(self, *exc):
         self.close()
+
+
+def _npy_bytes(array: np.ndarray) -> bytes:
+    import io
+
+    buf = io.BytesIO()
+    np.save(buf, array)
+    return buf.getvalue()
 
 
 class Animation:

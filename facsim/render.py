@@ -1,9 +1,11 @@
 """Headless OpenGL renderer for face stimuli: geometry + appearance + camera -> RGBA image.
 
 The renderer takes any mesh through :class:`RenderTopology` (static, uploaded once) and
-per-frame geometry-vertex positions; it computes smooth normals in numpy, uploads one
-dynamic vertex buffer, draws each region with its own shader variant, resolves the
-anti-aliasing and reads back one image.
+per-frame geometry-vertex positions; it computes smooth normals in numpy (a precomputed
+sparse face -> vertex matrix), uploads one dynamic vertex buffer, draws each region with
+its own shader variant (built with #defines, not branches: on llvmpipe a branch that
+is switched off still costs), resolves the anti-aliasing and reads back one image. Skin
+and eyeballs are drawn with back faces culled (winding checked on the first frame).
 
 Colour conventions: :class:`Appearance` colours are display sRGB values in [0, 1] (what a
 colour picker shows); shading is done in linear light and the output is sRGB-encoded 8-bit,
@@ -12,8 +14,9 @@ nothing is drawn; ``background=None`` gives a transparent background with straig
 (un-premultiplied) alpha.
 
 Light rig (:class:`Lighting`): soft studio lighting fixed to the CAMERA, so every view
-gets the same flattering key (upper camera-left), fill (camera-right, weaker, cooler),
-rim (behind, above) and a hemispheric ambient (world up brighter than down).
+gets the same flattering key (upper camera-left), fill (camera-right, weaker), rim
+(behind, above) and a hemispheric ambient (world up brighter than down, warm bounce).
+No cast shadows: :func:`bake_occlusion` gives per-vertex ambient occlusion to pass in.
 
 OpenGL: one context per process (EGL, created lazily on first use, reused by every
 Renderer and recreated in a forked child). A Renderer holds GL objects; release them with
@@ -47,7 +50,9 @@ from .camera import Camera, camera_basis, projection_matrix, view_matrix, _size_
 __all__ = [
     "REGIONS", "COLOR_NAMES", "DEFAULT_COLORS", "RenderTopology", "Appearance", "Lighting",
     "Renderer", "RenderError", "normal_operator", "vertex_normals", "srgb_to_linear",
-    "write_png", "gl_context", "region_components", "sphere_centre", "lash_coordinates", "AA_METHODS", "HM08_BROW_UV_FRAME", "bake_occlusion",
+    "write_png", "gl_context", "region_components", "sphere_centre", "lash_coordinates",
+    "crease_phase", "AA_METHODS", "HM08_BROW_UV_FRAME", "DEFAULT_BROW_UV_FRAME", "brow_uv_frame",
+    "bake_occlusion",
 ]
 
 #: Region names; ``RenderTopology.region`` holds indices into this tuple.
@@ -77,9 +82,27 @@ DEFAULT_COLORS: Mapping[str, tuple[float, float, float]] = MappingProxyType({
 #: (``antialias`` = factor per axis, then a box-filter downsampling pass).
 AA_METHODS = ("msaa", "ssaa")
 
-#: Eyebrow strokes for hm08's UV layout, where the head's island is turned 90 degrees: the
-#: brows run along v (strokes ~5 mm long) and u runs up the face (strands ~0.5 mm apart).
-HM08_BROW_UV_FRAME = ((0.0, 80.0), (1600.0, 0.0))
+#: Eyebrow strokes for hm08's raw UV layout, where the head's island is turned 90 degrees:
+#: the brows run along v (strokes ~3 mm long) and u runs up the face (strands ~0.5 mm apart).
+HM08_BROW_UV_FRAME = ((0.0, 160.0), (1600.0, 0.0))
+
+
+def brow_uv_frame(uv_box=None, frame=HM08_BROW_UV_FRAME) -> np.ndarray:
+    """The brow-stroke frame for UVs normalised to ``uv_box = (u0, v0, u1, v1)``.
+
+    A head whose UVs are ``u' = (u - u0) / (u1 - u0)`` (same for v) needs the raw frame's
+    columns scaled by the box's size; ``uv_box=None`` returns the raw frame.
+    """
+    m = np.asarray(frame, dtype=float)
+    if uv_box is None:
+        return m
+    u0, v0, u1, v1 = (float(x) for x in uv_box)
+    return m * np.array([u1 - u0, v1 - v0])[None, :]
+
+
+#: The default: facsim's head model, whose UVs are normalised to ``facsim.assets.PAINT_UV_BOX``
+#: (0.60, 0.10, 1.00, 0.90) (a test checks the two agree).
+DEFAULT_BROW_UV_FRAME = ((0.0, 128.0), (640.0, 0.0))
 
 _SHADER_DIR = Path(__file__).with_name("shaders")
 #: Draw groups in drawing order, each with its shader variant's #defines. Skin triangles
@@ -121,7 +144,7 @@ class RenderTopology:
         Render vertex -> geometry vertex. Render vertices are split at UV seams; normals are
         computed on geometry vertices so seams do not show.
     uv : (R, 2) float32
-        Skin UVs (MakeHuman layout, v up, [0, 1]); zeros for non-skin vertices.
+        Skin UVs (MakeHuman layout, v up, [0, 1]); unused (zeros, say) for non-skin.
     region : (R,) uint8
         Index into :data:`REGIONS` per render vertex. A triangle takes the region most of
         its vertices have (the first vertex's when all three differ).
@@ -241,11 +264,11 @@ class Lighting:
     key_direction: tuple[float, float, float] = (-0.6, 0.55, 0.6)
     key_color: tuple[float, float, float] = (1.3, 1.24, 1.15)
     fill_direction: tuple[float, float, float] = (0.8, -0.05, 0.6)
-    fill_color: tuple[float, float, float] = (0.20, 0.21, 0.24)
+    fill_color: tuple[float, float, float] = (0.22, 0.21, 0.22)
     rim_direction: tuple[float, float, float] = (0.35, 0.55, -0.75)
     rim_color: tuple[float, float, float] = (0.55, 0.55, 0.58)
     sky: tuple[float, float, float] = (0.22, 0.22, 0.23)
-    ground: tuple[float, float, float] = (0.08, 0.07, 0.06)
+    ground: tuple[float, float, float] = (0.11, 0.08, 0.065)
     exposure: float = 1.0
 
     def world_uniforms(self, camera: Camera) -> dict[str, tuple[float, ...]]:
@@ -377,6 +400,76 @@ def lash_coordinates(positions: np.ndarray, eyes: list[np.ndarray],
     return np.concatenate(out).astype(np.float32)
 
 
+def crease_phase(positions: np.ndarray, uv: np.ndarray, faces: np.ndarray,
+                 wrinkle: np.ndarray, operator: sp.csr_matrix | None = None) -> np.ndarray:
+    """Where across a crease each vertex lies, so creases can run along the contours of
+    ``wrinkle``: the distance (decimetres) from the UV centre along the direction in which
+    the wrinkle changes most.
+
+    Worked out in UV space, where the face is flat (a 3-D distance would bend the lines
+    over the curved forehead): the direction is the principal axis of the area-weighted
+    structure tensor of the wrinkle's UV gradient around each vertex (sign-free, so it
+    holds on a crease's crest, where the gradient flips), and UV distance is converted to
+    surface distance with the mesh's local UV metric. The origin is fixed, so the lines do
+    not swim as the wrinkle grows.
+
+    Parameters
+    ----------
+    positions : (R, 3) render-vertex positions
+    uv : (R, 2) render-vertex UVs
+    faces : (M, 3) render triangles
+    wrinkle : (R,) render-vertex wrinkle
+    operator : :func:`normal_operator` of ``faces`` (face -> vertex sums)
+
+    Returns
+    -------
+    (R,) float32, unsigned; 0 where the wrinkle is 0 all around or the UVs are degenerate.
+    """
+    p = np.asarray(positions, dtype=np.float64)
+    t = np.asarray(uv, dtype=np.float64)
+    w = np.asarray(wrinkle, dtype=np.float64)
+    faces = np.asarray(faces)
+    phase = np.zeros(len(p), dtype=np.float32)
+    live = np.flatnonzero((w[faces] > 0).any(axis=1))
+    if len(live) == 0:
+        return phase
+    f = faces[live]
+    du1, du2 = t[f[:, 1]] - t[f[:, 0]], t[f[:, 2]] - t[f[:, 0]]
+    det = du1[:, 0] * du2[:, 1] - du2[:, 0] * du1[:, 1]
+    ok = np.abs(det) > 1e-12
+    f, du1, du2, det, live = f[ok], du1[ok], du2[ok], det[ok], live[ok]
+    if len(f) == 0:
+        return phase
+    # Gradients per unit u and v: invert [[du1.u, du2.u], [du1.v, du2.v]] by hand (batched
+    # einsum on 2x2s is slow): d/du = (e1 du2.v - e2 du1.v) / det,
+    # d/dv = (e2 du1.u - e1 du2.u) / det.
+    cu1, cv1 = du1[:, 0] / det, du1[:, 1] / det
+    cu2, cv2 = du2[:, 0] / det, du2[:, 1] / det
+    dw1, dw2 = w[f[:, 1]] - w[f[:, 0]], w[f[:, 2]] - w[f[:, 0]]
+    g = np.stack([dw1 * cv2 - dw2 * cv1, dw2 * cu1 - dw1 * cu2], axis=1)   # dw/d(u, v)
+    e1, e2 = p[f[:, 1]] - p[f[:, 0]], p[f[:, 2]] - p[f[:, 0]]
+    ju = e1 * cv2[:, None] - e2 * cv1[:, None]                            # d(xyz)/du
+    jv = e2 * cu1[:, None] - e1 * cu2[:, None]                            # d(xyz)/dv
+    metric = np.stack([(ju * ju).sum(1), (jv * jv).sum(1), (ju * jv).sum(1)], axis=1)
+    area = 0.5 * np.abs(det)                                      # UV area as the weight
+    rows = np.zeros((len(faces), 7))
+    rows[live] = area[:, None] * np.stack([
+        g[:, 0] ** 2, g[:, 1] ** 2, g[:, 0] * g[:, 1],
+        metric[:, 0], metric[:, 1], metric[:, 2], np.ones(len(f))], axis=1)
+    if operator is None:
+        operator = normal_operator(faces, len(p))
+    acc = operator @ rows
+    verts = np.flatnonzero(acc[:, 0] + acc[:, 1] > 0)
+    a = acc[verts]
+    angle = 0.5 * np.arctan2(2.0 * a[:, 2], a[:, 0] - a[:, 1])  # principal axis of [[a0 a2][a2 a1]]
+    d = np.stack([np.cos(angle), np.sin(angle)], 1)
+    g00, g11, g01 = a[:, 3] / a[:, 6], a[:, 4] / a[:, 6], a[:, 5] / a[:, 6]
+    scale = np.sqrt(np.maximum(d[:, 0] ** 2 * g00 + 2 * d[:, 0] * d[:, 1] * g01
+                               + d[:, 1] ** 2 * g11, 0.0))        # dm per UV unit along d
+    phase[verts] = np.abs(((t[verts] - 0.5) * d).sum(axis=1)) * scale
+    return phase
+
+
 def write_png(path, image: np.ndarray) -> Path:
     """Write an (H, W, 3|4) uint8 image as PNG atomically (temp file, then ``os.replace``)."""
     from PIL import Image
@@ -486,9 +579,9 @@ def bake_occlusion(topology: RenderTopology, positions: np.ndarray, *, direction
     For each of ``directions`` directions over the sphere the whole mesh is drawn as a
     depth map; a vertex counts as lit from a direction when nothing lies in front of it
     there. Visibility is averaged with cosine weights over the hemisphere around the vertex
-    normal: 1 = open sky, 0 = fully enclosed. About 0.1-0.3 s for a head: bake once on the
-    neutral pose (sockets and creases change little with expression), or per frame where
-    that matters.
+    normal: 1 = open sky, 0 = fully enclosed. About 0.5-0.8 s for the head on llvmpipe:
+    bake once on the neutral pose (sockets and creases change little with expression), or
+    per frame where that matters.
 
     Parameters
     ----------
@@ -582,11 +675,14 @@ class Renderer:
     size : int or (width, height)
         Output image size in pixels.
     antialias : int
-        ``aa_method="msaa"``: samples per pixel (1 = off; at most the driver's maximum,
-        4 on llvmpipe). ``"ssaa"``: supersampling factor per axis (1..4).
+        ``aa_method="msaa"``: samples per pixel (1 = off; capped at the driver's maximum).
+        ``"ssaa"``: supersampling factor per axis (1..4).
     aa_method : {"msaa", "ssaa"}
-        Default MSAA: measured faster here for this shader (see benchmarks/bench_render.py);
-        the shaders filter their own procedural detail (iris edges, brow strands).
+        Measured on llvmpipe (2 cores, 512 px, the 12.7k-triangle head): 4x MSAA 48 ms,
+        2x2 SSAA 56 ms, no AA 24 ms per frame. llvmpipe shades every sample and only has
+        4x MSAA (a request for 2 samples gets 4, at the same cost), so the default is
+        ``msaa``/4. The shaders filter their own procedural detail (iris edges, brow
+        strands, creases), so ``antialias=1`` is a fair fast preview.
     background : (r, g, b) display sRGB in [0, 1], or None for transparent.
     lighting : Lighting
         Default rig; :meth:`render` can override it per call.
@@ -598,9 +694,8 @@ class Renderer:
     brow_uv_frame : (2, 2) array_like
         Maps skin UV to eyebrow-stroke space: row 0 gives the coordinate along the hairs
         (1 unit ~ one stroke length), row 1 across them (1 unit ~ one strand width). The
-        default, :data:`HM08_BROW_UV_FRAME`, fits hm08's raw UV layout; if you rescale the
-        UVs (``u' = (u - u0) / (u1 - u0)``), divide column 0 by ``1/(u1 - u0)``, i.e.
-        multiply it by ``u1 - u0`` (and likewise column 1 for v).
+        default fits facsim's head (hm08 UVs normalised to its paint box); for other
+        layouts see :func:`brow_uv_frame` and :data:`HM08_BROW_UV_FRAME`.
     cull_backfaces : bool
         Skip skin and eyeball triangles facing away (about 1.5x faster). Needs those
         surfaces closed (cap the neck); the winding is checked on the first frame and
@@ -610,7 +705,7 @@ class Renderer:
     def __init__(self, topology: RenderTopology, *, size=512, antialias: int = 4,
                  aa_method: str = "msaa", background=(0.5, 0.5, 0.5),
                  lighting: Lighting | None = None, wrinkle_depth: float = 0.012,
-                 wrinkle_darken: float = 0.3, brow_uv_frame=HM08_BROW_UV_FRAME,
+                 wrinkle_darken: float = 0.15, brow_uv_frame=DEFAULT_BROW_UV_FRAME,
                  cull_backfaces: bool = True):
         if not isinstance(topology, RenderTopology):
             raise TypeError(f"topology must be a RenderTopology, got {type(topology).__name__}")
@@ -647,14 +742,15 @@ class Renderer:
         self._faces = topology.faces.copy()
         self._geo_faces = np.ascontiguousarray(topology.geo_faces)
         self._normal_op = normal_operator(self._geo_faces, self._n_geo)
+        self._render_op = None  # face -> render vertex sums, built when wrinkles first come
         self._face_region = topology.face_regions()
         self._face_uv = topology.uv[topology.faces]             # (M, 3, 2) for brow coverage
         self._brow_faces = np.zeros(len(self._faces), dtype=bool)
         self._winding_checked = False
         self._draws: list[tuple[str, int, int]] = []
-        # Per-frame vertex data: position (3), normal (3), wrinkle, occlusion = 32 bytes.
-        self._geo_buffer = np.zeros((self._n_geo, 8), dtype=np.float32)
-        self._render_buffer = np.zeros((topology.n_render, 8), dtype=np.float32)
+        # Per-frame vertex data: position (3), normal (3), wrinkle, occlusion, crease phase.
+        self._geo_buffer = np.zeros((self._n_geo, 9), dtype=np.float32)
+        self._render_buffer = np.zeros((topology.n_render, 9), dtype=np.float32)
         self._appearance = None
         self._eyes = region_components(topology, "eyeball")
         self._lashes = region_components(topology, "lashes")
@@ -683,8 +779,8 @@ class Renderer:
             vertex_shader=_shader_source("face.vert.glsl", defines),
             fragment_shader=_shader_source("face.frag.glsl", defines)))
         vao = self._track(ctx.vertex_array(
-            prog, [(self._vbo_dynamic, "3f 3f 1f 1f", "in_pos", "in_normal", "in_wrinkle",
-                    "in_occlusion"),
+            prog, [(self._vbo_dynamic, "3f 3f 1f 1f 1f", "in_pos", "in_normal", "in_wrinkle",
+                    "in_occlusion", "in_crease"),
                    (self._vbo_static, "2f 3f", "in_uv", "in_eye")],
             index_buffer=self._ibo, index_element_size=4, skip_errors=True))
         _set_uniform(prog, "u_paint", 0)
@@ -829,8 +925,10 @@ class Renderer:
             Skin compression; creases and cavity darkening are drawn where it is > 0.
         occlusion : (N_geo,) float in [0, 1], optional
             Ambient visibility per geometry vertex (1 = open), e.g. from
-            :func:`bake_occlusion`; it darkens sockets and creases on skin, eyeballs and
-            lashes (the mouth regions have their own fixed darkening). Default: all 1.
+            :func:`bake_occlusion` on the neutral pose; it darkens sockets and creases on
+            skin, eyeballs and lashes, and dims teeth, tongue and mouth interior only down
+            to a floor (55 / 45 / 35 %), so occlusion baked on a closed mouth still lets an
+            open one show. Default: all 1.
         lighting : Lighting, optional
             Overrides the renderer's rig for this frame.
 
@@ -844,32 +942,17 @@ class Renderer:
             raise TypeError(f"appearance must be an Appearance, got {type(appearance).__name__}")
         if not isinstance(camera, Camera):
             raise TypeError(f"camera must be a Camera, got {type(camera).__name__}")
-        p = np.asarray(positions, dtype=np.float32)
-        if p.ndim != 2 or p.shape[1] != 3 or p.shape[0] < self._n_geo:
+        p_all = np.asarray(positions, dtype=np.float32)
+        if p_all.ndim != 2 or p_all.shape[1] != 3 or p_all.shape[0] < self._n_geo:
             raise ValueError(f"positions must be (N_geo, 3) with N_geo >= {self._n_geo}, "
-                             f"got {p.shape}")
-        p = p[: self._n_geo]
+                             f"got {p_all.shape}")
+        p = p_all[: self._n_geo]
         if not np.isfinite(p).all():
             raise ValueError("positions contain NaN or infinity")
-        w_geo = None
-        if wrinkle is not None:
-            w_geo = np.asarray(wrinkle, dtype=np.float32).reshape(-1)
-            if w_geo.shape[0] != positions.shape[0]:
-                raise ValueError(f"wrinkle must have one value per geometry vertex "
-                                 f"({positions.shape[0]}), got {w_geo.shape}")
-            w_geo = np.clip(w_geo[: self._n_geo], 0.0, None)
-            if not np.isfinite(w_geo).all():
-                raise ValueError("wrinkle contains NaN or infinity")
-
-        occ = None
-        if occlusion is not None:
-            occ = np.asarray(occlusion, dtype=np.float32).reshape(-1)
-            if occ.shape[0] != positions.shape[0]:
-                raise ValueError(f"occlusion must have one value per geometry vertex "
-                                 f"({positions.shape[0]}), got {occ.shape}")
-            occ = occ[: self._n_geo]
-            if not np.isfinite(occ).all():
-                raise ValueError("occlusion contains NaN or infinity")
+        w_geo = _per_vertex("wrinkle", wrinkle, len(p_all), self._n_geo)
+        if w_geo is not None:
+            w_geo = np.maximum(w_geo, 0.0)
+        occ = _per_vertex("occlusion", occlusion, len(p_all), self._n_geo)
         if not self._winding_checked:
             self._fix_winding(p)
             self._rebuild_draws()
@@ -884,19 +967,28 @@ class Renderer:
                          occlusion: np.ndarray | None) -> None:
         geo = self._geo_buffer
         normals = vertex_normals(p, self._geo_faces, self._normal_op)
-        if wrinkle is not None and self.wrinkle_depth > 0 and wrinkle.any():
-            sunk = p - (self.wrinkle_depth * wrinkle)[:, None] * normals
-            normals = vertex_normals(sunk, self._geo_faces, self._normal_op)
+        if wrinkle is not None and wrinkle.any():
+            if self.wrinkle_depth > 0:
+                sunk = p - (self.wrinkle_depth * wrinkle)[:, None] * normals
+                normals = vertex_normals(sunk, self._geo_faces, self._normal_op)
             geo[:, 6] = wrinkle
         else:
-            geo[:, 6] = 0.0 if wrinkle is None else wrinkle
+            geo[:, 6] = 0.0
         if len(self._lash_vertices):  # lashes reuse the wrinkle slot for root-to-tip
             geo[self._lash_vertices, 6] = lash_coordinates(p, self._eyes, self._lashes)
         geo[:, 7] = 1.0 if occlusion is None else occlusion
         geo[:, 0:3] = p
         geo[:, 3:6] = normals
-        np.take(geo, self.topology.render_to_geo, axis=0, out=self._render_buffer)
-        self._vbo_dynamic.write(self._render_buffer)
+        out = self._render_buffer
+        np.take(geo, self.topology.render_to_geo, axis=0, out=out)
+        if wrinkle is not None and wrinkle.any():
+            if self._render_op is None:
+                self._render_op = normal_operator(self._faces, self.topology.n_render)
+            out[:, 8] = crease_phase(out[:, 0:3], self.topology.uv, self._faces, out[:, 6],
+                                     self._render_op)
+        else:
+            out[:, 8] = 0.0
+        self._vbo_dynamic.write(out)
 
     def _set_camera(self, camera: Camera, lighting: Lighting) -> None:
         w, h = self.size
@@ -985,6 +1077,20 @@ class Renderer:
         state = "closed" if self._closed else "open"
         return (f"Renderer({self.topology.n_render} vertices, {len(self.topology.faces)} faces, "
                 f"size={self.size}, {self.aa_method} x{self.antialias}, {state})")
+
+
+def _per_vertex(name: str, value, n_rows: int, n_used: int) -> np.ndarray | None:
+    """Validate an optional per-geometry-vertex array; the rows the topology uses."""
+    if value is None:
+        return None
+    arr = np.asarray(value, dtype=np.float32).reshape(-1)
+    if arr.shape[0] != n_rows:
+        raise ValueError(f"{name} must have one value per geometry vertex ({n_rows}), "
+                         f"got {arr.shape}")
+    arr = arr[:n_used]
+    if not np.isfinite(arr).all():
+        raise ValueError(f"{name} contains NaN or infinity")
+    return arr
 
 
 def _orientation(p: np.ndarray, faces: np.ndarray) -> float:

@@ -1,8 +1,9 @@
 // Face fragment shader. One variant per region (render.py draws each region's faces with its
 // own program, so a fragment runs only its region's code: on llvmpipe both sides of a branch
 // cost, even when a uniform switches one off). Variants:
-//   REGION_SKIN (+ USE_UV, USE_WRINKLE, and USE_BROWS for triangles under painted brows), REGION_EYEBALL (+ USE_EYE), REGION_TEETH,
-//   REGION_TONGUE, REGION_MOUTH_INTERIOR, REGION_LASHES.
+//   REGION_SKIN (+ USE_UV, USE_WRINKLE; + USE_BROWS for triangles under painted brows),
+//   REGION_EYEBALL (+ USE_EYE), REGION_TEETH, REGION_TONGUE, REGION_MOUTH_INTERIOR,
+//   REGION_LASHES (+ USE_LASH).
 // All colour uniforms are linear RGB (render.py linearises the appearance's sRGB colours).
 
 #include "common.glsl"
@@ -18,6 +19,7 @@ in vec3 v_eye;
 #endif
 #ifdef USE_WRINKLE
 in float v_wrinkle;
+in float v_crease;
 #endif
 #ifdef USE_LASH
 in float v_lash;
@@ -60,6 +62,24 @@ uniform vec3 u_eyelid;
 uniform vec3 u_cheek;
 uniform float u_wrinkle_darken;
 
+#ifdef USE_WRINKLE
+// Creases: thin dark furrows with a faint lit ridge beside each, running along the contours
+// of the wrinkle field (v_crease is the distance across them), slightly wavy, fading in with
+// the wrinkle amount and to their mean where they would be finer than a pixel.
+const float CREASES_PER_DM = 11.0;   // about 9 mm apart
+float crease_shade(float wrinkle, float phase, vec2 uv) {
+    float s = phase * CREASES_PER_DM + 0.5 * value_noise(uv * vec2(40.0, 25.0), 0);
+    float c = cos(2.0 * PI * s);
+    float valley = pow(0.5 + 0.5 * c, 10.0);
+    float ridge = pow(0.5 + 0.5 * cos(2.0 * PI * (s + 0.22)), 8.0);
+    float lines = 1.0 - 0.55 * valley + 0.12 * ridge;
+    float detail = clamp(2.0 - 3.0 * fwidth(s), 0.0, 1.0);
+    float amount = smoothstep(0.05, 0.8, wrinkle);
+    float cavity = 1.0 - u_wrinkle_darken * clamp(wrinkle, 0.0, 1.0);
+    return mix(1.0, mix(0.93, lines, detail), amount) * cavity;
+}
+#endif
+
 // Brow hair: thin strokes whose coverage grows with the painted density. u_brow_frame maps
 // skin UV to stroke space (x along the hairs, one unit ~ a stroke length; y across, one unit
 // ~ a strand width); render.py's default fits hm08's UV layout. Where strands would be finer
@@ -68,17 +88,18 @@ uniform float u_wrinkle_darken;
 uniform mat2 u_brow_frame;
 // Returns (coverage, strand shade) for the brow colour over skin.
 vec2 brow_hair(vec2 uv, float density) {
-    if (density <= 0.002) return vec2(0.0, 1.0);
     vec2 p = u_brow_frame * uv;
     p.y += 0.6 * sin(p.x * 1.3) + 1.5 * value_noise(p * vec2(0.4, 0.004), 0);
     float n = 0.6 * value_noise(p, 0) + 0.4 * value_noise(p * vec2(2.3, 1.9) + 31.0, 0);
-    float threshold = 0.95 - 0.75 * density;
-    float aa = fwidth(n) + 0.05;
-    float strands = smoothstep(threshold - aa, threshold + aa, n);
-    float base = smoothstep(0.0, 0.5, density);
+    float aa = fwidth(n) + 0.04;
+    // Hairs exist where the noise beats 1 - density (sparse, broken edges); inside, they
+    // cover the skin by 55-95 % in streaks.
+    float present = smoothstep(1.0 - density - aa, 1.0 - density + aa, n);
+    float streaks = smoothstep(0.3 - aa, 0.7 + aa, n);
+    float strands = present * (0.55 + 0.4 * streaks);
     float detail = clamp(2.5 - 2.0 * fwidth(p.y), 0.0, 1.0);   // strands per pixel across
-    float cover = base * mix(0.75, 0.4 + 0.55 * strands, detail);
-    return vec2(cover, mix(1.0, 0.75 + 0.5 * n, detail));
+    float cover = mix(0.7 * smoothstep(0.0, 0.8, density), strands, detail);
+    return vec2(cover, mix(1.0, 0.8 + 0.4 * n, detail));
 }
 #endif
 #endif
@@ -95,7 +116,10 @@ const float LIMBUS_WIDTH = 0.22;   // fraction of the iris annulus darkened at i
 const int IRIS_FIBRES = 96;        // radial noise cells around the iris
 #endif
 
-#if defined(REGION_TEETH) || defined(REGION_TONGUE) || defined(REGION_MOUTH_INTERIOR) || defined(REGION_LASHES)
+#if defined(REGION_TEETH) || defined(REGION_TONGUE)
+#define ONE_ALBEDO
+#endif
+#if defined(ONE_ALBEDO) || defined(REGION_MOUTH_INTERIOR) || defined(REGION_LASHES)
 uniform vec3 u_albedo;
 #endif
 
@@ -132,7 +156,7 @@ void main() {
     albedo = mix(albedo, u_brows * brow.y, hair);
     float cavity = 1.0;
 #ifdef USE_WRINKLE
-    cavity = 1.0 - u_wrinkle_darken * clamp(v_wrinkle, 0.0, 1.0);
+    cavity = crease_shade(v_wrinkle, v_crease, v_uv);
 #endif
     vec3 wrap = vec3(0.45, 0.22, 0.16) * (1.0 - hair);
     vec3 diffuse = diffuse_light(n, wrap, occ) * albedo;
@@ -170,20 +194,25 @@ void main() {
     radiance = diffuse + spec * schlick(0.04, max(dot(n, v), 0.0)) * 8.0 * occ;
 #endif
 
+    // Inside the mouth the lips and cheeks shade everything; occlusion baked on a closed
+    // mouth would black it out, so it only dims these regions down to a floor.
 #ifdef REGION_TEETH
+    float mouth_shade = mix(0.55, 1.0, occ);
     vec3 spec = specular_light(n, v, 60.0) * 0.12;
-    radiance = diffuse_light(n, vec3(0.15), 1.0) * u_albedo + spec;
+    radiance = (diffuse_light(n, vec3(0.15), 1.0) * u_albedo + spec) * mouth_shade;
 #endif
 
 #ifdef REGION_TONGUE
+    float mouth_shade = mix(0.45, 1.0, occ);
     vec3 spec = specular_light(n, v, 35.0) * 0.08;
-    radiance = diffuse_light(n, vec3(0.3, 0.15, 0.1), 1.0) * u_albedo + spec;
+    radiance = (diffuse_light(n, vec3(0.3, 0.15, 0.1), 1.0) * u_albedo + spec) * mouth_shade;
 #endif
 
 #ifdef REGION_MOUTH_INTERIOR
     // Mostly hidden and in the mouth's own shadow: dim, a little wet.
+    float mouth_shade = mix(0.35, 1.0, occ);
     vec3 spec = specular_light(n, v, 30.0) * 0.04;
-    radiance = diffuse_light(n, vec3(0.3, 0.1, 0.1), 1.0) * u_albedo * 0.55 + spec;
+    radiance = (diffuse_light(n, vec3(0.3, 0.1, 0.1), 1.0) * u_albedo * 0.55 + spec) * mouth_shade;
 #endif
 
 #ifdef REGION_LASHES

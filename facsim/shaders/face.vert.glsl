@@ -7,7 +7,9 @@ in float in_occlusion;  // ambient visibility 0..1 (1 = open sky), per geometry 
 in float in_wrinkle;  // skin: wrinkle amount; lashes: root-to-tip coordinate
 #endif
 #ifdef USE_WRINKLE
+in float in_crease;   // distance across the creases (dm), see render.crease_phase
 out float v_wrinkle;
+out float v_crease;
 #endif
 #ifdef USE_LASH
 out float v_lash;
@@ -33,6 +35,7 @@ void main() {
     v_occlusion = in_occlusion;
 #ifdef USE_WRINKLE
     v_wrinkle = in_wrinkle;
+    v_crease = in_crease;
 #endif
 #ifdef USE_LASH
     v_lash = in_wrinkle;

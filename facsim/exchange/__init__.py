@@ -1,0 +1,337 @@
+"""Exchange: facsim data to and from other tools' files, one module per format.
+
+=================  ==========================================  =============================
+module             format                                      API
+=================  ==========================================  =============================
+``gltf``           glTF 2.0 binary (``.glb``): head mesh, AU   :func:`export_glb`
+                   morph targets, head/eye joints, animation
+``arkit``          ARKit-52 blendshape weights per frame,      :func:`write_arkit_csv`,
+                   Live Link Face CSV layout                   :func:`read_arkit_csv`
+``openface``       OpenFace 2.0 FeatureExtraction CSV          :func:`read_openface_csv`
+``notation_file``  ``.facs``: the notation as a compact,       :func:`dumps_notation`,
+                   lossless timeline text                      :func:`loads_notation`
+``meshfile``       OBJ / PLY of one deformed frame             :func:`write_mesh`
+=================  ==========================================  =============================
+
+Every reader returns a :class:`~facsim.timeline.Timeline`, every writer
+replaces its file atomically (:mod:`facsim.atomic`: a temporary file
+beside it, then moved into place). Format modules are imported only when their function is
+first used, so ``import facsim.exchange`` stays cheap and the core never
+imports them. Errors in input files are :class:`ExchangeError` (a
+``ValueError``): one line naming the file, the line (and column where it
+helps) and what is wrong.
+
+This module also holds what the formats share: :func:`timeline_from_samples`
+(recorded curves → a timeline of linear segments) and the rigid motions of
+the register engine (head 51–58, eyes 61–66) as rotation vectors and back.
+"""
+from __future__ import annotations
+
+from importlib import import_module
+from pathlib import Path
+from typing import Callable, Mapping
+
+import numpy as np
+
+#: Public function → the format module that defines it (imported on first use).
+_LAZY = {
+    "export_glb": "gltf",
+    "write_arkit_csv": "arkit", "read_arkit_csv": "arkit", "arkit_weights": "arkit",
+    "read_openface_csv": "openface",
+    "dumps_notation": "notation_file", "loads_notation": "notation_file",
+    "read_notation": "notation_file", "write_notation": "notation_file", "NotationFileError": "notation_file",
+    "write_mesh": "meshfile",
+}
+
+#: Suffixes :func:`load_any_timeline` reads, and how.
+TIMELINE_SUFFIXES = (".yaml", ".yml", ".json", ".facs", ".csv")
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        value = getattr(import_module(f"{__name__}.{_LAZY[name]}"), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+class ExchangeError(ValueError):
+    """An input file that cannot be read, in one line: ``file:line:column: problem``.
+
+    Attributes
+    ----------
+    problem : str
+        What is wrong.
+    file : str or None
+    line, column : int or None
+        1-based, where known.
+    """
+
+    def __init__(self, problem: str, *, file=None, line: int | None = None, column: int | None = None):
+        self.problem, self.file, self.line, self.column = problem, None if file is None else str(file), line, column
+        if self.file is not None:
+            where = self.file + "".join(f":{n}" for n in (line, column) if n is not None)
+        elif line is not None:
+            where = f"line {line}" + ("" if column is None else f", column {column}")
+        else:
+            where = ""
+        super().__init__(f"{where}: {problem}" if where else problem)
+
+    def in_file(self, file) -> "ExchangeError":
+        """The same error, naming the file it came from."""
+        return type(self)(self.problem, file=file, line=self.line, column=self.column)
+
+
+# ------------------------------------------------------------------ files ---
+
+def write_file(path, data: bytes | str) -> Path:
+    """Write ``data`` (bytes, or text as UTF-8) to ``path`` atomically (:mod:`facsim.atomic`); returns the path."""
+    from facsim.atomic import atomic_write
+
+    path = Path(path)
+    if not path.parent.is_dir():
+        raise FileNotFoundError(f"cannot write {path}: folder {path.parent} does not exist")
+    payload = data.encode("utf-8") if isinstance(data, str) else bytes(data)
+    return atomic_write(path, lambda tmp: tmp.write_bytes(payload))
+
+
+def _csv_kind(path: Path) -> str:
+    with open(path, encoding="utf-8-sig", errors="replace") as handle:
+        header = handle.readline()
+    names = {name.strip() for name in header.split(",")}
+    if "BlendShapeCount" in names:
+        return "arkit"
+    if {"success", "timestamp"} <= names or any(name.startswith("AU") and name.endswith("_r") for name in names):
+        return "openface"
+    raise ExchangeError("not a CSV facsim can read: the header has neither Live Link Face's 'BlendShapeCount' "
+                        "nor OpenFace's 'timestamp', 'success' and AU columns", file=path, line=1)
+
+
+def load_any_timeline(path):
+    """A :class:`~facsim.timeline.Timeline` from any file facsim reads, by suffix.
+
+    ``.yaml``/``.yml``/``.json`` (facsim's timeline format), ``.facs``
+    (:mod:`~facsim.exchange.notation_file`), ``.csv`` (an ARKit/Live Link
+    Face or OpenFace 2.0 CSV, told apart by its header).
+    """
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in TIMELINE_SUFFIXES:
+        raise ExchangeError(f"unsupported timeline file type {suffix or '(none)'!r}; use "
+                            f"{', '.join(TIMELINE_SUFFIXES)}", file=path)
+    if not path.is_file():
+        raise FileNotFoundError(f"no such file: {path}")
+    if suffix == ".facs":
+        return __getattr__("read_notation")(path)
+    if suffix == ".csv":
+        return (__getattr__("read_arkit_csv") if _csv_kind(path) == "arkit" else __getattr__("read_openface_csv"))(path)
+    from facsim.timeline import load_timeline
+
+    return load_timeline(path)
+
+
+def save_any_timeline(timeline, path) -> Path:
+    """Write ``timeline`` as ``.facs`` notation or YAML/JSON (by suffix), atomically."""
+    path = Path(path)
+    if path.suffix.lower() == ".facs":
+        return __getattr__("write_notation")(timeline, path)
+    from facsim.timeline import save_timeline
+
+    return save_timeline(timeline, path)
+
+
+# -------------------------------------------------------------- CSV ---
+
+def read_csv_rows(path) -> tuple[list[str], list[tuple[int, list[str]]]]:
+    """A CSV file's header (names stripped) and its data rows as (line number, cells).
+
+    Blank lines are skipped; every row must have as many cells as the header.
+    """
+    import csv
+    import io
+
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise ExchangeError(f"not UTF-8 text ({exc.reason} at byte {exc.start})", file=path) from None
+    reader = csv.reader(io.StringIO(text))
+    rows = [(reader.line_num, cells) for cells in reader if any(c.strip() for c in cells)]
+    if not rows:
+        raise ExchangeError("empty file; expected a CSV header", file=path, line=1)
+    header = [name.strip() for name in rows[0][1]]
+    for line, cells in rows[1:]:
+        if len(cells) != len(header):
+            problem = "truncated row: " if len(cells) < len(header) else "row too long: "
+            raise ExchangeError(f"{problem}{len(cells)} cells, the header has {len(header)}", file=path, line=line)
+    if len(rows) == 1:
+        raise ExchangeError("no frames: the file has a header but no rows", file=path, line=1)
+    return header, rows[1:]
+
+
+def csv_number(cells: list[str], i: int, header: list[str], line: int, path) -> float:
+    """Cell ``i`` of a row as a finite float, else an ExchangeError naming the line and column."""
+    text = cells[i].strip()
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not np.isfinite(value):
+        raise ExchangeError(f"column {header[i]}: {text!r} is not a number", file=path, line=line)
+    return value
+
+
+def require_columns(header: list[str], required, path, what: str) -> dict[str, int]:
+    """Index of each name in ``header`` (any case); an ExchangeError listing the missing ``required`` ones."""
+    lookup = {name.lower(): i for i, name in enumerate(header)}
+    missing = [name for name in required if name.lower() not in lookup]
+    if missing:
+        shown = ", ".join(missing[:6]) + (f" and {len(missing) - 6} more" if len(missing) > 6 else "")
+        raise ExchangeError(f"not {what}: missing column{'s' * (len(missing) > 1)} {shown}", file=path, line=1)
+    return lookup
+
+
+# ------------------------------------------------------ recorded curves ---
+
+def timeline_from_samples(times, curves: Mapping[tuple[int, str], np.ndarray], *, fps: float,
+                          decimals: int = 4, **settings):
+    """A timeline that passes through recorded levels at ``times``.
+
+    Each (code, side) curve becomes linear segments from frame to frame
+    (collinear runs merged, runs of zero left out), so sampling the timeline
+    at ``times[i]`` gives ``curves[key][i]`` (rounded to ``decimals``). The
+    last frame holds for one frame interval, which is where the timeline ends.
+
+    Parameters
+    ----------
+    times : (n,) array
+        Seconds, strictly increasing, the first >= 0.
+    curves : mapping (code, "left" | "right" | "both") → (n,) array of levels
+        Left and right curves of one AU that are equal become one ``both``
+        track, as does an AU that cannot act on one side (from its larger
+        side); otherwise each side is a track of its own.
+    fps : float
+        The timeline's frame rate (the last frame's length is ``1 / fps``).
+    **settings
+        ``character``, ``engine``, ``description``, ``intensities``.
+    """
+    from facsim.catalogue import info
+    from facsim.timeline import Segment, Timeline, Track
+
+    times = np.asarray(times, dtype=float)
+    if times.ndim != 1 or times.size == 0:
+        raise ValueError("times must be a non-empty 1-D array of seconds")
+    if times[0] < 0 or np.any(np.diff(times) <= 0):
+        raise ValueError("times must start at 0 s or later and increase strictly")
+    end = float(times[-1] + 1.0 / fps)
+    knots = np.append(times, end)
+    by_code: dict[int, dict[str, np.ndarray]] = {}
+    for (code, side), values in curves.items():
+        by_code.setdefault(int(code), {})[side] = np.clip(np.round(np.asarray(values, float), decimals), 0.0, 1.0)
+    tracks = []
+    for code in sorted(by_code):
+        sides = by_code[code]
+        left, right = sides.get("left"), sides.get("right")
+        twins = left is not None and right is not None and np.array_equal(left, right)
+        if "both" in sides or twins or not info(code).unilateral:
+            parts = [s for s in (sides.get("both"), left, right) if s is not None]
+            sides = {"both": np.max(parts, axis=0)}
+        for side in ("both", "left", "right"):
+            if side in sides:
+                segments = _linear_segments(knots, np.append(sides[side], sides[side][-1]), Segment)
+                if segments:
+                    tracks.append(Track(au=code, side=side, timing=segments))
+    return Timeline(tuple(tracks), duration=end, fps=fps, **settings)
+
+
+def _linear_segments(knots: np.ndarray, levels: np.ndarray, segment) -> tuple:
+    """Segments through (knots[i], levels[i]); collinear points merged, flat zero runs dropped."""
+    keep = np.ones(len(knots), bool)
+    if len(knots) > 2:
+        t0, t1, t2 = knots[:-2], knots[1:-1], knots[2:]
+        v0, v1, v2 = levels[:-2], levels[1:-1], levels[2:]
+        straight = np.abs(v0 + (v2 - v0) * (t1 - t0) / (t2 - t0) - v1) <= 1e-12
+        keep[1:-1] = ~straight
+    idx = np.flatnonzero(keep)
+    out = []
+    for a, b in zip(idx[:-1], idx[1:]):
+        if levels[a] == 0.0 and levels[b] == 0.0:
+            continue
+        out.append(segment(float(knots[a]), float(knots[b]), float(levels[a]), float(levels[b])))
+    return tuple(out)
+
+
+# ------------------------------------------------------- rigid motions ---
+
+def _table():
+    from facsim.registers import register_table
+
+    return register_table()
+
+
+def head_motion(levels: Callable[[int], float]) -> tuple[np.ndarray, np.ndarray]:
+    """Head rotation vector (radians) and shift (dm) from codes 51–58, as the register engine sums them.
+
+    ``levels(code)`` gives each code's intensity (e.g. ``Activations.level``).
+    """
+    rotvec, shift = np.zeros(3), np.zeros(3)
+    for code, spec in _table()["head_motions"].items():
+        level = levels(code)
+        if level:
+            if "translate" in spec:
+                shift += level * np.asarray(spec["translate"], float)
+            else:
+                rotvec += np.radians(spec["degrees"] * level) * np.asarray(spec["axis"], float)
+    return rotvec, shift
+
+
+def eye_motion(levels: Callable[[int], float]) -> dict[str, np.ndarray]:
+    """Rotation vector (radians) per eye ("left", "right") from codes 61–66, as the engine sums them."""
+    rotvec = {"left": np.zeros(3), "right": np.zeros(3)}
+    for code, spec in _table()["eye_rotations"].items():
+        level = levels(code)
+        if level:
+            for side in rotvec:
+                rotvec[side] += np.radians(spec[side] * level) * np.asarray(spec["axis"], float)
+    return rotvec
+
+
+def head_levels(rotvec_degrees) -> dict[int, float]:
+    """Levels of the head-turn codes that give rotation vector ``rotvec_degrees`` (clipped to 1).
+
+    Each code takes the component of the rotation along its axis, divided by
+    its angle at intensity 1; the opposite code of a pair gets 0.
+    """
+    rotvec = np.asarray(rotvec_degrees, float)
+    out = {}
+    for code, spec in _table()["head_motions"].items():
+        if "degrees" in spec:
+            axis = np.asarray(spec["axis"], float)
+            out[code] = float(np.clip(rotvec @ axis / spec["degrees"], 0.0, 1.0))
+    return out
+
+
+def eye_levels(left_degrees, right_degrees) -> dict[int, float]:
+    """Levels of codes 61–66 from each eye's rotation vector in degrees (clipped to 1).
+
+    Codes that turn both eyes the same way (61–64) take the eyes' mean
+    rotation along their axis; codes that turn them apart (65, 66) take half
+    the difference.
+    """
+    left, right = np.asarray(left_degrees, float), np.asarray(right_degrees, float)
+    out = {}
+    for code, spec in _table()["eye_rotations"].items():
+        axis = np.asarray(spec["axis"], float)
+        if spec["left"] == spec["right"]:
+            amount, full = (left + right) @ axis / 2, spec["left"]
+        else:
+            amount, full = (left - right) @ axis / 2, (spec["left"] - spec["right"]) / 2
+        out[code] = float(np.clip(amount / full, 0.0, 1.0))
+    return out
+
+
+__all__ = [
+    "ExchangeError", "TIMELINE_SUFFIXES", "csv_number", "eye_levels", "eye_motion", "head_levels", "head_motion",
+    "load_any_timeline", "read_csv_rows", "require_columns", "save_any_timeline",
+    "timeline_from_samples", "write_file", *sorted(_LAZY),
+]

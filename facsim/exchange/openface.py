@@ -1,0 +1,172 @@
+"""OpenFace 2.0 FeatureExtraction CSV → timeline: a recorded performance, replayed on any character.
+
+Columns used (names are matched after stripping the spaces OpenFace puts
+after each comma, in any case): ``timestamp`` and ``success`` (required),
+``face_id``, ``confidence``, ``gaze_angle_x``, ``gaze_angle_y``,
+``pose_Rx``, ``pose_Ry``, ``pose_Rz`` (optional), and the AU intensity
+columns ``AU01_r`` … ``AU45_r`` (at least one). Presence columns (``AUxx_c``)
+are not used: AU28 has only presence and is left out.
+
+Conversions
+    * Intensity 0–5 → level: 0 → 0, 1 → A, 2 → B, 3 → C, 4 → D, 5 → E of
+      the intensity table (HapFACS: 0.15, 0.30, 0.55, 0.85, 1.0), linear in
+      between, clipped to 0..5.
+    * Head pose: ``pose_R*`` are radians, R = Rx·Ry·Rz in the camera frame
+      (x right in the image, y down, z away from the camera). facsim's head
+      frame (+X the character's left, +Y up, +Z toward the camera) is that
+      frame turned 180° about x, so the head's rotation vector is
+      (rx, −ry, −rz) of the camera one; its share along each head-turn axis
+      over the register engine's full angle gives 51–56
+      (:func:`facsim.exchange.head_levels`).
+    * Gaze: ``gaze_angle_x/y`` are radians in the camera frame (x > 0: the
+      person looks to the image's right, their own left; y > 0: down).
+      The gaze is turned into the head's frame (so a turned head looking
+      at the camera has its eyes turned back), then its yaw and pitch give
+      61–64 with the engine's eye angles (:func:`facsim.exchange.eye_levels`).
+    * Frames with ``success`` 0 (and, with ``min_confidence``, less confident
+      ones) hold the last good frame's values (neutral before the first).
+    * Times are ``timestamp`` minus the first one. The frame rate is
+      1 / median frame interval, snapped to a common rate within 1 %; when
+      every timestamp is within a quarter frame of ``i / fps`` the times
+      become exactly ``i / fps``, so the timeline's frames sample the
+      recorded ones.
+
+Each AU becomes a track of linear segments from frame to frame
+(:func:`facsim.exchange.timeline_from_samples`).
+"""
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+
+from . import ExchangeError, csv_number, eye_levels, head_levels, read_csv_rows, require_columns, timeline_from_samples
+
+#: Frame rates the measured one is snapped to (within 1 %).
+COMMON_FPS = (15, 24, 25, 30, 48, 50, 60, 90, 100, 120)
+_AU_COLUMN = re.compile(r"^AU(\d+)_r$", re.IGNORECASE)
+_POSE = ("pose_Rx", "pose_Ry", "pose_Rz")
+_GAZE = ("gaze_angle_x", "gaze_angle_y")
+
+
+def intensity_levels(values, table: str = "hapfacs") -> np.ndarray:
+    """OpenFace intensities (0–5) as levels: 0, A … E of ``table`` at 0, 1 … 5, linear between.
+
+    Examples
+    --------
+    >>> intensity_levels([0, 1, 3, 4.5, 7]).tolist()
+    [0.0, 0.15, 0.55, 0.925, 1.0]
+    """
+    from facsim.catalogue import INTENSITY_TABLES, LETTERS
+
+    knots = [0.0] + [INTENSITY_TABLES[table][letter] for letter in LETTERS]
+    return np.interp(np.clip(np.asarray(values, float), 0.0, 5.0), np.arange(6.0), knots)
+
+
+def head_rotvec_degrees(pose: np.ndarray) -> np.ndarray:
+    """Head rotation vectors (n, 3) in degrees, facsim's head frame, from OpenFace ``pose_R*`` (n, 3) radians."""
+    from scipy.spatial.transform import Rotation
+
+    camera = Rotation.from_euler("XYZ", np.atleast_2d(pose)).as_rotvec()
+    return np.degrees(camera * np.array([1.0, -1.0, -1.0]))
+
+
+def eye_rotvec_degrees(gaze: np.ndarray, head_degrees: np.ndarray) -> np.ndarray:
+    """Eye-in-head rotation vectors (n, 3) in degrees from OpenFace ``gaze_angle_x/y`` (n, 2) radians."""
+    from scipy.spatial.transform import Rotation
+
+    gaze = np.atleast_2d(gaze)
+    forward = np.stack([np.tan(gaze[:, 0]), -np.tan(gaze[:, 1]), np.ones(len(gaze))], axis=1)  # head frame axes
+    in_head = Rotation.from_rotvec(np.radians(head_degrees)).inv().apply(forward)
+    yaw = np.degrees(np.arctan2(in_head[:, 0], in_head[:, 2]))
+    pitch = np.degrees(np.arctan2(-in_head[:, 1], np.hypot(in_head[:, 0], in_head[:, 2])))
+    return np.stack([pitch, yaw, np.zeros(len(gaze))], axis=1)
+
+
+def _frame_rate(times: np.ndarray) -> float:
+    if len(times) < 2:
+        return 30.0
+    rate = 1.0 / float(np.median(np.diff(times)))
+    near = min(COMMON_FPS, key=lambda r: abs(r - rate))
+    return float(near) if abs(near - rate) <= 0.01 * rate else round(rate, 3)
+
+
+def _hold_bad_frames(values: np.ndarray, good: np.ndarray) -> np.ndarray:
+    """Each bad row replaced by the last good row before it (zeros before the first)."""
+    index = np.where(good, np.arange(len(good)), -1)
+    last = np.maximum.accumulate(index)
+    padded = np.vstack([np.zeros((1, values.shape[1])), values])
+    return padded[last + 1]
+
+
+def read_openface_csv(path, *, intensities: str = "hapfacs", face_id: int | None = None,
+                      min_confidence: float | None = None, fps: float | None = None):
+    """A timeline from an OpenFace 2.0 FeatureExtraction CSV (see the module docstring).
+
+    Parameters
+    ----------
+    path : path
+    intensities : str
+        Letter table for intensities 1–5 (``"hapfacs"`` or ``"facshuman"``).
+    face_id : int, optional
+        Which face of a multi-face file (default: the lowest id).
+    min_confidence : float, optional
+        Also hold frames whose ``confidence`` is below this.
+    fps : float, optional
+        The timeline's frame rate; default: measured from the timestamps.
+
+    Raises
+    ------
+    ExchangeError
+        Missing columns, a truncated row, a cell that is not a number,
+        timestamps that go backwards; naming the file and line.
+    """
+    path = Path(path)
+    header, data = read_csv_rows(path)
+    lookup = require_columns(header, ["timestamp", "success"], path, "an OpenFace CSV")
+    au_at = {int(m.group(1)): i for i, name in enumerate(header) if (m := _AU_COLUMN.match(name))}
+    if not au_at:
+        raise ExchangeError("not an OpenFace CSV: no AU intensity columns (AU01_r ...)", file=path, line=1)
+    wanted = ["timestamp", "success", "face_id", "confidence", *_POSE, *_GAZE]
+    optional = {name: lookup.get(name.lower()) for name in wanted}
+    numbers = np.array([[csv_number(cells, i, header, line, path) if i is not None else 0.0
+                         for i in [*optional.values(), *au_at.values()]] for line, cells in data])
+    column = {name: numbers[:, k] for k, name in enumerate(optional)}
+    if optional["face_id"] is not None:
+        chosen = column["face_id"].min() if face_id is None else face_id
+        keep = column["face_id"] == chosen
+        if not keep.any():
+            raise ExchangeError(f"no rows with face_id {face_id}", file=path)
+        numbers, data = numbers[keep], [row for row, k in zip(data, keep) if k]
+        column = {name: numbers[:, k] for k, name in enumerate(optional)}
+    stamps = column["timestamp"]
+    backwards = np.flatnonzero(np.diff(stamps) <= 0)
+    if backwards.size:
+        raise ExchangeError(f"timestamp {stamps[backwards[0] + 1]:g} does not come after the previous row's "
+                            f"({stamps[backwards[0]]:g})", file=path, line=data[backwards[0] + 1][0])
+    good = column["success"] > 0
+    if min_confidence is not None and optional["confidence"] is not None:
+        good &= column["confidence"] >= min_confidence
+    values = _hold_bad_frames(numbers[:, len(optional):], good)
+    pose = _hold_bad_frames(np.stack([column[n] for n in _POSE], 1), good)
+    gaze = _hold_bad_frames(np.stack([column[n] for n in _GAZE], 1), good)
+
+    times = stamps - stamps[0]
+    rate = float(fps) if fps else _frame_rate(times)
+    index = np.round(times * rate)
+    if np.all(np.abs(times * rate - index) <= 0.25) and np.all(np.diff(index) > 0):
+        times = index / rate
+    curves = {(code, "both"): intensity_levels(values[:, k], intensities) for k, code in enumerate(au_at)}
+    head = head_rotvec_degrees(pose)
+    if any(optional[n] is not None for n in _POSE):
+        for code in head_levels(np.zeros(3)):
+            curves[(code, "both")] = np.array([head_levels(v)[code] for v in head])
+    if any(optional[n] is not None for n in _GAZE):
+        eyes = eye_rotvec_degrees(gaze, head)
+        levels = [eye_levels(v, v) for v in eyes]
+        for code in (61, 62, 63, 64):
+            curves[(code, "both")] = np.array([lv[code] for lv in levels])
+    curves = {key: v for key, v in curves.items() if np.any(v > 0)}
+    return timeline_from_samples(times, curves, fps=rate, intensities=intensities,
+                                 description=f"OpenFace performance {path.name}")
