@@ -93,6 +93,9 @@ def build_parser() -> argparse.ArgumentParser:
     from . import dynamics_cli  # noqa: WPS433 — the video commands live beside the timeline code
 
     dynamics_cli.add_commands(sub, add_view_options)
+    from . import exchange_cli
+
+    exchange_cli.add_commands(sub, add_view_options)
     return parser
 
 

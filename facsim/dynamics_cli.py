@@ -41,7 +41,8 @@ def add_commands(sub, add_view_options) -> None:
 
 def timeline_activations(path, time: float):
     """The activations of timeline ``path`` at ``time`` seconds."""
-    from .timeline import load_timeline, sample
+    from .exchange import load_any_timeline as load_timeline
+    from .timeline import sample
 
     timeline = load_timeline(path)
     if not 0 <= time <= timeline.length:
@@ -51,7 +52,7 @@ def timeline_activations(path, time: float):
 
 def cmd_animate(args) -> None:
     from .cli import render_options
-    from .timeline import load_timeline
+    from .exchange import load_any_timeline as load_timeline
     from .video import animate
 
     timeline = load_timeline(args.timeline)
@@ -77,8 +78,8 @@ def cmd_emotion(args) -> None:
 
 
 def cmd_plot(args) -> None:
+    from .exchange import load_any_timeline as load_timeline
     from .plot import plot_timeline
-    from .timeline import load_timeline
 
     plot_timeline(load_timeline(args.timeline), args.output)
     print(f"wrote {args.output}")

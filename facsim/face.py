@@ -133,7 +133,11 @@ class Face:
         return self.engine(act) if act else self.neutral
 
     def camera(self, *, view: str = "front", yaw=None, pitch=None, projection="perspective", size=(512, 512), fov_deg=None):
-        """A camera framing this character's head and upper neck."""
+        """A camera framing this character's neutral head and upper neck (the same for every frame)."""
+        return self._camera(view, yaw, pitch, projection, tuple(size), fov_deg)
+
+    @lru_cache(maxsize=16)  # noqa: B019 — a Face lives as long as its renders
+    def _camera(self, view, yaw, pitch, projection, size, fov_deg):
         from .camera import DEFAULT_FOV_DEG, frame_points
 
         skin = self.neutral[self.head.skin]

@@ -22,7 +22,8 @@ ARKit → AUs
     columns duplicate a kept AU's are left out (listed in ``arkit52.yaml``).
     The inverse recovers levels exactly where no two active AUs share a shape;
     where they do, Eq. 1's clamp is not undone. Head angles give 51–56 (each
-    code's share of the rotation along its axis over its full angle); eye
+    code's share of the rotation along its axis over its full angle; 57/58,
+    moving the head forward and back, have no ARKit column); eye
     angles, when the file has any, give 61–66, else 61–64 come from the
     eyeLook shapes. The levels become a timeline of linear segments from
     frame to frame (:func:`facsim.exchange.timeline_from_samples`).

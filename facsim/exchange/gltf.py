@@ -39,6 +39,8 @@ from pathlib import Path
 
 import numpy as np
 
+from facsim.expression import Activations
+
 from . import eye_motion, head_motion, write_file
 
 #: facsim decimetres → glTF metres.
@@ -247,87 +249,28 @@ def _quaternions(rotvecs: np.ndarray) -> np.ndarray:
 def glb_bytes(face, timeline=None, *, aus="all", interpolation: str = "LINEAR", normals: bool = True,
               fps: float | None = None) -> bytes:
     """The character of ``face`` as GLB bytes (see the module docstring and :func:`export_glb`)."""
-    from facsim.expression import Activations
-    from facsim.registers import RegisterEngine, register_table
-    from facsim.render import REGIONS, vertex_normals
-
     interpolation = interpolation.upper()
     if interpolation not in ("LINEAR", "STEP"):
         raise ValueError(f"interpolation must be LINEAR or STEP, got {interpolation!r}")
-    head, topo = face.head, face.head.topology
-    engine = face.engine if face.engine_name == "registers" else RegisterEngine(
-        head, face.data, face.character, face.base_positions)
-    neutral = np.asarray(face.neutral, np.float64)
-    geo_faces = topo.geo_faces
-    normals_of = lambda positions: vertex_normals(positions, geo_faces)  # noqa: E731
-
-    eyeball = REGIONS.index("eyeball")
-    keep = np.flatnonzero(topo.region != eyeball)                      # head-mesh render vertices
-    local = np.full(topo.n_render, -1)
-    local[keep] = np.arange(len(keep))
-    geo = topo.render_to_geo[keep]
-    pivot = head.joint(face.base_positions, "joint-neck").astype(np.float64)
-
-    b = GlbBuilder()
-    attributes = {"POSITION": b.accessor(neutral[geo] * METRES, "VEC3", target=ARRAY_BUFFER, bounds=True)}
-    if normals:
-        attributes["NORMAL"] = b.accessor(normals_of(neutral)[geo], "VEC3", target=ARRAY_BUFFER)
-    attributes["TEXCOORD_0"] = b.accessor(topo.uv[keep], "VEC2", target=ARRAY_BUFFER)
-    blend = register_table()["neck_blend"]
-    follow = _smoothstep(blend["none_below"], blend["full_above"], neutral[geo, 1] - pivot[1])
-    weights = np.zeros((len(keep), 4), np.float32)
-    weights[:, 1] = follow.astype(np.float32)
-    weights[:, 0] = 1.0 - weights[:, 1]
-    joints = np.zeros((len(keep), 4), np.uint8)
-    joints[:, 1] = weights[:, 1] > 0                                  # an unused slot names joint 0
-    attributes["JOINTS_0"] = b.accessor(joints, "VEC4", UBYTE, target=ARRAY_BUFFER)
-    attributes["WEIGHTS_0"] = b.accessor(weights, "VEC4", target=ARRAY_BUFFER)
-
     keys = morph_target_keys(aus)
-    targets = []
-    neutral_normals = normals_of(neutral) if normals else None
-    for code, side in keys:
-        sides = ("left", "right") if side == "both" else (side,)
-        moved = np.asarray(engine(Activations({(code, s): 1.0 for s in sides})), np.float64)
-        target = {"POSITION": b.delta_accessor((moved[geo] - neutral[geo]) * METRES)}
-        if normals:
-            target["NORMAL"] = b.delta_accessor(normals_of(moved)[geo] - neutral_normals[geo])
-        targets.append(target)
-
+    head = face.head
+    pivot = head.joint(face.base_positions, "joint-neck").astype(np.float64)
+    b = GlbBuilder()
     materials, material_index = _materials(b, face.appearance)
-    face_region = topo.face_regions()
-    primitives = []
-    for region in PRIMITIVES:
-        tris = topo.faces[face_region == REGIONS.index(region)]
-        if len(tris):
-            indices = local[tris].reshape(-1)
-            textured = region == "skin"
-            primitive = {"attributes": {k: v for k, v in attributes.items() if textured or k != "TEXCOORD_0"},
-                         "indices": b.accessor(indices, "SCALAR", USHORT if len(keep) < 65536 else UINT,
-                                               target=ELEMENT_ARRAY_BUFFER, bounds=True),
-                         "material": material_index[region], "mode": 4}
-            if targets:
-                primitive["targets"] = targets
-            primitives.append(primitive)
-    face_mesh = {"name": "face", "primitives": primitives}
-    if targets:
-        face_mesh["weights"] = [0.0] * len(targets)
-        face_mesh["extras"] = {"targetNames": [target_name(*k) for k in keys]}
-    meshes = [face_mesh]
-
-    nodes = [{"name": "neck", "translation": list(pivot * METRES), "children": [1]},
+    meshes = [_face_mesh(b, face, keys, pivot, material_index, normals)]
+    nodes = [{"name": "neck", "translation": _floats(pivot * METRES), "children": [1]},
              {"name": "head", "children": [2, 3]}]
     for side, suffix in (("left", "L"), ("right", "R")):
         centre, radius = head.eye_pivot(face.base_positions, side)
-        meshes.append(_eye_mesh(b, topo, head.eye_vertices[side], radius * METRES, material_index["eye"], suffix))
+        meshes.append(_eye_mesh(b, head.topology, head.eye_vertices[side], radius * METRES,
+                                material_index["eye"], suffix))
         nodes.append({"name": f"eye_{suffix}", "mesh": len(meshes) - 1,
-                      "translation": list((np.asarray(centre, float) - pivot) * METRES)})
+                      "translation": _floats((np.asarray(centre, float) - pivot) * METRES)})
     inverse_bind = np.tile(np.eye(4), (2, 1, 1))
     inverse_bind[:, 3, :3] = -pivot * METRES                           # column-major: translation in row 3
     skin = {"name": "neck_head", "joints": [0, 1], "skeleton": 0,
             "inverseBindMatrices": b.accessor(inverse_bind, "MAT4")}
     nodes.append({"name": "face", "mesh": 0, "skin": 0})
-
     document = {
         "asset": {"version": "2.0", "generator": _generator(),
                   "extras": {"character": face.character.name or "custom",
@@ -338,6 +281,68 @@ def glb_bytes(face, timeline=None, *, aus="all", interpolation: str = "LINEAR", 
     if timeline is not None:
         document["animations"] = [_animation(b, timeline, keys, fps, interpolation)]
     return b.glb(document)
+
+
+def _floats(values) -> list[float]:
+    return [float(v) for v in values]
+
+
+def _face_mesh(b: GlbBuilder, face, keys, pivot, material_index: dict, normals: bool) -> dict:
+    """Mesh ``face``: the head without eyeballs, skinned to neck/head, one primitive per material, AU targets."""
+    from facsim.registers import RegisterEngine, register_table
+    from facsim.render import REGIONS, vertex_normals
+
+    head, topo = face.head, face.head.topology
+    engine = face.engine if face.engine_name == "registers" else RegisterEngine(
+        head, face.data, face.character, face.base_positions)
+    neutral = np.asarray(face.neutral, np.float64)
+    keep = np.flatnonzero(topo.region != REGIONS.index("eyeball"))   # head-mesh render vertices
+    local = np.full(topo.n_render, -1)
+    local[keep] = np.arange(len(keep))
+    geo = topo.render_to_geo[keep]
+    normals_of = lambda positions: vertex_normals(positions, topo.geo_faces)[geo]  # noqa: E731
+
+    rest_normals = normals_of(neutral)
+    attributes = {"POSITION": b.accessor(neutral[geo] * METRES, "VEC3", target=ARRAY_BUFFER, bounds=True)}
+    if normals:
+        attributes["NORMAL"] = b.accessor(rest_normals, "VEC3", target=ARRAY_BUFFER)
+    attributes["TEXCOORD_0"] = b.accessor(topo.uv[keep], "VEC2", target=ARRAY_BUFFER)
+    blend = register_table()["neck_blend"]
+    weights = np.zeros((len(keep), 4), np.float32)
+    weights[:, 1] = _smoothstep(blend["none_below"], blend["full_above"], neutral[geo, 1] - pivot[1])
+    weights[:, 0] = 1.0 - weights[:, 1]
+    joints = np.zeros((len(keep), 4), np.uint8)
+    joints[:, 1] = weights[:, 1] > 0                                  # an unused slot names joint 0
+    attributes["JOINTS_0"] = b.accessor(joints, "VEC4", UBYTE, target=ARRAY_BUFFER)
+    attributes["WEIGHTS_0"] = b.accessor(weights, "VEC4", target=ARRAY_BUFFER)
+
+    targets = []
+    for code, side in keys:
+        sides = ("left", "right") if side == "both" else (side,)
+        moved = np.asarray(engine(Activations({(code, s): 1.0 for s in sides})), np.float64)
+        target = {"POSITION": b.delta_accessor((moved[geo] - neutral[geo]) * METRES)}
+        if normals:
+            target["NORMAL"] = b.delta_accessor(normals_of(moved) - rest_normals)
+        targets.append(target)
+
+    primitives = []
+    face_region = topo.face_regions()
+    for region in PRIMITIVES:
+        tris = topo.faces[face_region == REGIONS.index(region)]
+        if not len(tris):
+            continue
+        primitive = {"attributes": {k: v for k, v in attributes.items() if region == "skin" or k != "TEXCOORD_0"},
+                     "indices": b.accessor(local[tris].reshape(-1), "SCALAR", USHORT if len(keep) < 65536 else UINT,
+                                           target=ELEMENT_ARRAY_BUFFER, bounds=True),
+                     "material": material_index[region], "mode": 4}
+        if targets:
+            primitive["targets"] = targets
+        primitives.append(primitive)
+    mesh = {"name": "face", "primitives": primitives}
+    if targets:
+        mesh["weights"] = [0.0] * len(targets)
+        mesh["extras"] = {"targetNames": [target_name(*k) for k in keys]}
+    return mesh
 
 
 def _generator() -> str:

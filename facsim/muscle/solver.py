@@ -78,7 +78,7 @@ class Model:
     area_matrix: sp.csr_matrix   # (V, T) a third of each triangle's area to its column vertices
     area_scatter: sp.csr_matrix  # (T, V) its transpose
     contact_ids: np.ndarray      # points kept above the skull ...
-    contact_floor: np.ndarray    # (K,) ... by at least this much ...
+    contact_floor: np.ndarray    # (K, C) ... by at least this much (never more than at rest) ...
     contact_site: np.ndarray     # (K, C, 3) ... over one of these bone sites (rest, in their bone's frame)
     contact_site_normal: np.ndarray  # (K, C, 3)
     contact_jaw: np.ndarray      # (K,) bool: the bone is the jaw
@@ -187,6 +187,12 @@ def build_model(net: TensionNet, layer: MuscleLayer, spec: dict, tongue: TongueM
     contact_parent = np.r_[skin_contact, parent[muscle_contact]]
     contact_floor = np.r_[net.floor[skin_contact], layer.node_floor[muscle_contact]]
     candidates = net.candidates[contact_parent]
+    # A point may not be held further out than it rests over each site (in concave places —
+    # the nostrils, the ear — a site across the cavity would otherwise push it), and sites
+    # facing away from the point's own bone normal are not its skull at all.
+    height = ((rest[contact_ids][:, None, :] - net.sites[candidates]) * net.site_normal[candidates]).sum(-1)
+    facing = (net.site_normal[candidates] * net.normal[contact_parent][:, None, :]).sum(-1) > 0.3
+    contact_floor = np.where(facing, np.minimum(contact_floor[:, None], height), -np.inf)
 
     # Eyeball contact for lids, the sac and the lid muscles' points.
     eye_of = np.full(ns, -1)
@@ -455,6 +461,7 @@ class Floors:
 
     site: np.ndarray             # (3, B, K) bone point under each contact point
     normal: np.ndarray           # (3, B, K) its outward normal
+    floor: np.ndarray            # (B, K) least height over it
 
 
 def select_sites(model: Model, x: np.ndarray, ld: Loads) -> Floors:
@@ -473,15 +480,17 @@ def select_sites(model: Model, x: np.ndarray, ld: Loads) -> Floors:
     k = np.arange(len(p))[:, None]
     site = model.contact_site[k, best]                         # (K, B, 3)
     normal = model.contact_site_normal[k, best]
+    floor = model.contact_floor[k, best].T                     # (B, K)
     if jaw.any():
         site[jaw] = np.einsum("bij,kbj->kbi", rot, site[jaw] - hinge) + hinge + shift
         normal[jaw] = np.einsum("bij,kbj->kbi", rot, normal[jaw])
-    return Floors(np.ascontiguousarray(site.transpose(2, 1, 0)), np.ascontiguousarray(normal.transpose(2, 1, 0)))
+    return Floors(np.ascontiguousarray(site.transpose(2, 1, 0)), np.ascontiguousarray(normal.transpose(2, 1, 0)),
+                  np.ascontiguousarray(floor))
 
 
 def _gaps(model: Model, x: np.ndarray, floors: Floors):
     """Gaps (> 0: through the floor) of the skull and eyeball contacts, and the eyeball normals."""
-    skull_gap = model.contact_floor - _dot(x[:, :, model.contact_ids] - floors.site, floors.normal)
+    skull_gap = floors.floor - _dot(x[:, :, model.contact_ids] - floors.site, floors.normal)
     v = x[:, :, model.eye_ids] - model.eye_centre
     dist = np.sqrt(_dot(v, v))
     return skull_gap, model.eye_floor - dist, v / np.maximum(dist, 1e-12)
