@@ -30,6 +30,18 @@ def _color(text: str):
         raise argparse.ArgumentTypeError(f"{exc} (or white, black, grey, transparent)") from None
 
 
+def _antialias(text: str):
+    if text == "fxaa":
+        return text
+    try:
+        samples = int(text)
+    except ValueError:
+        samples = 0
+    if samples < 1:
+        raise argparse.ArgumentTypeError(f"antialias must be a number of samples (1, 2, 4) or fxaa, got {text!r}")
+    return samples
+
+
 def _size(text: str):
     try:
         if "x" in text:
@@ -52,7 +64,8 @@ def add_view_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--size", type=_size, default=(512, 512), help="N or WxH pixels (default 512)")
     p.add_argument("--projection", choices=("perspective", "orthographic"), default="perspective")
     p.add_argument("--background", type=_color, default=(1.0, 1.0, 1.0), help="#rrggbb, a colour name or transparent")
-    p.add_argument("--antialias", type=int, default=4, help="MSAA samples (1 = off)")
+    p.add_argument("--antialias", type=_antialias, default=4,
+                   help="MSAA samples (1 = off, 4 = default) or fxaa (fast post-process smoothing)")
     p.add_argument("--intensities", choices=("hapfacs", "facshuman"), default="hapfacs",
                    help="what the letters A-E mean (HapFACS: 15/30/55/85/100 %%)")
 

@@ -10,7 +10,7 @@ def add_commands(sub, add_view_options) -> None:
     p.add_argument("--audio", help="an audio file to mux into the MP4/WebM")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     add_view_options(p)
-    p.set_defaults(handler=cmd_animate, character=None, engine=None)
+    p.set_defaults(handler=cmd_animate, character=None, engine=None, antialias="fxaa")
 
     p = sub.add_parser("emotion", help="a HapFACS-style emotion (or FACS) stimulus video: onset, apex, offset")
     p.add_argument("name", help='an emotion (see `facsim emotions`) or a FACS string such as "1+2+5B+26"')
@@ -28,7 +28,7 @@ def add_commands(sub, add_view_options) -> None:
     p.add_argument("--save-timeline", help="also write the timeline used (YAML or JSON)")
     p.add_argument("--quiet", action="store_true")
     add_view_options(p)
-    p.set_defaults(handler=cmd_emotion)
+    p.set_defaults(handler=cmd_emotion, antialias="fxaa")
 
     p = sub.add_parser("plot", help="plot a timeline's AU intensities over time (PNG or SVG)")
     p.add_argument("timeline")

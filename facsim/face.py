@@ -147,17 +147,23 @@ class Face:
         return frame_points(skin[keep], view=view, yaw=yaw, pitch=pitch, projection=projection,
                             fov_deg=fov_deg or DEFAULT_FOV_DEG, margin=0.06, aspect=width / height)
 
-    def renderer(self, size=(512, 512), *, antialias: int = 2, background=(1.0, 1.0, 1.0)):
-        """A renderer for this head (cached per size, anti-aliasing and background)."""
+    def renderer(self, size=(512, 512), *, antialias=4, background=(1.0, 1.0, 1.0)):
+        """A renderer for this head (cached per size, anti-aliasing and background).
+
+        ``antialias``: MSAA samples (1 = off, 4 = llvmpipe's best) or ``"fxaa"``
+        (post-process edge smoothing at about the cost of no AA).
+        """
         from .render import Renderer
 
         key = (tuple(size), antialias, None if background is None else tuple(background))
         if key not in self._renderers:
-            self._renderers[key] = Renderer(self.head.topology, size=tuple(size), antialias=antialias, background=background)
+            method = "fxaa" if antialias == "fxaa" else "msaa"
+            self._renderers[key] = Renderer(self.head.topology, size=tuple(size), background=background,
+                                            antialias=1 if method == "fxaa" else int(antialias), aa_method=method)
         return self._renderers[key]
 
     def render(self, expression=None, *, view: str = "front", yaw=None, pitch=None, size=512,
-               projection: str = "perspective", background=(1.0, 1.0, 1.0), antialias: int = 2,
+               projection: str = "perspective", background=(1.0, 1.0, 1.0), antialias=4,
                positions=None, wrinkle=None) -> np.ndarray:
         """Render ``expression`` to an (H, W, 4) uint8 RGBA image.
 

@@ -80,7 +80,7 @@ DEFAULT_COLORS: Mapping[str, tuple[float, float, float]] = MappingProxyType({
 
 #: Anti-aliasing methods: multisampling (``antialias`` = samples) or supersampling
 #: (``antialias`` = factor per axis, then a box-filter downsampling pass).
-AA_METHODS = ("msaa", "ssaa")
+AA_METHODS = ("msaa", "ssaa", "fxaa")
 
 #: Eyebrow strokes for hm08's raw UV layout, where the head's island is turned 90 degrees:
 #: the brows run along v (strokes ~3 mm long) and u runs up the face (strands ~0.5 mm apart).
@@ -676,8 +676,10 @@ class Renderer:
         Output image size in pixels.
     antialias : int
         ``aa_method="msaa"``: samples per pixel (1 = off; capped at the driver's maximum).
-        ``"ssaa"``: supersampling factor per axis (1..4).
-    aa_method : {"msaa", "ssaa"}
+        ``"ssaa"``: supersampling factor per axis (1..4). ``"fxaa"``: ignored.
+    aa_method : {"msaa", "ssaa", "fxaa"}
+        ``"fxaa"`` shades one sample per pixel and smooths edges in a post pass: about the
+        cost of no AA, for video frames where 4x MSAA would not keep up.
         Measured on llvmpipe (2 cores, 512 px, the 12.7k-triangle head): 4x MSAA 48 ms,
         2x2 SSAA 56 ms, no AA 24 ms per frame. llvmpipe shades every sample and only has
         4x MSAA (a request for 2 samples gets 4, at the same cost), so the default is
@@ -851,9 +853,10 @@ class Renderer:
                 self._out_fbo = self._scene_fbo
             self._downsample = None
         else:
-            k = self.antialias
+            k = self.antialias if self.aa_method == "ssaa" else 1
             self._scene_tex = self._track(ctx.texture((w * k, h * k), 4))
-            self._scene_tex.filter = (ctx.NEAREST, ctx.NEAREST)  # never mipmapped (render target)
+            # Never mipmapped (a render target); FXAA reads between texels.
+            self._scene_tex.filter = (ctx.LINEAR, ctx.LINEAR) if self.aa_method == "fxaa" else (ctx.NEAREST, ctx.NEAREST)
             self._scene_fbo = self._track(ctx.framebuffer(
                 color_attachments=[self._scene_tex],
                 depth_attachment=self._track(ctx.depth_renderbuffer((w * k, h * k)))))
@@ -864,7 +867,8 @@ class Renderer:
                 defines["UNPREMULTIPLY"] = ""
             prog = self._track(ctx.program(
                 vertex_shader=_shader_source("fullscreen.vert.glsl", {}),
-                fragment_shader=_shader_source("downsample.frag.glsl", defines)))
+                fragment_shader=_shader_source(f"{'fxaa' if self.aa_method == 'fxaa' else 'downsample'}.frag.glsl",
+                                               defines)))
             _set_uniform(prog, "u_image", 0)
             self._downsample = self._track(ctx.vertex_array(prog, []))
         self._readback = bytearray(w * h * 4)

@@ -180,8 +180,10 @@ def animate(timeline, path, *, face=None, character=None, engine=None, fps: floa
 
     ``character`` and ``engine`` default to the timeline's own settings, then to
     "ava" and "registers". ``render_options`` go to :meth:`Face.render` (view,
-    yaw, pitch, size, projection, background, antialias).
+    yaw, pitch, size, projection, background, antialias); video frames default to
+    FXAA anti-aliasing, which keeps up with real time where 4x MSAA does not.
     """
+    render_options.setdefault("antialias", "fxaa")
     from .face import Face
     from .timeline import frame_times, sample_frames
 

@@ -67,3 +67,13 @@ def test_renders_are_reproducible(face_of):
 def test_bad_size_is_refused(face_of, size):
     with pytest.raises(ValueError, match="image size"):
         face_of("ava").render(size=size)
+
+
+def test_fxaa_smooths_edges_like_msaa(face_of):
+    face = face_of("ava")
+    plain, fxaa, msaa = (face.render("6+12", size=128, antialias=a).astype(int) for a in (1, "fxaa", 4))
+    bg = background_mask(plain.astype(np.uint8))
+    silhouette = bg ^ np.roll(bg, 1, axis=1)  # pixels where the head meets the background
+    def error(img):
+        return np.abs(img - msaa)[silhouette].mean()
+    assert error(fxaa) < 0.8 * error(plain)

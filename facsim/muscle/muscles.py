@@ -179,13 +179,13 @@ class _Builder:
         kinds = (LID, SOCKET) if self.anat.kind[vid] in (LID, SOCKET) else (OUTER, LID)
         radius = sel.get("radius", 0.04)
         heads, w = patch(self.anat, vid, radius, kinds=kinds)
-        if side == "right" and heads is not None:
-            pass  # patch() works on the vertex given, already mirrored
         centre = (w[:, None] * self.net.rest[heads]).sum(axis=0)
+        normal = (w[:, None] * self.net.normal[heads]).sum(axis=0)
+        normal /= np.linalg.norm(normal)
         on_eye = self.anat.kind[vid] in (LID, SOCKET)
         # Lid muscles lie on the tarsus, right under the skin; elsewhere half a tissue depth down.
-        depth = 0.0 if on_eye else INSERTION_DEPTH * self.net.depth[vid]
-        node = self.node(centre - depth * self.net.normal[vid], vid, 0.1 * self.net.depth[vid])
+        depth = 0.0 if on_eye else INSERTION_DEPTH * (w * self.net.depth[heads]).sum()
+        node = self.node(centre - depth * normal, vid, 0.1 * self.net.depth[vid])
         for h, wh in zip(heads, w):
             self.arc(node, int(h), self.c["insertion"] * wh)
         return node, heads, w

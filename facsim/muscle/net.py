@@ -184,6 +184,7 @@ class Anatomy:
     eye_centre: dict
     eye_radius: float
     landmarks: dict
+    mouth_corner: int
 
     @property
     def outer(self) -> np.ndarray:
@@ -235,7 +236,18 @@ def anatomy(head) -> Anatomy:
         jaw_weight=jaw_weight, lip_half=lip_half, rim_pairs=rim_pairs, margins=margins,
         canthi=canthi, fixed=np.asarray(head.neck_loop), mirror=np.asarray(head.mirror),
         eye_centre=eye_centre, eye_radius=eye_radius, landmarks=dict(landmarks(head)),
+        mouth_corner=_mouth_corner(base[:n], edges, kind),
     )
+
+
+def _mouth_corner(points, edges, kind) -> int:
+    """The left corner of the mouth: the outer-skin vertex on the lips' rim furthest from the midline."""
+    lining = kind == MOUTH
+    rim = np.zeros(len(kind), bool)
+    for a, b in (edges.T, edges[:, ::-1].T):
+        rim[a[(~lining[a]) & lining[b]]] = True
+    ids = np.flatnonzero(rim & (points[:, 0] > 0))
+    return int(ids[np.argmax(points[ids, 0])])
 
 
 def _lid_margins(base, edges, kind, eye_side):
@@ -360,9 +372,13 @@ def resolve_vertex(anat: Anatomy, sel: dict, side: str = "left") -> int:
         name = sel["landmark"]
         if name in ("medial_canthus", "lateral_canthus"):
             vid = anat.canthi["left"][0 if name == "medial_canthus" else 1]
+        elif name == "mouth_corner":
+            vid = anat.mouth_corner
         else:
             marks = anat.landmarks
             vid = marks[name] if name in marks else marks[name + "_left"]
+            # The project's landmarks may fall on the mouth lining; muscles insert into outer skin.
+            vid = outer[np.argmin(np.linalg.norm(base[outer] - base[vid], axis=1))]
     elif "lid" in sel:
         ids = anat.margins["left"][sel["lid"]]
         ax = np.abs(base[ids, 0])
