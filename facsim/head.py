@@ -51,6 +51,8 @@ NECK_JOINT = "joint-neck"
 #: hm08's lash strips are long opaque cards; drawn at this fraction of their
 #: length (toward their roots on the lid) they read as lashes, not eyeliner.
 LASH_LENGTH = 0.45
+#: Least distance (dm) kept between moved skin and the eyeball surface.
+EYE_CLEARANCE = 0.004
 
 
 @dataclass(frozen=True, eq=False)  # identity-hashed: caches key on the model
@@ -91,6 +93,7 @@ class HeadModel:
     skin_vertex_count: int
     lashes: np.ndarray  # geometry indices of lash vertices ...
     lash_roots: np.ndarray  # ... and of the lash vertex at the root of each one's strand
+    lash_anchors: np.ndarray  # ... and of the lid skin vertex that root grows from
     masks: dict  # MakeHuman's UV masks (lips, eyelids, inside-mouth) over the paint box
     mirror: np.ndarray = field(repr=False)  # geometry index of each vertex's mirror image
 
@@ -103,23 +106,47 @@ class HeadModel:
         """Geometry indices of the skin surface (including mouth and eye sockets)."""
         return np.arange(self.skin_vertex_count)
 
-    def positions(self, base_positions: np.ndarray, *, eye_base=None, eye_rotations=None) -> np.ndarray:
+    def positions(self, base_positions: np.ndarray, *, neutral_base=None, eye_rotations=None) -> np.ndarray:
         """Geometry positions (N_geo, 3) from morphed base positions (19158, 3).
 
-        ``eye_base`` gives the base positions the eye pivots are measured on (the
-        character's neutral, so expression targets cannot move the eyeballs);
-        ``eye_rotations`` maps "left"/"right" to a 3×3 rotation about the eye centre.
+        ``neutral_base`` is the character's neutral base mesh when ``base_positions``
+        carries an expression: the eye pivots are measured on it (expression targets
+        must not move the eyeballs), and lashes follow the lid skin they grow from
+        (some targets move the lids but not the lash cards). ``eye_rotations`` maps
+        "left"/"right" to a 3×3 rotation about the eye centre.
         """
+        neutral = base_positions if neutral_base is None else neutral_base
         out = np.empty((self.vertex_count, 3), np.float32)
         out[: len(self.base_index)] = base_positions[self.base_index]
         for side in EYE_SIDES:
-            centre, radius = self.eye_pivot(base_positions if eye_base is None else eye_base, side)
+            centre, radius = self.eye_pivot(neutral, side)
             local = self.eye_local if not eye_rotations else self.eye_local @ np.asarray(eye_rotations[side]).T
             out[self.eye_vertices[side]] = centre + radius * local
+        if neutral_base is not None:
+            skin_moved = out[self.lash_anchors] - neutral[self.base_index[self.lash_anchors]]
+            root_moved = out[self.lash_roots] - neutral[self.base_index[self.lash_roots]]
+            out[self.lashes] += skin_moved - root_moved
         roots = out[self.lash_roots]
         out[self.lashes] = roots + LASH_LENGTH * (out[self.lashes] - roots)
         out[self.cap_vertex] = out[self.neck_loop].mean(axis=0)
         return out
+
+    def keep_skin_off_eyes(self, positions: np.ndarray, neutral: np.ndarray, neutral_base: np.ndarray) -> None:
+        """Push skin that an expression moved into an eyeball back onto its surface (in place).
+
+        Summed targets can draw the lids or the skin below them inward through the
+        eyeball, which then shows through the skin. Skin outside the eye at neutral
+        is kept at least ``EYE_CLEARANCE`` off it (or as far as it was, if closer).
+        """
+        skin = slice(0, self.skin_vertex_count)
+        for side in EYE_SIDES:
+            centre, radius = self.eye_pivot(neutral_base, side)
+            rest = np.linalg.norm(neutral[skin] - centre, axis=1)
+            offset = positions[skin] - centre
+            distance = np.linalg.norm(offset, axis=1)
+            floor = np.minimum(rest, radius + EYE_CLEARANCE)
+            inside = (distance < floor) & (rest >= radius)
+            positions[skin][inside] = centre + offset[inside] * (floor[inside] / distance[inside])[:, None]
 
     def joint(self, base_positions: np.ndarray, name: str) -> np.ndarray:
         """Centre of MakeHuman joint cube ``name`` (e.g. "joint-mouth") after morphing."""
@@ -325,7 +352,9 @@ def _lash_roots(positions, region) -> dict:
     # Roots: the half of the lash vertices closest to the skin; each tip takes its nearest root.
     roots = lashes[depth <= np.median(depth)]
     nearest = cKDTree(positions[roots]).query(positions[lashes])[1]
-    return {"lashes": lashes, "lash_roots": roots[nearest]}
+    lash_roots = roots[nearest]
+    anchors = skin[cKDTree(positions[skin]).query(positions[lash_roots])[1]]
+    return {"lashes": lashes, "lash_roots": lash_roots, "lash_anchors": anchors}
 
 
 def _geo_mirror(base_mirror, base_index, eye_vertices, eye_local, n_geo) -> np.ndarray:

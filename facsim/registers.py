@@ -157,7 +157,8 @@ class RegisterEngine:
                 base += weight * self.column(col)
         morphed = np.array(self.base_positions, copy=True)
         morphed[self.head.base_index] = base
-        positions = self.head.positions(morphed, eye_base=self.base_positions, eye_rotations=self.eye_rotations(act))
+        positions = self.head.positions(morphed, neutral_base=self.base_positions, eye_rotations=self.eye_rotations(act))
+        self.head.keep_skin_off_eyes(positions, self.neutral, self.base_positions)
         return self.move_head(positions, act)
 
     def eye_rotations(self, act: Activations) -> dict[str, np.ndarray]:

@@ -152,6 +152,8 @@ class VideoWriter:
 def _rgb(frame: np.ndarray) -> np.ndarray:
     if frame.shape[2] == 3:
         return frame
+    if frame[..., 3].min() == 255:  # opaque background: nothing to composite
+        return frame[..., :3]
     alpha = frame[..., 3:4].astype(np.float32) / 255
     return (frame[..., :3] * alpha + 255 * (1 - alpha) + 0.5).astype(np.uint8)
 

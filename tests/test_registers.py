@@ -145,3 +145,19 @@ def test_emotions_differ_from_neutral_where_their_aus_act(face_of):
             continue
         img = face.render(emotion(name), size=128).astype(int)
         assert np.abs(img - neutral).sum(-1).max() > 100, name
+
+
+def test_no_pair_of_aus_pushes_skin_into_an_eyeball(engine, head):
+    """Every pair of simulated AUs at E: finite geometry, skin stays off the eyeballs."""
+    import itertools
+    codes = sorted(simulated_codes())
+    skin = slice(0, head.skin_vertex_count)
+    pivots = [head.eye_pivot(engine.base_positions, side) for side in ("left", "right")]
+    outside = [np.linalg.norm(engine.neutral[skin] - c, axis=1) >= r for c, r in pivots]
+    for a, b in itertools.combinations(codes, 2):
+        p = engine(Activations({(a, s): 1.0 for s in ("left", "right")} | {(b, s): 1.0 for s in ("left", "right")}))
+        assert np.isfinite(p).all(), (a, b)
+        if {a, b} & set(register_table()["head_motions"]):
+            continue  # the head (eyes included) moved rigidly: the contact is the neutral's
+        for (c, r), out in zip(pivots, outside):
+            assert (np.linalg.norm(p[skin][out] - c, axis=1) >= r - 1e-4).all(), (a, b)

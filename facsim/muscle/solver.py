@@ -40,7 +40,7 @@ from .muscles import Drive, MuscleLayer, TongueModel, jaw_pose
 from .net import Arcs, TensionNet, jaw_transform
 
 #: L-BFGS memory.
-HISTORY = 20
+HISTORY = 10
 
 
 # ------------------------------------------------------------------ model ---
@@ -130,6 +130,7 @@ class State:
     x: np.ndarray
     drive: Drive
     jaw: np.ndarray
+    memory: tuple = ()           # the minimiser's curvature history, carried to the next frame
 
     @property
     def batch(self) -> int:
@@ -263,7 +264,7 @@ def build_model(net: TensionNet, layer: MuscleLayer, spec: dict, tongue: TongueM
         lip_pairs=rim, lip_floor=np.minimum(lip_sep, 0.0), lip_k=float(np.median(net.contact_k[net.contact_k > 0])),
         seg_a=seg_a, seg_b=seg_b, seg_scatter_a=seg_a.T.tocsr(), seg_scatter_b=seg_b.T.tocsr(),
         seg_bone_a=bone_a, seg_bone_b=bone_b, force_matrix=force_matrix, tongue=tongue,
-        stiffness=system.tocsr(), solve_rest=lu.solve, max_step=0.04 * net.scale, jaw_spec=spec["jaw"],
+        stiffness=system.tocsr(), solve_rest=lu.solve, max_step=0.025 * net.scale, jaw_spec=spec["jaw"],
     )
 
 
@@ -540,7 +541,8 @@ def _per_config(a, b) -> np.ndarray:
     return np.einsum("cbn,cbn->b", a, b)
 
 
-def minimise(model: Model, x: np.ndarray, ld: Loads, iterations: int, *, tolerance: float = 1e-7) -> np.ndarray:
+def minimise(model: Model, x: np.ndarray, ld: Loads, iterations: int, *, tolerance: float = 1e-7,
+             memory: tuple = ()) -> tuple[np.ndarray, tuple]:
     """Projected L-BFGS from ``x`` (3, B, N), H₀⁻¹ = the factorised rest stiffness.
 
     A point on its contact floor may not step further in (that part of the
@@ -548,12 +550,17 @@ def minimise(model: Model, x: np.ndarray, ld: Loads, iterations: int, *, toleran
     side. The skull site under each point is chosen once per call, so the
     energy is fixed during the iterations. Each configuration keeps its own
     history and its own backtracking step.
+
+    ``memory`` is the L-BFGS history of a previous call (pairs of steps and
+    gradient changes): the net's curvature changes little from one increment
+    or frame to the next, so carrying it over saves relearning it. Returns the
+    new points and the updated memory.
     """
     floors = select_sites(model, x, ld)
     x, gaps = project_contacts(model, x, floors)
     e, g = energy(model, x, ld)
     g = _hold_on_contacts(model, g, gaps, floors, sign=1.0)  # the walls take up what pushes into them
-    s_hist, y_hist, rho_hist = [], [], []
+    s_hist, y_hist, rho_hist = (list(part) for part in memory) if memory else ([], [], [])
     for _ in range(iterations):
         if np.abs(g).max() < tolerance:
             break
@@ -601,7 +608,7 @@ def minimise(model: Model, x: np.ndarray, ld: Loads, iterations: int, *, toleran
             rho_hist.append(1.0 / sy)
             if len(s_hist) > HISTORY:
                 del s_hist[0], y_hist[0], rho_hist[0]
-    return x
+    return x, (tuple(s_hist), tuple(y_hist), tuple(rho_hist))
 
 
 # ------------------------------------------------------------------ solve ---
@@ -627,11 +634,11 @@ def solve(model: Model, state: State, target: Drive, *, steps: int = 3, iteratio
     every intermediate state is a valid expression, and ``callback(state)``
     sees each one (animation frames).
     """
-    x = state.x
+    x, memory = state.x, state.memory
     for k in range(1, steps + 1):
         d = _lerp_drive(state.drive, target, k / steps)
         ld = loads(model, d)
-        x = minimise(model, x, ld, iterations)
+        x, memory = minimise(model, x, ld, iterations, memory=memory)
         if callback is not None:
-            callback(State(x, d, ld.jaw))
-    return State(x, target, ld.jaw)
+            callback(State(x, d, ld.jaw, memory))
+    return State(x, target, ld.jaw, memory)
