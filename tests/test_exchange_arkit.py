@@ -60,7 +60,7 @@ def test_weights_are_the_registers_faceunits_targets():
     assert weights["mouthSmileLeft"] == pytest.approx(0.5) and weights["mouthSmileRight"] == 0.0
     assert weights["cheekSquintLeft"] == pytest.approx(0.1)          # 12's second register: max 0.2
     both = arkit_weights(Activations({(6, "left"): 1.0, (7, "left"): 1.0}))
-    assert both["eyeSquintLeft"] == pytest.approx(0.45)               # Eq. 1 clamps to the smaller max
+    assert both["eyeSquintLeft"] == pytest.approx(0.3)                # Eq. 1 clamps to the smaller max (AU6: 0.3)
 
 
 def test_inverse_map_is_unambiguous():
