@@ -19,7 +19,7 @@ _LAZY = {
     "Activations": "facsim.expression",
     "emotion": "facsim.emotions",
     "Character": "facsim.character",
-    "load_timeline": "facsim.timeline",
+    "load_timeline": "facsim.timeline_io",
     "stimulus_timeline": "facsim.timeline",
     "animate": "facsim.video",
 }

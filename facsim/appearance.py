@@ -18,7 +18,7 @@ import numpy as np
 from .assets import cache_dir
 from .atomic import atomic_write
 from .character import COLOR_KEYS, Character
-from .render import Appearance
+from .render_inputs import Appearance
 
 #: Young-adult colours per ethnicity (sRGB). Sources: typical values of the
 #: Fitzpatrick II / IV / V–VI skin types; brows and irises the commonest shade.

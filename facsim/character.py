@@ -26,7 +26,9 @@ Face-shape sliders are named after the target files without their direction:
 Examples
 --------
 >>> macro_weights(Character(gender=1.0, age=25))["caucasian-male-young"]
-0.3333333333333333
+1.0
+>>> round(macro_weights(Character(gender=1.0, age=25, african=1.0))["caucasian-male-young"], 3)
+0.5
 """
 from __future__ import annotations
 

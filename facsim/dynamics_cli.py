@@ -63,7 +63,8 @@ def cmd_animate(args) -> None:
 
 def cmd_emotion(args) -> None:
     from .cli import render_options
-    from .timeline import Blinks, save_timeline, stimulus_timeline
+    from .timeline import Blinks, stimulus_timeline
+    from .timeline_io import save_timeline
     from .video import animate
 
     timeline = stimulus_timeline(
@@ -88,6 +89,6 @@ def cmd_plot(args) -> None:
 def cmd_schema(args) -> None:
     import json
 
-    from .timeline import timeline_schema
+    from .timeline_io import timeline_schema
 
     print(json.dumps(timeline_schema(), indent=2))

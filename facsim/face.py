@@ -113,7 +113,7 @@ class Face:
 
         from .assets import cache_dir
         from .atomic import atomic_write
-        from .render import bake_occlusion
+        from .render_occlusion import bake_occlusion
 
         key = hashlib.sha256(repr((OCCLUSION_VERSION, self.character.with_(name="", description="", colors={})))
                              .encode()).hexdigest()[:16]
@@ -188,7 +188,7 @@ class Face:
 
     def save(self, path, expression=None, **render_options) -> np.ndarray:
         """Render and write a PNG atomically; returns the image."""
-        from .render import write_png
+        from .images import write_png
 
         image = self.render(expression, **render_options)
         write_png(path, image)

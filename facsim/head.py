@@ -23,7 +23,7 @@ from functools import cached_property
 import numpy as np
 
 from .assets import PAINT_UV_BOX
-from .render import REGIONS, RenderTopology
+from .render_inputs import REGIONS, RenderTopology
 
 #: Segmentation labels that make up the head surface, its mouth and eye sockets.
 HEAD_LABELS = ("head", "mouth_cavity", "eye_cavity.L", "eye_cavity.R")

@@ -10,8 +10,8 @@ Examples
 --------
 >>> combine_registers([(0.3, 0.6), (0.5, 1.0)])   # AUs x, y share a register
 0.6
->>> combine_registers([(0.2, 0.6), (0.3, 1.0)])
-0.5
+>>> round(combine_registers([(0.2, 0.6), (0.3, 1.0)]), 2)   # 0.2·0.6 + 0.3·1.0, under 0.6
+0.42
 """
 from __future__ import annotations
 

@@ -78,7 +78,7 @@ class VideoWriter:
         if frame.dtype != np.uint8 or frame.ndim != 3 or frame.shape[2] not in (3, 4):
             raise ValueError(f"frames must be (H, W, 3|4) uint8 arrays, got {frame.dtype} {frame.shape}")
         if self.format == "png":
-            from .render import write_png
+            from .images import write_png
 
             write_png(self._tmp / f"frame_{self.frames_written:05d}.png", frame)
         elif self.format == "gif":

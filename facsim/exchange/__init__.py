@@ -125,7 +125,7 @@ def load_any_timeline(path):
         return __getattr__("read_notation")(path)
     if suffix == ".csv":
         return (__getattr__("read_arkit_csv") if _csv_kind(path) == "arkit" else __getattr__("read_openface_csv"))(path)
-    from facsim.timeline import load_timeline
+    from facsim.timeline_io import load_timeline
 
     return load_timeline(path)
 
@@ -135,7 +135,7 @@ def save_any_timeline(timeline, path) -> Path:
     path = Path(path)
     if path.suffix.lower() == ".facs":
         return __getattr__("write_notation")(timeline, path)
-    from facsim.timeline import save_timeline
+    from facsim.timeline_io import save_timeline
 
     return save_timeline(timeline, path)
 

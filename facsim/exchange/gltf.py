@@ -145,7 +145,7 @@ def _srgb8(linear: np.ndarray) -> np.ndarray:
 
 
 def _linear(colour) -> np.ndarray:
-    from facsim.render import srgb_to_linear
+    from facsim.render_inputs import srgb_to_linear
 
     return srgb_to_linear(np.asarray(colour, float))
 
@@ -290,7 +290,8 @@ def _floats(values) -> list[float]:
 def _face_mesh(b: GlbBuilder, face, keys, pivot, material_index: dict, normals: bool) -> dict:
     """Mesh ``face``: the head without eyeballs, skinned to neck/head, one primitive per material, AU targets."""
     from facsim.registers import RegisterEngine, register_table
-    from facsim.render import REGIONS, vertex_normals
+    from facsim.render_geometry import vertex_normals
+    from facsim.render_inputs import REGIONS
 
     head, topo = face.head, face.head.topology
     engine = face.engine if face.engine_name == "registers" else RegisterEngine(

@@ -1,0 +1,66 @@
+"""The process's OpenGL context and the shader sources, shared by everything that draws.
+
+One context per process (EGL, created lazily on first use, reused by every
+:class:`~facsim.render.Renderer` and by :func:`~facsim.render_occlusion.bake_occlusion`,
+and recreated in a forked child). Shaders are read from ``facsim/shaders`` with
+``#include "common.glsl"`` expanded and a variant's ``#define`` lines put in front.
+``moderngl`` is imported only when a context is first needed.
+"""
+from __future__ import annotations
+
+import os
+import threading
+from pathlib import Path
+
+
+class RenderError(RuntimeError):
+    """OpenGL could not be set up or used (no driver, context creation failed, ...)."""
+
+
+_CTX = None
+_CTX_PID = None
+_CTX_LOCK = threading.Lock()
+
+
+def gl_context():
+    """The process's shared moderngl context (EGL, GL >= 3.3), created on first use."""
+    global _CTX, _CTX_PID
+    with _CTX_LOCK:
+        if _CTX is None or _CTX_PID != os.getpid():
+            _CTX = _create_context()
+            _CTX_PID = os.getpid()
+        return _CTX
+
+
+def _create_context():
+    import moderngl
+
+    errors = []
+    for kwargs in ({"backend": "egl"}, {}):  # EGL: headless Linux; {}: the platform default
+        try:
+            return moderngl.create_context(standalone=True, require=330, **kwargs)
+        except Exception as exc:  # moderngl raises bare Exception subclasses per backend
+            errors.append(f"{kwargs.get('backend', 'default')}: {exc}")
+    raise RenderError("could not create an OpenGL 3.3 context (" + "; ".join(errors) + "). On "
+                      "Debian/Ubuntu install libegl1 libgl1 libgl1-mesa-dri for headless Mesa.")
+
+
+_SHADER_DIR = Path(__file__).with_name("shaders")
+
+
+def _shader_source(name: str, defines: dict[str, object]) -> str:
+    text = (_SHADER_DIR / name).read_text()
+    include = '#include "common.glsl"'
+    if include in text:
+        text = text.replace(include, (_SHADER_DIR / "common.glsl").read_text())
+    head = ["#version 330 core"] + [f"#define {k} {v}".rstrip() for k, v in defines.items()]
+    return "\n".join(head) + "\n#line 1\n" + text
+
+
+def _set_uniform(program, name: str, value) -> None:
+    """Set a uniform if the compiler kept it (moderngl raises KeyError for removed ones)."""
+    try:
+        uniform = program[name]
+    except KeyError:
+        return
+    uniform.value = value
