@@ -172,8 +172,10 @@ class Face:
         """
         size = _size_pair(size)
         if positions is None:
-            positions = self.deform(expression)
-            wrinkle = getattr(self.engine, "last_wrinkle", None) if wrinkle is None else wrinkle
+            act = to_activations(expression)
+            positions = self.engine(act) if act else self.neutral
+            if wrinkle is None and act:  # the neutral face has no creases
+                wrinkle = getattr(self.engine, "last_wrinkle", None)
         camera = self.camera(view=view, yaw=yaw, pitch=pitch, projection=projection, size=size)
         return self.renderer(size, antialias=antialias, background=background).render(
             np.asarray(positions, np.float32), appearance=self.appearance, camera=camera, wrinkle=wrinkle,
