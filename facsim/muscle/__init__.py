@@ -21,17 +21,23 @@ from scipy.spatial import cKDTree
 
 from ..expression import Activations
 from . import solver
-from .muscles import au_table, build_muscles, build_tongue, drive, pressure_patches
-from .net import LID, SIDES, anatomy, build_net, load_spec, move_with_jaw
-from .wrinkles import WrinkleModel, build_wrinkles, wrinkle_field
+from .muscles import au_table, build_muscles, build_tongue, drive, jaw_pose, pressure_patches
+from .net import LID, SIDES, anatomy, build_net, jaw_transform, load_spec, move_with_jaw
+from .wrinkles import build_wrinkles, wrinkle_field
 
 __all__ = ["MuscleEngine", "simulated_codes", "coverage"]
 
 #: Increments of a static solve (Platt & Badler's n) and iterations per increment.
-STATIC_STEPS = 3
-STATIC_ITERATIONS = 14
+STATIC_STEPS = 2
+STATIC_ITERATIONS = 20
+#: A static solve takes one more increment per this many degrees of jaw opening.
+JAW_DEGREES_PER_STEP = 10.0
+#: At most this many extra rounds of iterations for a static solve that ends with folded skin.
+POLISH_ROUNDS = 5
+#: Expressions solved together by :meth:`MuscleEngine.solve_many`.
+BATCH = 4
 #: Iterations per animation frame (the state carries over, so frames converge over time).
-FRAME_ITERATIONS = 5
+FRAME_ITERATIONS = 1
 
 
 def simulated_codes() -> set[int]:
@@ -59,8 +65,15 @@ class _Parts:
         # Lashes ride the lid vertex nearest their root, turning with its local frame.
         lids = np.flatnonzero(anatomy(head).kind == LID)
         _, near = cKDTree(neutral[lids]).query(neutral[head.lashes], k=3)
+        frame = lids[near]                                              # (L, 3) vertices spanning a frame
+        # The right lashes take the mirror image of their left twins' frames (symmetric faces stay so).
+        mirror = np.asarray(head.mirror)
+        twin = {int(v): k for k, v in enumerate(head.lashes)}
+        for k, v in enumerate(head.lashes):
+            if neutral[v, 0] < 0 and int(mirror[v]) in twin:
+                frame[k] = mirror[frame[twin[int(mirror[v])]]]
         self.lashes = head.lashes
-        self.lash_frame = lids[near]                                    # (L, 3) vertices spanning a frame
+        self.lash_frame = frame
         self.lash_offset = np.einsum("lij,lj->li", _frames(neutral, self.lash_frame),
                                      neutral[head.lashes] - neutral[self.lash_frame[:, 0]])
         self.eye = {s: head.eye_vertices[s] for s in SIDES}
@@ -120,27 +133,69 @@ class MuscleEngine:
 
         self.head = head
         base_positions = np.asarray(base_positions, np.float32)
-        self.model, self.wrinkles, neutral = _built(head, base_positions)
+        self.model, self.wrinkles, neutral = _built(head, data, base_positions)
         self.neutral = neutral.astype(np.float32)
         self.parts = _Parts(head, data, neutral, self.model.net)
         # Rigid head (51–58) and eye (61–66) motions are the register engine's, shared by both engines.
         self.rigid = RegisterEngine(head, data, character, base_positions)
         self.state = solver.rest_state(self.model)
-        self.last_wrinkle = np.zeros(head.vertex_count, np.float32)
+        self._wrinkle_of = None  # (state, index) whose wrinkles ``last_wrinkle`` computes on demand
+        self._wrinkle = None
         self.last_state = self.state
 
     # -- public API
     def __call__(self, act: Activations) -> np.ndarray:
         """Static solve: the expression ``act`` reached from rest in n increments."""
-        state = solver.solve(self.model, solver.rest_state(self.model), drive(self.model.layer, act),
-                             steps=STATIC_STEPS, iterations=STATIC_ITERATIONS)
-        return self._finish(state, act)
+        return self.solve_many([act])[0]
+
+    def solve_many(self, acts, *, steps: int = STATIC_STEPS, iterations: int = STATIC_ITERATIONS) -> np.ndarray:
+        """Static solves of several expressions at once (batched): positions (B, N_geo, 3) float32.
+
+        ``last_wrinkle`` and ``last_state`` then describe the last expression.
+        """
+        acts = list(acts)
+        out = [None] * len(acts)
+        for k, state, b in self.static_states(acts, steps=steps, iterations=iterations):
+            out[k] = self.geometry(state, acts[k], b)
+            if k == len(acts) - 1:
+                self._remember(state, b)
+        return np.stack(out)
+
+    def static_states(self, acts, *, steps: int = STATIC_STEPS, iterations: int = STATIC_ITERATIONS):
+        """Yield ``(k, state, b)``: expression ``k`` of ``acts`` solved from rest is configuration
+        ``b`` of ``state``.
+
+        Expressions needing the same number of increments are solved together, a
+        few at a time (beyond that the arrays leave the cache); each solves exactly
+        as it would alone.
+        """
+        acts = list(acts)
+        extra = [self._extra_steps(drive(self.model.layer, act)) for act in acts]
+        for more in sorted(set(extra)):
+            group = [k for k, e in enumerate(extra) if e == more]
+            for start in range(0, len(group), BATCH):
+                part = group[start:start + BATCH]
+                target = drive(self.model.layer, [acts[k] for k in part])
+                state = solve_static(self.model, target, steps=steps + more, iterations=iterations)
+                for b, k in enumerate(part):
+                    yield k, state, b
+
+    def _extra_steps(self, target) -> int:
+        """More increments for big jaw motions: the face then moves far, and the net is followed
+        more safely in smaller steps (the paper's n-step contraction as a continuation method)."""
+        pose = jaw_pose(self.model.layer, target.muscle, self.model.jaw_spec)
+        return int(np.degrees(pose[:, 0]).max() // JAW_DEGREES_PER_STEP)
 
     def step(self, act: Activations, *, iterations: int = FRAME_ITERATIONS) -> np.ndarray:
-        """One animation frame: apply the change since the previous frame and relax the net."""
+        """One animation frame: apply the change since the previous frame and relax the net.
+
+        The state (positions, applied activations and the minimiser's memory)
+        carries over between calls, so a held expression keeps converging.
+        """
         self.state = solver.solve(self.model, self.state, drive(self.model.layer, act), steps=1,
-                                  iterations=iterations)
-        return self._finish(self.state, act)
+                                  iterations=iterations, settle=False)
+        self._remember(self.state, 0)
+        return self.geometry(self.state, act)
 
     def animate(self, frames):
         """Yield positions for each Activations in ``frames`` (the stateful path, from rest)."""
@@ -153,18 +208,26 @@ class MuscleEngine:
         self.state = solver.rest_state(self.model)
 
     # -- geometry
-    def _finish(self, state: solver.State, act: Activations) -> np.ndarray:
+    def _remember(self, state: solver.State, index: int) -> None:
         self.last_state = state
-        positions = self.geometry(state, act)
-        skin = state.points(0)[: self.model.net.count]
-        wrinkle = np.zeros(self.head.vertex_count, np.float32)
-        wrinkle[: len(skin)] = wrinkle_field(self.wrinkles, skin)
-        self.last_wrinkle = wrinkle
-        return positions
+        self._wrinkle_of, self._wrinkle = (state, index), None
+
+    @property
+    def last_wrinkle(self) -> np.ndarray | None:
+        """Skin compression of the last result (N_geo,) float32 ≥ 0, for the renderer's creases.
+
+        Computed when first asked for (a render needs it; a solve does not).
+        """
+        if self._wrinkle is None and self._wrinkle_of is not None:
+            state, index = self._wrinkle_of
+            skin = state.points(index)[: self.model.net.count]
+            wrinkle = np.zeros(self.head.vertex_count, np.float32)
+            wrinkle[: len(skin)] = wrinkle_field(self.wrinkles, skin)
+            self._wrinkle = wrinkle
+        return self._wrinkle
 
     def geometry(self, state: solver.State, act: Activations, index: int = 0) -> np.ndarray:
         """Geometry positions (N_geo, 3) float32 of configuration ``index`` of a state."""
-        from .net import jaw_transform
         model = self.model
         net = model.net
         rot, shift = jaw_transform(state.jaw[index:index + 1], net.hinge, model.jaw_spec["yaw_per_lateral"])
@@ -175,25 +238,53 @@ class MuscleEngine:
         return self.rigid.move_head(out.astype(np.float32), act).astype(np.float32)
 
 
+def solve_static(model, target, *, steps: int, iterations: int) -> solver.State:
+    """An expression from rest in ``steps`` increments; where the skin is still folded through
+    itself at the end (a big change not yet relaxed), keep relaxing, a few rounds at most."""
+    state = solver.solve(model, solver.rest_state(model, target.muscle.shape[0]), target, steps=steps,
+                         iterations=iterations)
+    for _ in range(POLISH_ROUNDS):
+        folded = solver.folded(model, state.x) > 0
+        if not folded.any():
+            break
+        more = solver.solve(model, state, target, steps=1, iterations=iterations)
+        # Only the folded ones take the extra round (so a batch solves each alike to alone).
+        state = solver.State(np.where(folded[None, :, None], more.x, state.x), target,
+                             np.where(folded[:, None], more.jaw, state.jaw))
+    return state
+
+
 _MODELS: dict = {}
 
 
-def _built(head, base_positions):
+def _built(head, data, base_positions):
     """The model of a character, built once per process (about a second) and reused."""
     key = (id(head), hash(base_positions.tobytes()))
     if key not in _MODELS:
-        _MODELS[key] = _build_all(head, base_positions)
+        _MODELS[key] = _build_all(head, data, base_positions)
         while len(_MODELS) > 8:
             _MODELS.pop(next(iter(_MODELS)))
     return _MODELS[key]
 
 
-def _build_all(head, base_positions):
+def _build_all(head, data, base_positions):
     spec = load_spec()
     anat = anatomy(head)
     net = build_net(head, base_positions, anat=anat, spec=spec)
     layer = build_muscles(anat, net, spec)
     neutral = head.positions(base_positions).astype(float)
     tongue = build_tongue(head, anat, net, spec, neutral)
-    model = solver.build_model(net, layer, spec, tongue, pressure_patches(anat, net, spec))
+    model = solver.build_model(net, layer, spec, tongue, pressure_patches(anat, net, spec),
+                               teeth=_teeth_rows(head, data, neutral), mirror=np.asarray(head.mirror)[: net.count])
     return model, build_wrinkles(anat, net, spec), neutral
+
+
+def _teeth_rows(head, data, neutral) -> dict:
+    """Rest positions of the upper and lower tooth rows (geometry vertices of hm08's teeth helpers)."""
+    geo_of_base = np.full(len(head.base_vertices), -1, np.int64)
+    geo_of_base[head.base_index] = np.arange(len(head.base_index))
+    rows = {}
+    for name, group in (("upper", "helper-upper-teeth"), ("lower", "helper-lower-teeth")):
+        ids = geo_of_base[data.group_vertices(group)]
+        rows[name] = neutral[ids[ids >= 0]]
+    return rows

@@ -29,8 +29,7 @@ import numpy as np
 import yaml
 from scipy.spatial import cKDTree
 
-from .net import (LID, OUTER, SIDES, SOCKET, Anatomy, Arcs, TensionNet, carry_points, move_with_jaw,
-                  patch, resolve_vertex)
+from .net import LID, OUTER, SIDES, SOCKET, Anatomy, Arcs, TensionNet, carry_points, patch, resolve_vertex
 
 AU_FILE = "muscle_aus.yaml"
 #: Depth (in tissue depths below the skin) of an insertion's muscle point.
@@ -102,6 +101,7 @@ class MuscleLayer:
     bulge_ids: np.ndarray
     bulge_vec: np.ndarray
     bulge_muscle: np.ndarray
+    clench: np.ndarray = None    # (M,) bool: contracting it presses the teeth together
 
     def index(self, name: str, side: str) -> int:
         """Index of muscle ``name`` on ``side`` (midline muscles answer for both sides)."""
@@ -136,7 +136,7 @@ class _Builder:
         self.floor.append(float(floor))
         return self.n_skin + len(self.nodes) - 1
 
-    def arc(self, i: int, j: int, k: float, beta: float = 2.0, compress: float = 1.0):
+    def arc(self, i: int, j: int, k: float, beta: float = 0.0, compress: float = 1.0):
         pi, pj = self.position(i), self.position(j)
         for key, v in zip(("i", "j", "rest", "k", "beta", "compress"),
                           (i, j, np.linalg.norm(pi - pj), k, beta, compress)):
@@ -155,10 +155,14 @@ class _Builder:
 
     # -- selectors on the character
     def skin_point(self, sel: dict, side: str) -> tuple[int, np.ndarray]:
-        """Vertex and position of a skin selector, moved ``depth`` tissue depths inward."""
+        """Vertex and position of a skin selector, moved ``depth`` tissue depths inward (and by
+        ``offset``, base-mesh dm, mirrored on the right)."""
         vid = resolve_vertex(self.anat, sel, side)
         depth = sel.get("depth", 0.0) * self.net.depth[vid]
-        return vid, self.net.rest[vid] - depth * self.net.normal[vid]
+        offset = np.asarray(sel.get("offset", (0.0, 0.0, 0.0)), float) * self.net.scale
+        if side == "right":
+            offset = offset * [-1.0, 1.0, 1.0]
+        return vid, self.net.rest[vid] - depth * self.net.normal[vid] + offset
 
     def point(self, sel: dict, side: str) -> tuple[int, np.ndarray]:
         """Any selector → (nearest skin vertex, position on this character)."""
@@ -170,8 +174,15 @@ class _Builder:
             p = centre + self.net.scale * np.asarray(sel["eye"], float) * mirror
         else:
             return self.skin_point(sel, side)
-        vid = self.anat.outer[self._outer_tree.query(p)[1]]
-        return int(vid), p
+        return self._nearest(p, side)[0], p
+
+    def _nearest(self, p, side: str, k: int = 1) -> list[int]:
+        """The ``k`` outer-skin vertices nearest to ``p``, chosen on the left and mirrored for the
+        right (so that ties break alike on both sides)."""
+        left = np.asarray(p, float) * ([-1.0, 1.0, 1.0] if side == "right" else 1.0)
+        _, j = self._outer_tree.query(left, k=k)
+        ids = self.anat.outer[np.atleast_1d(j)]
+        return [int(self.anat.mirror[v]) if side == "right" else int(v) for v in ids]
 
     def insertion(self, sel: dict, side: str) -> tuple[int, np.ndarray, np.ndarray]:
         """A muscle point beneath a patch of skin heads: (node, heads, weights)."""
@@ -198,9 +209,8 @@ class _Builder:
             return self.bone(p, on_jaw)
         node = self.node(p, vid, 0.1 * self.net.depth[vid])
         # Coupled to the skin above it (the muscle lies in the superficial fascia).
-        _, near = self._outer_tree.query(p, k=3)
-        for h in self.anat.outer[near]:
-            self.arc(node, int(h), self.c["guide_coupling"] / 3.0)
+        for h in self._nearest(p, side, k=3):
+            self.arc(node, h, self.c["guide_coupling"] / 3.0)
         return node
 
 
@@ -225,9 +235,8 @@ def _fan(spec: dict) -> list[dict]:
 def build_muscles(anat: Anatomy, net: TensionNet, spec: dict) -> MuscleLayer:
     """Read the muscles of ``spec`` (muscles.yaml) onto a character's net."""
     b = _Builder(anat, net, spec["net"])
-    names, muscle_of, side_of, kinds, force, tone = [], [], [], [], [], []
+    names, muscle_of, side_of, kinds, force, tone, clench = [], [], [], [], [], [], []
     jaw_action, bulges = [], []
-    jaw_spec = spec["jaw"]
     for name, m in spec["muscles"].items():
         sides = ("both",) if m.get("midline") else SIDES
         for side in sides:
@@ -239,6 +248,7 @@ def build_muscles(anat: Anatomy, net: TensionNet, spec: dict) -> MuscleLayer:
             kinds.append(m["kind"])
             force.append(float(m["force"]))
             tone.append(float(m.get("tone", 0.0)))
+            clench.append(bool(m.get("clench", False)))
             action = np.zeros(3)
             if m["kind"] == "linear":
                 _linear(b, m, index, geo_side)
@@ -246,10 +256,10 @@ def build_muscles(anat: Anatomy, net: TensionNet, spec: dict) -> MuscleLayer:
                 _sphincter(b, m, index, geo_side, midline=side == "both")
             elif m["kind"] == "jaw":
                 action = _jaw_action(b, m, geo_side, net)
-                if "belly" in m:
-                    bulges.append((index, m["belly"], geo_side))
             else:
                 raise ValueError(f"muscles.yaml, {name}: unknown kind {m['kind']!r} (linear, sphincter, jaw)")
+            if "belly" in m:  # a contracting belly thickens (its volume is kept) and pushes the skin out
+                bulges.append((index, m["belly"], geo_side))
             jaw_action.append(action)
 
     bulge_ids, bulge_vec, bulge_muscle = [], [], []
@@ -278,6 +288,7 @@ def build_muscles(anat: Anatomy, net: TensionNet, spec: dict) -> MuscleLayer:
         bulge_ids=np.concatenate(bulge_ids) if bulge_ids else np.zeros(0, np.int64),
         bulge_vec=np.concatenate(bulge_vec) if bulge_vec else np.zeros((0, 3)),
         bulge_muscle=np.concatenate(bulge_muscle) if bulge_muscle else np.zeros(0, np.int64),
+        clench=np.asarray(clench, bool),
     )
 
 
@@ -336,8 +347,14 @@ def _sphincter(b: _Builder, m: dict, index: int, side: str, midline: bool):
             node, _, _ = b.insertion({**sel, "radius": radius}, side)
             chain.append(node)
     pairs = list(zip(chain[:-1], chain[1:])) + ([(chain[-1], chain[0])] if closed else [])
+    bias = m.get("bias")
+    centre_y = np.mean([b.position(r)[1] for r in chain])
     for p, q in pairs:
-        b.segment(p, q, index, 1.0)
+        weight = 1.0
+        if bias:  # segments below the ring's centre pull with `below`, above with `above`
+            t = np.clip((0.5 * (b.position(p)[1] + b.position(q)[1]) - centre_y) / (0.2 * b.net.scale), -1.0, 1.0)
+            weight = bias["below"] + (bias["above"] - bias["below"]) * 0.5 * (1.0 + t)
+        b.segment(p, q, index, weight)
         if p >= 0 and q >= 0:
             b.arc(p, q, b.c["muscle_passive"], beta=0.0, compress=0.2)
 
@@ -396,8 +413,7 @@ def drive(layer: MuscleLayer, activations_list) -> Drive:
             if not entry:
                 continue
             for name, value in (entry.get("muscles") or {}).items():
-                magnitude, target = (value, side) if not isinstance(value, dict) else (
-                    value["level"], {"same": side, "opposite": SIDES[1 - SIDES.index(side)]}.get(value.get("side", "same"), value.get("side")))
+                magnitude, target = _muscle_entry(value, side)
                 k = layer.index(name, target)
                 share = 0.5 if layer.side[k] == "both" else 1.0  # midline muscles: mean of the sides
                 muscle[bi, k] += share * magnitude * level
@@ -406,10 +422,25 @@ def drive(layer: MuscleLayer, activations_list) -> Drive:
             lip_pressure[bi] += 0.5 * air.get("lips", 0.0) * level
             tongue_spec = entry.get("tongue") or {}
             tongue[bi, 0] = max(tongue[bi, 0], tongue_spec.get("protrude", 0.0) * level)
-            tongue[bi, 1] += tongue_spec.get("sweep", 0.0) * level * (1 if side == "left" else -1)
+            # One tongue: it turns toward the side scored (toward the left when both are).
+            if side == "left" or act[code, "left"] == 0:
+                tongue[bi, 1] += tongue_spec.get("sweep", 0.0) * level * (1 if side == "left" else -1)
             tongue[bi, 2] = max(tongue[bi, 2], tongue_spec.get("lift", 0.0) * level)
     return Drive(np.clip(muscle, -1, 1), np.clip(pressure, -1, 1), np.clip(lip_pressure, -1, 1),
                  np.clip(tongue, -1, 1))
+
+
+def _muscle_entry(value, side: str) -> tuple[float, str]:
+    """An AU's muscle entry: a magnitude (on the AU's side) or ``{level, side}`` with side one of
+    same, opposite, left, right."""
+    if not isinstance(value, dict):
+        return float(value), side
+    where = value.get("side", "same")
+    if where == "same":
+        return float(value["level"]), side
+    if where == "opposite":
+        return float(value["level"]), SIDES[1 - SIDES.index(side)]
+    return float(value["level"]), where
 
 
 def jaw_pose(layer: MuscleLayer, muscle: np.ndarray, jaw_spec: dict, *, clench_floor: float = 0.0) -> np.ndarray:
@@ -426,6 +457,10 @@ def jaw_pose(layer: MuscleLayer, muscle: np.ndarray, jaw_spec: dict, *, clench_f
     o, p, lat = jaw_spec["opening"], jaw_spec["protrusion"], jaw_spec["lateral"]
     max_open = np.radians(o["max_degrees"])
     opening = max_open * np.tanh(np.maximum(gen[:, 0], 0.0) * o["compliance"] / max_open)
+    # Clenched teeth interlock: a jaw pressed shut by its clenchers (masseter) does not slide.
+    clench = np.clip(np.max(np.where(layer.clench, muscle, 0.0), axis=1, keepdims=True) / 0.5, 0.0, 1.0)
+    free = 1.0 - clench * clench * (3.0 - 2.0 * clench)
+    gen = np.c_[gen[:, :1], gen[:, 1:] * free]
     forward = np.where(gen[:, 1] >= 0,
                        p["max"] * np.tanh(gen[:, 1] * p["compliance"] / p["max"]),
                        p["retrusion"] * np.tanh(gen[:, 1] * p["compliance"] / p["retrusion"]))
@@ -477,7 +512,7 @@ def build_tongue(head, anat: Anatomy, net: TensionNet, spec: dict, positions: np
     t = spec["tongue"]
     ids = np.flatnonzero(head.region == REGIONS.index("tongue"))
     rest = positions[ids].astype(float)
-    tip = rest[np.argmax(rest[:, 2])]
+    tip = rest[np.argmax(rest[:, 2])] * [0.0, 1.0, 1.0]  # on the midline (the tongue is symmetric)
     root = carry_points(anat, net.rest, [t["root"]["at"]])[0]
     radius = t["tip_radius"] * net.scale
     reach = t["reach"] * net.scale

@@ -202,8 +202,12 @@ def anatomy(head) -> Anatomy:
     edges = unique_edges(tri)
     adj = adjacency(edges, n)
     normal = vertex_normals(base, tri, n)
+    # MakeHuman's UV masks are not quite symmetric; the anatomy must be (hm08 is).
+    mirror = np.asarray(head.mirror)[:n]
     lids_mask = mask_per_vertex(head, "eyelids")[:n]
+    lids_mask = np.maximum(lids_mask, lids_mask[mirror])
     lips_mask = mask_per_vertex(head, "lips")[:n]
+    lips_mask = np.maximum(lips_mask, lips_mask[mirror])
 
     kind = np.full(n, OUTER, np.int8)
     kind[head.region[:n] == REGIONS.index("mouth_interior")] = MOUTH
@@ -228,8 +232,10 @@ def anatomy(head) -> Anatomy:
     margins, canthi = _lid_margins(base, edges, kind, eye_side)
     tissue = _tissue_fields(spec["tissue"], base[:n], kind, eye_side, eye_centre, eye_radius,
                             lips_mask, adj)
+    tissue = {key: 0.5 * (v + v[mirror]) for key, v in tissue.items()}
     lip_half, rim_pairs = _lip_halves(base[:n], edges, kind, lips_mask)
     jaw_weight = _jaw_weight(spec["jaw"], base[:n], kind, lip_half)
+    jaw_weight = 0.5 * (jaw_weight + jaw_weight[mirror])
     return Anatomy(
         base=base, base_normal=normal, skin_count=n, triangles=tri, edges=edges,
         bends=bending_pairs(tri), kind=kind, eye_side=eye_side, tissue=tissue,
@@ -353,7 +359,8 @@ def _jaw_weight(spec, points, kind, lip_half) -> np.ndarray:
     b = spec["blend"]
     upper = _polyline(spec["upper_border"], z)
     lower = _polyline(spec["lower_border"], z)
-    weight = smoothstep(-b, b, upper - y) * smoothstep(-b, b, y - lower)
+    weight = (smoothstep(-b, b, upper - y) * smoothstep(-b, b, y - lower)
+              * smoothstep(spec["back"] - b, spec["back"] + b, z))
     lining = kind == MOUTH
     line = _polyline(spec["lining_border"], z)
     weight[lining] = (smoothstep(-0.02, 0.02, line - y) * smoothstep(spec["lining_back"] - 0.03,
@@ -407,6 +414,8 @@ def _ray(base, outer, normal, plane, axis, coords) -> int:
     p = base[facing]
     dist = np.hypot(p[:, plane[0]] - coords[0], p[:, plane[1]] - coords[1])
     near = dist < 0.04
+    if plane[0] == 0 and abs(coords[0]) < 1e-9:  # on the midline: only midline vertices (keeps rings symmetric)
+        near &= np.abs(p[:, 0]) < 1e-5
     if not near.any():
         return int(facing[np.argmin(dist)])
     return int(facing[near][np.argmax(p[near, axis])])
@@ -447,7 +456,8 @@ class Arcs:
     @staticmethod
     def concat(parts) -> "Arcs":
         parts = [p for p in parts if len(p)]
-        return Arcs(*(np.concatenate([getattr(p, f) for p in parts]) for f in ("i", "j", "rest", "k", "beta", "compress")))
+        fields = ("i", "j", "rest", "k", "beta", "compress")
+        return Arcs(*(np.concatenate([getattr(p, f) for p in parts]) for f in fields))
 
 
 @dataclass(frozen=True, eq=False)
@@ -507,6 +517,8 @@ class TensionNet:
     hinge: np.ndarray
     scale: float
     constants: dict
+    laplacian: sp.csr_matrix = None   # (N_skin, N_skin) umbrella Laplacian of the skin
+    bend_k: np.ndarray = None         # (N_skin,) bending stiffness per point
 
     @property
     def count(self) -> int:
@@ -559,7 +571,30 @@ def build_net(head, base_positions, *, anat: Anatomy | None = None, spec: dict |
         k = 2.0 / (1.0 / tissue["stiffness"][i] + 1.0 / tissue["stiffness"][j])
         return Arcs(i, j, rest_len, factor * k, mean("beta"), mean("compress"))
 
-    arcs = Arcs.concat([arcs_of(anat.edges, 1.0), arcs_of(anat.bends, constants["bend"])])
+    # Arcs across each pair of triangles (shear and folding) only where asked for: the
+    # bending energy below holds the surface's shape more cheaply.
+    parts = [arcs_of(anat.edges, 1.0)]
+    if constants.get("shear_arcs", 0.0) > 0:
+        parts.append(arcs_of(anat.bends, constants["shear_arcs"]))
+    # Where the mouth's lining runs close under the skin (the upper vestibule beneath the nose and
+    # lip), arcs through the tissue keep it there, so it neither pokes through nor is left behind.
+    lining, outer = np.flatnonzero(anat.kind == MOUTH), anat.outer
+    dist, near = cKDTree(rest[outer]).query(rest[lining])
+    close = dist < constants["lining_tie"] * scale
+    if close.any():
+        i, j = lining[close], outer[near[close]]
+        parts.append(Arcs(i, j, dist[close], np.full(close.sum(), 0.5), np.zeros(close.sum()), np.ones(close.sum())))
+    arcs = Arcs.concat(parts)
+
+    # Bending: the umbrella Laplacian of the skin keeps its rest value (per point, in the frame of
+    # the bone beneath); stiffness ∝ D / h² — at fine mesh scales bending, not stretching, holds
+    # the skin's shape (lips, lids, the corners of the mouth).
+    adj = adjacency(anat.edges, n)
+    degree = np.asarray(adj.sum(axis=1)).ravel()
+    laplacian = (sp.identity(n) - sp.diags(1.0 / np.maximum(degree, 1)) @ adj).tocsr()
+    edge_sum = np.bincount(anat.edges.ravel(), np.repeat(parts[0].rest, 2), minlength=n)
+    spacing = edge_sum / np.maximum(np.bincount(anat.edges.ravel(), minlength=n), 1)
+    bend_k = constants["bend_modulus"] * scale ** 2 * tissue["stiffness"] / np.maximum(spacing, 1e-3) ** 2
 
     # Attachments: shear of the soft tissue column (stiffness ∝ area / depth).
     column = constants["shear_modulus"] * tissue["attach"] * area / np.maximum(depth, 1e-3)
@@ -601,8 +636,9 @@ def build_net(head, base_positions, *, anat: Anatomy | None = None, spec: dict |
         jaw_weight=anat.jaw_weight.copy(), sites=sites, site_normal=normal[site_ids],
         site_on_jaw=site_on_jaw, candidates=cand, floor=floor, contact_k=contact_k,
         eye_ids=eye_ids, eye_index=eye_index, eye_floor=eye_floor, eye_centre=eye_centre,
-        eye_radius=eye_radius, rim_pairs=anat.rim_pairs, hinge=np.asarray(head.joint(base_positions, "joint-mouth"), float),
-        scale=scale, constants=constants,
+        eye_radius=eye_radius, rim_pairs=anat.rim_pairs,
+        hinge=np.asarray(head.joint(base_positions, "joint-mouth"), float),
+        scale=scale, constants=constants, laplacian=laplacian, bend_k=bend_k,
     )
 
 
