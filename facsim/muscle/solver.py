@@ -789,7 +789,7 @@ def minimise(model: Model, x: np.ndarray, ld: Loads, iterations: int, *, toleran
 
     x_in = x
     x, gaps = project(x)
-    known = start is not None and np.array_equal(x, x_in)  # the start is still where we are
+    known = start is not None and np.abs(x - x_in).max() < 1e-12  # the start is still where we are
     e, g = start if known else energy_at(x)
     raw = (e, g)
     g = hold(g.copy(), gaps, floors, sign=1.0)  # the walls take up what pushes into them
@@ -916,7 +916,7 @@ def solve(model: Model, state: State, target: Drive, *, steps: int = 3, iteratio
             start = (known[1] - old_e + new_e, known[2] - old_g + new_g)
         x, memory, (e, g) = minimise(model, x, ld, iterations, memory=memory, floors=floors, start=start)
         known = (ld, e, g)
-        mirrored = symmetric_drive(model, d)
+        mirrored = symmetric_drive(model, d) if settle else np.zeros(0, bool)
         if mirrored.any():  # a symmetric drive moves the face symmetrically: drop the round-off that breaks it
             rest = model.rest.T[:, None, :]
             moved = x[:, mirrored] - rest

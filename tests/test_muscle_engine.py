@@ -1,0 +1,210 @@
+"""The muscle engine: each simulated AU moves the face the way FACS says, sides, masking, animation."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from facsim.catalogue import catalogue
+from facsim.expression import Activations, activations
+from facsim.notation import parse
+
+X, Y, Z = 0, 1, 2
+#: AU → checks (landmark on the character's left, axis, sign): the FACS manual's appearance changes.
+#: "lip_corner" is the outer corner of the mouth (the muscle engine's modiolus).
+DIRECTIONS = {
+    1: [("inner_brow", Y, +1)],
+    2: [("outer_brow", Y, +1)],
+    4: [("inner_brow", Y, -1), ("inner_brow", X, -1)],      # lowered and drawn together
+    5: [("upper_lid", Y, +1)],
+    6: [("cheek", Y, +1), ("lower_lid", Y, +1)],
+    7: [("lower_lid", Y, +1)],
+    8: [("lower_lip", Y, +1)],                              # the lips come toward each other
+    9: [("nose_wing", Y, +1), ("inner_brow", Y, -1)],
+    10: [("upper_lip", Y, +1)],
+    11: [("nasolabial_fold", Y, +1)],
+    12: [("lip_corner", Y, +1), ("lip_corner", X, +1)],
+    13: [("lip_corner", Y, +1)],
+    14: [("lip_corner", Z, -1)],
+    15: [("lip_corner", Y, -1)],
+    16: [("lower_lip", Y, -1)],
+    17: [("chin", Y, +1)],
+    18: [("lip_corner", X, -1)],
+    19: [("lower_lip", Y, -1), ("tongue_tip", Z, +1)],
+    20: [("lip_corner", X, +1)],
+    21: [("jaw_angle", Y, -1)],
+    22: [("upper_lip", Z, +1)],
+    23: [("lip_corner", X, -1)],
+    24: [("lower_lip", Y, +1)],
+    25: [("lower_lip", Y, -1)],
+    26: [("chin", Y, -1)],
+    27: [("chin", Y, -1)],
+    28: [("lower_lip", Z, -1)],
+    29: [("chin", Z, +1)],
+    30: [("chin", X, +1)],                                  # toward the character's left
+    31: [("jaw_angle", X, +1)],                             # the masseter bulges
+    32: [("lower_lip", Y, +1)],
+    33: [("buccal", X, +1)],                                # the cheek over the mouth cavity inflates
+    34: [("buccal", X, +1)],
+    35: [("buccal", X, -1)],
+    36: [("buccal", X, +1)],                                # the tongue pushes the left cheek out
+    37: [("lower_lip", Y, -1), ("tongue_tip", Z, +1)],
+    38: [("nose_wing", X, +1)],
+    39: [("nose_wing", X, -1)],
+    41: [("glabella", Y, -1)],
+    42: [("inner_brow", Y, -1)],
+    43: [("upper_lid", Y, -1)],
+    44: [("inner_brow", X, -1)],
+    45: [("upper_lid", Y, -1)],
+    46: [("upper_lid", Y, -1)],
+    51: [("nose_tip", X, +1)],
+    52: [("nose_tip", X, -1)],
+    53: [("nose_tip", Y, +1)],
+    54: [("nose_tip", Y, -1)],
+    55: [("glabella", X, +1)],
+    56: [("glabella", X, -1)],
+    57: [("nose_tip", Z, +1)],
+    58: [("nose_tip", Z, -1)],
+    63: [("upper_lid", Y, +1)],
+    64: [("upper_lid", Y, -1)],
+}
+#: Least motion (dm) that counts as moving: 0.3 mm.
+MOVES = 0.003
+
+
+@pytest.fixture(scope="module")
+def face(face_of):
+    return face_of("noah", "muscle")
+
+
+@pytest.fixture(scope="module")
+def engine(face):
+    return face.engine
+
+
+@pytest.fixture(scope="module")
+def marks(head, engine):
+    from facsim.landmarks import landmarks
+    from facsim.muscle.net import anatomy
+
+    from facsim.muscle.net import resolve_vertex
+
+    found = dict(landmarks(head))
+    found["lip_corner_left"] = anatomy(head).mouth_corner
+    found["buccal"] = resolve_vertex(anatomy(head), {"front": [0.4, 6.6]})
+    tongue = engine.model.tongue
+    found["tongue_tip"] = int(tongue.ids[np.argmax(tongue.rest[:, 2])])
+    return found
+
+
+@pytest.fixture(scope="module")
+def single(engine):
+    """Every simulated code at E, solved in one batch: code → positions."""
+    from facsim.muscle import simulated_codes
+
+    codes = sorted(simulated_codes())
+    acts = [activations(parse(str(code))) for code in codes]
+    return dict(zip(codes, engine.solve_many(acts))), engine.neutral
+
+
+def test_every_simulated_au_is_checked_or_is_an_eye_turn():
+    from facsim.muscle import simulated_codes
+
+    assert simulated_codes() - set(DIRECTIONS) <= {61, 62, 65, 66}
+
+
+@pytest.mark.parametrize("code", sorted(DIRECTIONS))
+def test_au_moves_landmarks_the_way_facs_says(single, marks, code):
+    solved, neutral = single
+    delta = solved[code] - neutral
+    for name, axis, sign in DIRECTIONS[code]:
+        key = name if name in marks else name + "_left"
+        assert sign * delta[marks[key], axis] > MOVES, (code, name, axis, delta[marks[key]])
+
+
+def test_eyes_turn_left_on_61_and_right_on_62(single, head):
+    solved, neutral = single
+    for code, sign in ((61, +1), (62, -1)):
+        for side in ("left", "right"):
+            eye = head.eye_vertices[side]
+            pupil = eye[np.argmax(head.eye_local[:, 2])]
+            assert sign * (solved[code][pupil, X] - neutral[pupil, X]) > 0.03
+
+
+def test_every_catalogue_action_is_simulated_or_explained():
+    from facsim.muscle import coverage, simulated_codes
+
+    explained = coverage()
+    for code, info in catalogue().items():
+        if info.rendered:
+            assert code in explained, code
+            assert code in simulated_codes() or explained[code].startswith("not simulated")
+
+
+@pytest.mark.parametrize("code", [1, 2, 4, 5, 6, 9, 12, 15, 17, 20, 24, 26, 27, 33, 43])
+def test_bilateral_aus_are_symmetric(single, head, code):
+    p = single[0][code]
+    skin = head.skin
+    assert np.abs(p[head.mirror[skin]] * [-1, 1, 1] - p[skin]).max() < 1e-3  # 0.1 mm
+
+
+@pytest.mark.parametrize("code", [1, 2, 4, 6, 12, 15, 20, 46])
+def test_unilateral_aus_move_only_their_side(engine, code):
+    left, right = engine.solve_many([activations(parse(f"L{code}")), activations(parse(f"R{code}"))])
+    x = engine.neutral[:, X]
+    for moved, own, other in ((left, x > 0.05, x < -0.15), (right, x < -0.05, x > 0.15)):
+        delta = np.linalg.norm(moved - engine.neutral, axis=1)
+        assert delta[own].max() > 0.01
+        assert delta[other].max() < 0.25 * delta[own].max()
+
+
+def test_masking_cheek_raiser_after_smile_lifts_the_corner_less(engine, marks):
+    corner = marks["lip_corner_left"]
+    neutral, six, twelve, both = engine.solve_many(
+        [Activations(), activations(parse("6")), activations(parse("12")), activations(parse("12+6"))])
+    alone = six[corner, Y] - neutral[corner, Y]
+    after = both[corner, Y] - twelve[corner, Y]
+    assert alone > MOVES  # the cheek raiser lifts the corner ...
+    assert after < 0.6 * alone  # ... much less once the smile has stretched the tissue
+
+
+def test_animation_path_converges_to_the_static_solve(engine):
+    target = activations(parse("1+2+12"))
+    engine.reset()
+    for k in range(1, 9):  # the expression comes on over 8 frames, then is held
+        engine.step(target.scaled(k / 8))
+    for _ in range(20):
+        held = engine.step(target)
+    direct = engine(target)
+    gap = np.linalg.norm(held - direct, axis=1)
+    assert gap.max() < 0.04 and gap.mean() < 0.002  # within 4 mm anywhere and 0.2 mm on average
+
+
+def test_a_step_applies_only_the_change(engine):
+    act = activations(parse("4"))
+    engine.reset()
+    for _ in range(40):  # reach the expression and hold it
+        held = engine.step(act)
+    again = engine.step(act)  # nothing changed: the face stays where it is
+    assert np.abs(again - held).max() < 0.003
+    from facsim.landmarks import landmarks
+
+    brow = landmarks(engine.head)["inner_brow_left"]
+    first = engine.step(act.scaled(0.5))  # half the action: the brows start back up at once ...
+    for _ in range(10):
+        later = engine.step(act.scaled(0.5))
+    assert first[brow, 1] > held[brow, 1] + 0.0005
+    assert later[brow, 1] > first[brow, 1] + 0.005  # ... and keep rising over the next frames
+
+
+def test_engine_api(face, engine, head):
+    assert engine.name == "muscle"
+    p = engine(activations(parse("4+6")))
+    assert p.shape == (head.vertex_count, 3) and p.dtype == np.float32
+    w = engine.last_wrinkle
+    assert w.shape == (head.vertex_count,) and w.dtype == np.float32 and (w >= 0).all()
+    assert w.max() > 0.2  # 4+6 creases the skin
+
+
+def test_face_renders_with_the_muscle_engine(face):
+    img = face.render("4+6", size=96)
+    assert img.shape == (96, 96, 4)

@@ -1,0 +1,185 @@
+"""The muscle engine's pieces: the energy and its gradient, the solver, the jaw, the data, wrinkles."""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+from facsim.expression import Activations, activations
+from facsim.notation import parse
+
+
+@pytest.fixture(scope="module")
+def engine(face_of):
+    return face_of("ava", "muscle").engine
+
+
+@pytest.fixture(scope="module")
+def model(engine):
+    return engine.model
+
+
+def _drive(model, text):
+    from facsim.muscle.muscles import drive
+
+    return drive(model.layer, activations(parse(text)) if text else Activations())
+
+
+@pytest.mark.parametrize("text", ["12", "4+6", "26", "33", "19", "24+17", "43"])
+def test_gradient_matches_finite_differences(model, text):
+    from facsim.muscle import solver
+
+    rng = np.random.default_rng(7)
+    ld = solver.loads(model, _drive(model, text))
+    x = solver.rest_state(model).x + 0.01 * rng.standard_normal((3, 1, model.count))
+    _, grad = solver.energy(model, x, ld)
+    v = rng.standard_normal(x.shape)
+    h = 1e-6
+    numeric = (solver.energy(model, x + h * v, ld)[0] - solver.energy(model, x - h * v, ld)[0]) / (2 * h)
+    assert numeric[0] == pytest.approx((grad * v).sum(), rel=1e-5)
+
+
+def test_rest_is_an_equilibrium(model):
+    from facsim.muscle import solver
+
+    state = solver.rest_state(model)
+    ld = solver.loads(model, state.drive)
+    energy, grad = solver.energy(model, state.x, ld)
+    assert abs(energy[0]) < 1e-8 and np.abs(grad).max() < 1e-8
+    moved = solver.solve(model, state, state.drive, steps=1, iterations=10)
+    assert np.abs(moved.x - state.x).max() < 1e-9
+
+
+def test_the_stiffness_is_factorised_once_and_reused(engine, monkeypatch):
+    import scipy.sparse.linalg as spla
+
+    calls = []
+    real = spla.splu
+    monkeypatch.setattr(spla, "splu", lambda *a, **k: calls.append(1) or real(*a, **k))
+    engine.reset()
+    for k in range(1, 6):
+        engine.step(activations(parse("12")).scaled(k / 5))
+    engine(activations(parse("4")))
+    assert calls == []  # frames and static solves only back-substitute
+
+
+def test_model_builds_quickly(face_of):
+    from facsim.muscle import MuscleEngine, _MODELS
+
+    face = face_of("ava", "muscle")
+    _MODELS.clear()
+    start = time.perf_counter()
+    MuscleEngine(face.head, face.data, face.character, face.base_positions)
+    assert time.perf_counter() - start < 3.0
+
+
+def test_batched_solves_equal_single_ones(engine):
+    acts = [activations(parse(t)) for t in ("1", "15", "26")]
+    together = engine.solve_many(acts)
+    for act, batched in zip(acts, together):
+        assert np.abs(engine(act) - batched).max() < 1e-5
+
+
+def test_jaw_statics(model):
+    from facsim.muscle.muscles import jaw_pose
+
+    def pose(text):
+        return jaw_pose(model.layer, _drive(model, text).muscle, model.jaw_spec)[0]
+
+    drop, stretch = np.degrees(pose("26")[0]), np.degrees(pose("27")[0])
+    assert 8 < drop < 16 and stretch > drop + 8  # relaxed elevators drop it; digastric pulls it wide
+    assert np.abs(pose("31")).max() < 1e-9  # clenching keeps it shut
+    assert pose("29")[1] > 0.05  # thrust forward
+    assert pose("30")[2] > 0.03  # sideways, to the character's left
+    assert pose("")[0] == 0
+
+
+def test_muscle_data_is_consistent(model):
+    from facsim.muscle import au_table
+    from facsim.muscle.net import load_spec
+
+    spec = load_spec()
+    names = set(spec["muscles"])
+    required = {"frontalis_medial", "frontalis_lateral", "corrugator_supercilii", "procerus", "depressor_supercilii",
+                "orbicularis_oculi_orbital", "orbicularis_oculi_palpebral_upper", "levator_palpebrae_superioris",
+                "levator_labii_superioris", "levator_labii_superioris_alaeque_nasi", "zygomaticus_minor",
+                "zygomaticus_major", "levator_anguli_oris", "risorius", "buccinator", "depressor_anguli_oris",
+                "depressor_labii_inferioris", "mentalis", "incisivus_labii_superioris", "orbicularis_oris_peripheral",
+                "nasalis_alar", "platysma", "masseter", "temporalis", "medial_pterygoid", "lateral_pterygoid",
+                "digastric"}
+    assert required <= names
+    for code, entry in au_table()["action_units"].items():
+        assert entry["how"], code
+        for name, value in (entry.get("muscles") or {}).items():
+            assert name in names, (code, name)
+    # Paired muscles are mirror images: same number of fibre segments on each side.
+    layer = model.layer
+    for name in names:
+        sides = [k for k, m in enumerate(layer.muscle) if m == name]
+        counts = [int((layer.seg_muscle == k).sum()) for k in sides]
+        assert len(set(counts)) == 1, name
+
+
+def test_improved_muscles_bend_over_bone(model):
+    """Zygomaticus major and frontalis pass through intermediate muscle points (Platt & Badler fig. 5)."""
+    layer = model.layer
+    for name in ("zygomaticus_major_left", "frontalis_medial_left"):
+        k = layer.names.index(name)
+        segs = np.flatnonzero(layer.seg_muscle == k)
+        assert ((layer.seg_a[segs] >= 0) & (layer.seg_b[segs] >= 0)).any(), name  # muscle point → muscle point
+
+
+def test_coverage_lists_every_facial_action(engine):
+    from facsim.catalogue import catalogue
+    from facsim.muscle import coverage, simulated_codes
+
+    explained = coverage()
+    actions = [c for c, info in catalogue().items() if info.kind in ("action", "head", "eye")]
+    assert set(actions) <= set(explained)
+    assert {19, 25, 26, 27, 29, 30, 31, 33, 34, 35, 36, 37, 38, 39} <= simulated_codes()  # the paper's unsolved ones
+
+
+def _wrinkles(engine, text):
+    engine(activations(parse(text)))
+    return engine.last_wrinkle
+
+
+def test_wrinkles_appear_where_the_skin_is_squeezed(engine, head):
+    from facsim.landmarks import landmarks
+
+    marks = landmarks(head)
+    rest = engine.neutral
+    skin = head.skin
+    forehead = skin[(rest[skin, 1] > rest[marks["inner_brow_left"], 1] + 0.06) & (np.abs(rest[skin, 0]) < 0.35)
+                     & (rest[skin, 2] > rest[marks["inner_brow_left"], 2] - 0.25)]
+    glabella = skin[np.linalg.norm(rest[skin] - rest[marks["glabella"]], axis=1) < 0.08]
+    chin = skin[np.linalg.norm(rest[skin] - rest[marks["chin"]], axis=1) < 0.1]
+    neutral = _wrinkles(engine, "")
+    assert neutral is None or neutral.max() < 1e-6
+    assert _wrinkles(engine, "1+2")[forehead].max() > 0.3   # forehead lines
+    assert _wrinkles(engine, "4")[glabella].max() > 0.3     # glabellar furrows
+    assert _wrinkles(engine, "17")[chin].max() > 0.05       # the chin boss dimples
+
+
+def test_wrinkle_lines_run_across_the_compression(engine, head):
+    """On 1+2 the forehead is squeezed vertically, so its lines run horizontally; on 4 the
+    glabella is squeezed sideways, so its furrows run vertically."""
+    from facsim.landmarks import landmarks
+    from facsim.muscle.wrinkles import principal_compression
+
+    marks = landmarks(head)
+    model = engine.wrinkles
+    centre = engine.neutral[model.triangles].mean(axis=1)
+    brow = engine.neutral[marks["inner_brow_left"]]
+    regions = {
+        "1+2": (1, (centre[:, 1] > brow[1] + 0.03) & (np.abs(centre[:, 0]) < 0.4) & (centre[:, 2] > brow[2] - 0.3)),
+        "4": (0, np.linalg.norm(centre - engine.neutral[marks["glabella"]], axis=1) < 0.1),
+    }
+    for text, (axis, region) in regions.items():
+        engine(activations(parse(text)))
+        skin = engine.last_state.points(0)[: engine.model.net.count]
+        squeeze, direction, _ = principal_compression(model, skin)
+        weights = squeeze * region
+        along = (np.abs(direction[:, axis]) * weights).sum() / weights.sum()
+        assert along > 0.6, (text, along)
