@@ -9,6 +9,7 @@ Examples
 from __future__ import annotations
 
 from functools import cached_property, lru_cache
+from typing import NamedTuple
 
 import numpy as np
 
@@ -164,11 +165,12 @@ class Face:
 
     def render(self, expression=None, *, view: str = "front", yaw=None, pitch=None, size=512,
                projection: str = "perspective", background=(1.0, 1.0, 1.0), antialias=4,
-               positions=None, wrinkle=None) -> np.ndarray:
+               positions=None, wrinkle=None, crease_phase=None) -> np.ndarray:
         """Render ``expression`` to an (H, W, 4) uint8 RGBA image.
 
         ``background=None`` gives a transparent background. ``positions`` renders
-        given geometry instead of deforming (e.g. from another engine).
+        given geometry instead of deforming (e.g. from another engine), with its
+        ``wrinkle`` and ``crease_phase`` if it has them (see :meth:`Renderer.render`).
         """
         size = _size_pair(size)
         if positions is None:
@@ -176,10 +178,11 @@ class Face:
             positions = self.engine(act) if act else self.neutral
             if wrinkle is None and act:  # the neutral face has no creases
                 wrinkle = getattr(self.engine, "last_wrinkle", None)
+                crease_phase = getattr(self.engine, "last_crease_phase", None)
         camera = self.camera(view=view, yaw=yaw, pitch=pitch, projection=projection, size=size)
         return self.renderer(size, antialias=antialias, background=background).render(
             np.asarray(positions, np.float32), appearance=self.appearance, camera=camera, wrinkle=wrinkle,
-            occlusion=self.occlusion,
+            crease_phase=crease_phase, occlusion=self.occlusion,
         )
 
     def start_animation(self) -> "Animation":
@@ -216,16 +219,25 @@ def _npy_bytes(array: np.ndarray) -> bytes:
     return buf.getvalue()
 
 
+class Frame(NamedTuple):
+    """One deformed frame: what :meth:`Face.render` takes as ``**frame._asdict()``."""
+
+    positions: np.ndarray
+    wrinkle: np.ndarray | None = None        # skin compression (muscle engine)
+    crease_phase: np.ndarray | None = None   # where across its furrows each vertex lies
+
+
 class Animation:
-    """Steps an engine frame by frame: ``positions, wrinkle = animation.step(activations)``."""
+    """Steps an engine frame by frame: ``frame = animation.step(activations)``, a :class:`Frame`."""
 
     def __init__(self, engine):
         self.engine = engine
         self._stateful = hasattr(engine, "step")
 
-    def step(self, act: Activations):
+    def step(self, act: Activations) -> Frame:
         positions = self.engine.step(act) if self._stateful else self.engine(act)
-        return positions, getattr(self.engine, "last_wrinkle", None)
+        return Frame(positions, getattr(self.engine, "last_wrinkle", None),
+                     getattr(self.engine, "last_crease_phase", None))
 
 
 def _size_pair(size) -> tuple[int, int]:

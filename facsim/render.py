@@ -44,7 +44,7 @@ import numpy as np
 
 from .camera import Camera, projection_matrix, view_matrix, _size_pair
 from .images import write_png
-from .render_geometry import (_faces_touching, _orientation, crease_phase, lash_coordinates, normal_operator,
+from .render_geometry import (CREASES_PER_DM, _faces_touching, _orientation, crease_phase, lash_coordinates, normal_operator,
                               region_components, sphere_centre, sphere_directions, vertex_normals)
 from .render_gl import RenderError, _set_uniform, _shader_source, gl_context
 from .render_inputs import (COLOR_NAMES, DEFAULT_BROW_UV_FRAME, DEFAULT_COLORS, HM08_BROW_UV_FRAME, REGIONS,
@@ -55,7 +55,7 @@ __all__ = [
     "REGIONS", "COLOR_NAMES", "DEFAULT_COLORS", "RenderTopology", "Appearance", "Lighting",
     "Renderer", "RenderError", "normal_operator", "vertex_normals", "srgb_to_linear",
     "write_png", "gl_context", "region_components", "sphere_centre", "lash_coordinates",
-    "crease_phase", "AA_METHODS", "HM08_BROW_UV_FRAME", "DEFAULT_BROW_UV_FRAME", "brow_uv_frame",
+    "crease_phase", "CREASES_PER_DM", "AA_METHODS", "HM08_BROW_UV_FRAME", "DEFAULT_BROW_UV_FRAME", "brow_uv_frame",
     "bake_occlusion", "sphere_directions",
 ]
 
@@ -335,8 +335,8 @@ class Renderer:
 
     # -- per frame -----------------------------------------------------------------------
     def render(self, positions: np.ndarray, *, appearance: Appearance, camera: Camera,
-               wrinkle: np.ndarray | None = None, occlusion: np.ndarray | None = None,
-               lighting: Lighting | None = None) -> np.ndarray:
+               wrinkle: np.ndarray | None = None, crease_phase: np.ndarray | None = None,
+               occlusion: np.ndarray | None = None, lighting: Lighting | None = None) -> np.ndarray:
         """Render one frame.
 
         Parameters
@@ -347,6 +347,10 @@ class Renderer:
         camera : Camera
         wrinkle : (N_geo,) float >= 0, optional
             Skin compression; creases and cavity darkening are drawn where it is > 0.
+        crease_phase : (N_geo,) float, optional
+            Where across its creases each vertex lies, in crease spacings (a crease is drawn
+            at each whole number), e.g. the muscle engine's ``last_crease_phase``. Default:
+            creases along the contours of ``wrinkle`` (:func:`crease_phase`).
         occlusion : (N_geo,) float in [0, 1], optional
             Ambient visibility per geometry vertex (1 = open), e.g. from
             :func:`bake_occlusion` on the neutral pose; it darkens sockets and creases on
@@ -376,18 +380,19 @@ class Renderer:
         w_geo = _per_vertex("wrinkle", wrinkle, len(p_all), self._n_geo)
         if w_geo is not None:
             w_geo = np.maximum(w_geo, 0.0)
+        phase = _per_vertex("crease_phase", crease_phase, len(p_all), self._n_geo)
         occ = _per_vertex("occlusion", occlusion, len(p_all), self._n_geo)
         if not self._winding_checked:
             self._fix_winding(p)
             self._rebuild_draws()
-        self._update_vertices(p, w_geo, occ)
+        self._update_vertices(p, w_geo, phase, occ)
         if appearance is not self._appearance:
             self._upload_appearance(appearance)
         self._set_camera(camera, lighting or self.lighting)
         self._draw()
         return self._read()
 
-    def _update_vertices(self, p: np.ndarray, wrinkle: np.ndarray | None,
+    def _update_vertices(self, p: np.ndarray, wrinkle: np.ndarray | None, phase: np.ndarray | None,
                          occlusion: np.ndarray | None) -> None:
         geo = self._geo_buffer
         normals = vertex_normals(p, self._geo_faces, self._normal_op)
@@ -405,7 +410,9 @@ class Renderer:
         geo[:, 3:6] = normals
         out = self._render_buffer
         np.take(geo, self.topology.render_to_geo, axis=0, out=out)
-        if wrinkle is not None and wrinkle.any():
+        if wrinkle is not None and wrinkle.any() and phase is not None:
+            out[:, 8] = phase[self.topology.render_to_geo]
+        elif wrinkle is not None and wrinkle.any():
             if self._render_op is None:
                 self._render_op = normal_operator(self._faces, self.topology.n_render)
             out[:, 8] = crease_phase(out[:, 0:3], self.topology.uv, self._faces, out[:, 6],

@@ -123,11 +123,15 @@ def lash_coordinates(positions: np.ndarray, eyes: list[np.ndarray],
     return np.concatenate(out).astype(np.float32)
 
 
+CREASES_PER_DM = 11.0  # spacing of the creases drawn along a wrinkle field's contours: about 9 mm
+
+
 def crease_phase(positions: np.ndarray, uv: np.ndarray, faces: np.ndarray,
                  wrinkle: np.ndarray, operator: sp.csr_matrix | None = None) -> np.ndarray:
-    """Where across a crease each vertex lies, so creases can run along the contours of
-    ``wrinkle``: the distance (decimetres) from the UV centre along the direction in which
-    the wrinkle changes most.
+    """Where across a crease each vertex lies, in crease spacings, so creases can run along
+    the contours of ``wrinkle`` (for a wrinkle field that comes without its own phase): the
+    distance from the UV centre along the direction in which the wrinkle changes most,
+    times :data:`CREASES_PER_DM`.
 
     Worked out in UV space, where the face is flat (a 3-D distance would bend the lines
     over the curved forehead): the direction is the principal axis of the area-weighted
@@ -189,7 +193,7 @@ def crease_phase(positions: np.ndarray, uv: np.ndarray, faces: np.ndarray,
     g00, g11, g01 = a[:, 3] / a[:, 6], a[:, 4] / a[:, 6], a[:, 5] / a[:, 6]
     scale = np.sqrt(np.maximum(d[:, 0] ** 2 * g00 + 2 * d[:, 0] * d[:, 1] * g01
                                + d[:, 1] ** 2 * g11, 0.0))        # dm per UV unit along d
-    phase[verts] = np.abs(((t[verts] - 0.5) * d).sum(axis=1)) * scale
+    phase[verts] = np.abs(((t[verts] - 0.5) * d).sum(axis=1)) * scale * CREASES_PER_DM
     return phase
 
 

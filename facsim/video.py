@@ -199,8 +199,7 @@ def animate(timeline, path, *, face=None, character=None, engine=None, fps: floa
         with VideoWriter(path, fps, audio=audio) as writer:
             state = face.start_animation()
             for i, act in enumerate(frames):
-                positions, wrinkle = state.step(act)
-                writer.append(face.render(positions=positions, wrinkle=wrinkle, **render_options))
+                writer.append(face.render(**state.step(act)._asdict(), **render_options))
                 bar.update(i + 1)
         assert len(frame_times(timeline, fps)) == writer.frames_written
         return writer.path

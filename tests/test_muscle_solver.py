@@ -183,3 +183,20 @@ def test_wrinkle_lines_run_across_the_compression(engine, head):
         weights = squeeze * region
         along = (np.abs(direction[:, axis]) * weights).sum() / weights.sum()
         assert along > 0.6, (text, along)
+
+
+def test_furrow_phase_counts_furrows_across_the_compression(engine, head):
+    """The renderer draws a furrow at each whole phase: on 4 the glabella's phase climbs
+    sideways by about one per glabellar furrow spacing, and hardly at all upward."""
+    from facsim.landmarks import landmarks
+
+    marks = landmarks(head)
+    engine(activations(parse("4")))
+    phase = engine.last_crease_phase
+    rest = engine.neutral
+    region = head.skin[np.linalg.norm(rest[head.skin] - rest[marks["glabella"]], axis=1) < 0.12]
+    design = np.c_[rest[region, :2], np.ones(len(region))]
+    (per_x, per_y, _), *_ = np.linalg.lstsq(design, phase[region], rcond=None)
+    spacing = engine.wrinkles.wavelength[region].mean()
+    assert abs(per_x) > 3 * abs(per_y), (per_x, per_y)
+    assert 0.5 < abs(per_x) * spacing < 1.5, abs(per_x) * spacing

@@ -14,7 +14,7 @@ import pytest
 from facsim.camera import Camera, frame_camera, project
 from facsim.render import (
     COLOR_NAMES, DEFAULT_BROW_UV_FRAME, DEFAULT_COLORS, REGIONS, Appearance, Lighting,
-    RenderError, Renderer, RenderTopology, bake_occlusion, brow_uv_frame, crease_phase,
+    CREASES_PER_DM, RenderError, Renderer, RenderTopology, bake_occlusion, brow_uv_frame, crease_phase,
     lash_coordinates,
     normal_operator, region_components, sphere_centre, srgb_to_linear, vertex_normals,
     write_png,
@@ -301,6 +301,29 @@ def test_wrinkle_darkens_the_skin(renderer, scene):
     assert np.abs(creased[lower, 35:60] - plain[lower, 35:60]).max() <= 2
 
 
+def test_creases_run_where_the_crease_phase_says(renderer, scene):
+    """An engine's own crease phase decides the furrows' direction: a phase rising with height
+    draws horizontal lines (the image changes down a column), one rising across draws vertical ones."""
+    _, pos, parts = scene
+    cam, app = head_camera("front"), appearance()
+    wrinkle = np.zeros(len(pos), np.float32)
+    wrinkle[parts["head"]] = 1.0
+    spacing = 0.2  # dm between furrows: about ten pixels apart in this small render
+
+    def grey(phase):
+        img = renderer.render(pos, appearance=app, camera=cam, wrinkle=wrinkle, crease_phase=phase)
+        return img.astype(float)[15:45, 35:60, :3].mean(2)
+
+    flat = grey(np.zeros(len(pos)))  # the same cavity shading without furrows
+    images = {axis: grey(pos[:, axis] / spacing) - flat for axis in (0, 1)}
+    across = {axis: np.abs(np.diff(img, axis=1)).mean() for axis, img in images.items()}  # along a row
+    down = {axis: np.abs(np.diff(img, axis=0)).mean() for axis, img in images.items()}    # along a column
+    assert down[1] > 1.5 * across[1]   # phase rises with height: horizontal lines
+    assert across[0] > 1.5 * down[0]   # phase rises across: vertical lines
+    with pytest.raises(ValueError, match="crease_phase must have one value per geometry vertex"):
+        renderer.render(pos, appearance=app, camera=cam, wrinkle=wrinkle, crease_phase=np.zeros(3))
+
+
 def test_occlusion_darkens(renderer, scene):
     _, pos, _ = scene
     cam, app = head_camera("front"), appearance()
@@ -543,5 +566,5 @@ def test_crease_phase_runs_across_the_wrinkle_contours():
     phase = crease_phase(positions, uv, faces, wrinkle).reshape(n, n)
     inner = phase[3:-3, 3:-3]
     assert np.allclose(inner, inner[:, :1], atol=1e-6)            # constant along u
-    assert np.allclose(inner[:, 0], np.abs(v[3:-3, 0] - 0.5) * 1.0, atol=1e-6)  # v in dm
+    assert np.allclose(inner[:, 0], np.abs(v[3:-3, 0] - 0.5) * 1.0 * CREASES_PER_DM, atol=1e-5)  # v in dm, in spacings
     assert (crease_phase(positions, uv, faces, np.zeros(n * n)) == 0).all()

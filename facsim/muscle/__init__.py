@@ -218,13 +218,23 @@ class MuscleEngine:
 
         Computed when first asked for (a render needs it; a solve does not).
         """
+        return self._creases()[0]
+
+    @property
+    def last_crease_phase(self) -> np.ndarray | None:
+        """Where across its furrows each vertex of the last result lies (N_geo,) float32, in
+        furrow spacings: the renderer draws the furrows of ``last_wrinkle`` at whole numbers."""
+        return self._creases()[1]
+
+    def _creases(self):
         if self._wrinkle is None and self._wrinkle_of is not None:
             state, index = self._wrinkle_of
             skin = state.points(index)[: self.model.net.count]
-            wrinkle = np.zeros(self.head.vertex_count, np.float32)
-            wrinkle[: len(skin)] = wrinkle_field(self.wrinkles, skin)
-            self._wrinkle = wrinkle
-        return self._wrinkle
+            strength, phase = wrinkle_field(self.wrinkles, skin)
+            self._wrinkle = tuple(np.zeros(self.head.vertex_count, np.float32) for _ in range(2))
+            self._wrinkle[0][: len(skin)] = strength
+            self._wrinkle[1][: len(skin)] = phase
+        return self._wrinkle or (None, None)
 
     def geometry(self, state: solver.State, act: Activations, index: int = 0) -> np.ndarray:
         """Geometry positions (N_geo, 3) float32 of configuration ``index`` of a state."""

@@ -10,13 +10,12 @@ This module turns the compression into a per-vertex crease strength:
 1. :func:`principal_compression` — per triangle, the smaller principal stretch
    of the deformation (rest → now) and its direction in the rest surface.
 2. per vertex, the area-weighted compression tensor, its strength and direction;
-3. :func:`wrinkle_field` — the strength modulated by a furrow pattern
-   perpendicular to the compression direction (so lines appear as lines:
-   horizontal forehead lines when the brows rise, vertical glabellar furrows
-   when they are drawn together, radial crow's feet beside the eye), a dimple
-   pattern where the skin is squeezed in every direction (the chin on AU17),
-   and unpatterned folds along anatomical creases (nasolabial fold, lid folds,
-   the fold at the inner eye).
+3. :func:`wrinkle_field` — the strength, and a furrow phase that runs along
+   the compression direction, so the renderer draws lines perpendicular to it
+   (horizontal forehead lines when the brows rise, vertical glabellar furrows
+   when they are drawn together, crow's feet beside the eye), with the
+   anatomical creases (nasolabial fold, lid folds, the fold at the inner eye)
+   deepened where they lie.
 """
 from __future__ import annotations
 
@@ -24,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 
 from .net import OUTER, Anatomy, TensionNet, resolve_vertex
 
@@ -40,13 +40,16 @@ class WrinkleModel:
     wavelength: np.ndarray      # (N,) furrow spacing
     zone_gain: np.ndarray       # (N,) how readily the skin creases there (deep forehead lines, fine crow's feet)
     straight: np.ndarray        # (N,) 1 where lines run straight across the face (forehead, glabella)
-    pattern_weight: np.ndarray  # (N,) 1 where wrinkles form in lines, 0 on creases and off the face
-    crease: np.ndarray          # (N,) strength of anatomical folds (unpatterned)
+    on_face: np.ndarray         # (N,) 1 on the outer skin, 0 inside the lips and lids
+    crease: np.ndarray          # (N,) extra depth along anatomical folds (0 = none, 1 = twice as deep)
     gain: float
     threshold: float
     exponent: float
     smooth: sp.csr_matrix       # (N, N) one pass of neighbour averaging
     passes: int                 # how many, on the compression tensor (a steady direction field)
+    edges: np.ndarray           # (E, 2) skin edges
+    incidence: sp.csr_matrix    # (E, N) −1 at an edge's first point, +1 at its second
+    integrate: object           # solves (BᵀB + εI) φ = b: the phase from its edge differences
 
 
 def build_wrinkles(anat: Anatomy, net: TensionNet, spec: dict) -> WrinkleModel:
@@ -75,14 +78,7 @@ def build_wrinkles(anat: Anatomy, net: TensionNet, spec: dict) -> WrinkleModel:
     total = np.asarray(to_vertex.sum(axis=1)).ravel()
     to_vertex = sp.diags(1.0 / np.maximum(total, 1e-14)) @ to_vertex
 
-    # Furrow spacing: the zone's, never finer than the mesh can draw (about 2.5 edges).
-    edge = np.zeros(n)
-    counts = np.zeros(n)
-    lengths = net.arcs.rest[: len(anat.edges)]
-    for col in (anat.edges[:, 0], anat.edges[:, 1]):
-        np.add.at(edge, col, lengths)
-        np.add.at(counts, col, 1)
-    edge /= np.maximum(counts, 1)
+    # Furrow spacing per zone (drawn per pixel by the renderer, so it may be finer than the mesh).
     wavelength = np.full(n, float(w["wavelength"]))
     zone_gain = np.ones(n)
     straight = np.zeros(n)
@@ -93,7 +89,7 @@ def build_wrinkles(anat: Anatomy, net: TensionNet, spec: dict) -> WrinkleModel:
         zone_gain = zone_gain * (1 - weight) + zone.get("gain", 1.0) * weight
         if zone.get("straight"):
             straight = np.maximum(straight, weight)
-    wavelength = np.maximum(wavelength * net.scale, w["min_edges"] * edge)
+    wavelength = wavelength * net.scale
 
     crease = np.zeros(n)
     for line in w.get("creases", []):
@@ -106,12 +102,18 @@ def build_wrinkles(anat: Anatomy, net: TensionNet, spec: dict) -> WrinkleModel:
     adj = sp.coo_matrix((np.ones(2 * len(edges)), (edges.ravel(), edges[:, ::-1].ravel())), shape=(n, n)).tocsr()
     adj = adj + sp.identity(n)
     smooth = sp.diags(1.0 / np.asarray(adj.sum(axis=1)).ravel()) @ adj
+    m = len(edges)
+    incidence = sp.csr_matrix((np.r_[-np.ones(m), np.ones(m)], (np.r_[np.arange(m), np.arange(m)],
+                                                                 np.r_[edges[:, 0], edges[:, 1]])), shape=(m, n))
+    # The graph Laplacian never changes, so it is factorised once; ε pins the free constant.
+    integrate = spla.factorized((incidence.T @ incidence + 1e-4 * sp.identity(n)).tocsc())
     return WrinkleModel(
         triangles=tri, rest_inverse=inv, rest_frame=frame, to_vertex=to_vertex.tocsr(), rest=rest,
         wavelength=wavelength, zone_gain=zone_gain, straight=np.clip(straight * 2.0, 0.0, 1.0), crease=crease,
-        pattern_weight=on_face * (1.0 - np.clip(crease, 0, 1)),
+        on_face=on_face,
         gain=float(w["gain"]), threshold=float(w["threshold"]), exponent=float(w["exponent"]),
         smooth=smooth.tocsr(), passes=int(w.get("smoothing", 2)),
+        edges=edges, incidence=incidence, integrate=integrate,
     )
 
 
@@ -166,32 +168,50 @@ def _principal_axis(tensors: np.ndarray, iterations: int = 6) -> np.ndarray:
     return v
 
 
-def wrinkle_field(model: WrinkleModel, positions: np.ndarray) -> np.ndarray:
-    """Crease strength per skin vertex (N,) float32 ≥ 0 for skin ``positions`` (N, 3)."""
-    squeeze, direction, large = principal_compression(model, positions)
-    # Average the compression as a tensor (so opposite directions agree), and how much the other
-    # direction is squeezed too (both: dimples, not lines).
+def wrinkle_field(model: WrinkleModel, positions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Crease strength and crease phase per skin vertex for skin ``positions`` (N, 3).
+
+    Returns ``(strength, phase)``, both (N,) float32: ``strength`` ≥ 0 is how deeply the skin
+    creases there (smooth: it varies over the width of a furrow pattern, not from point to
+    point); ``phase`` is the position across the furrows, in furrow spacings (the renderer
+    draws a furrow at each whole number, per pixel — far finer than the mesh could carry).
+    The furrows run across the main compression direction, so their phase is the rest
+    position measured along it.
+    """
+    squeeze, direction, _ = principal_compression(model, positions)
+    # Average the compression as a tensor, so opposite directions agree.
     tensor = squeeze[:, None, None] * direction[:, :, None] * direction[:, None, :]
-    fields = model.to_vertex @ np.c_[tensor.reshape(len(squeeze), 9), squeeze, np.maximum(1.0 - large, 0.0)]
+    fields = model.to_vertex @ np.c_[tensor.reshape(len(squeeze), 9), squeeze]
     for _ in range(model.passes):  # buckling is a pattern over several points, not one
         fields = model.smooth @ fields
-    v_tensor = fields[:, :9].reshape(-1, 3, 3)
-    v_squeeze, v_other = fields[:, 9], fields[:, 10]
-    v_dir = _principal_axis(v_tensor)                                    # main compression direction
+    v_dir = _principal_axis(fields[:, :9].reshape(-1, 3, 3))             # main compression direction
+    v_squeeze = fields[:, 9]
     strength = np.clip((v_squeeze - model.threshold) / (1.0 - model.threshold), 0.0, None) ** model.exponent
 
     # On the forehead and glabella the lines run straight across or straight up (their skin is
     # held flat by the bone beneath): the direction snaps to the nearer of height and width.
     snapped = np.where(np.abs(v_dir[:, 1:2]) >= np.abs(v_dir[:, 0:1]), [[0.0, 1.0, 0.0]], [[1.0, 0.0, 0.0]])
     along = (1 - model.straight)[:, None] * v_dir + model.straight[:, None] * snapped
-    phase = 2.0 * np.pi * (model.rest * along).sum(1) / model.wavelength
-    lines = 0.5 * (1.0 + np.cos(phase))
-    # Where the skin is squeezed every way, a dimple pattern (cosines across both directions).
-    across = np.cross(v_dir, model.rest / np.maximum(np.linalg.norm(model.rest, axis=1, keepdims=True), 1e-12))
-    across /= np.maximum(np.linalg.norm(across, axis=1, keepdims=True), 1e-12)
-    phase2 = 2.0 * np.pi * (model.rest * across).sum(1) / model.wavelength
-    dimples = lines * 0.5 * (1.0 + np.cos(phase2))
-    both = np.clip(v_other / np.maximum(v_squeeze, 1e-9), 0.0, 1.0)
-    pattern = (1 - both) * lines + both * dimples
-    out = model.gain * model.zone_gain * strength * (model.pattern_weight * pattern + model.crease)
-    return np.clip(out, 0.0, 2.0).astype(np.float32)
+    phase = _furrow_phase(model, along)
+    out = model.gain * model.zone_gain * strength * model.on_face * (1.0 + model.crease)
+    return np.clip(out, 0.0, 2.0).astype(np.float32), phase.astype(np.float32)
+
+
+def _furrow_phase(model: WrinkleModel, along: np.ndarray) -> np.ndarray:
+    """The phase whose gradient is ``along / wavelength`` as nearly as can be (least squares
+    over the skin edges): furrows then keep their spacing where the direction turns, which
+    measuring each point from one origin would not (a small turn there moves far points by
+    many furrows).
+
+    A direction's sign is arbitrary: each point takes the one whose largest component is
+    positive, and an edge whose ends still disagree (where the field turns through the
+    diagonal) asks for no change of phase across it.
+    """
+    largest = np.take_along_axis(along, np.abs(along).argmax(axis=1)[:, None], axis=1)
+    along = along * np.where(largest < 0, -1.0, 1.0)
+    i, j = model.edges[:, 0], model.edges[:, 1]
+    mean = 0.5 * (along[i] + along[j])
+    agree = (along[i] * along[j]).sum(1) > 0
+    step = (model.rest[j] - model.rest[i]) * mean
+    diff = np.where(agree, step.sum(1) * 2.0 / (model.wavelength[i] + model.wavelength[j]), 0.0)
+    return model.integrate(model.incidence.T @ diff)

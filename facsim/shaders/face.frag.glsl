@@ -63,18 +63,17 @@ uniform vec3 u_cheek;
 uniform float u_wrinkle_darken;
 
 #ifdef USE_WRINKLE
-// Creases: thin dark furrows with a faint lit ridge beside each, running along the contours
-// of the wrinkle field (v_crease is the distance across them), slightly wavy, fading in with
-// the wrinkle amount and to their mean where they would be finer than a pixel.
-const float CREASES_PER_DM = 11.0;   // about 9 mm apart
+// Creases: thin dark furrows with a faint lit ridge beside each, one at each whole number of
+// the crease phase (v_crease, in furrow spacings), slightly wavy, fading in with the wrinkle
+// amount and to their mean where they would be finer than a pixel.
 float crease_shade(float wrinkle, float phase, vec2 uv) {
-    float s = phase * CREASES_PER_DM + 0.5 * value_noise(uv * vec2(40.0, 25.0), 0);
+    float s = phase + 0.5 * value_noise(uv * vec2(40.0, 25.0), 0);
     float c = cos(2.0 * PI * s);
     float valley = pow(0.5 + 0.5 * c, 10.0);
     float ridge = pow(0.5 + 0.5 * cos(2.0 * PI * (s + 0.22)), 8.0);
     float lines = 1.0 - 0.55 * valley + 0.12 * ridge;
     float detail = clamp(2.0 - 3.0 * fwidth(s), 0.0, 1.0);
-    float amount = smoothstep(0.05, 0.8, wrinkle);
+    float amount = smoothstep(0.15, 0.9, wrinkle);
     float cavity = 1.0 - u_wrinkle_darken * clamp(wrinkle, 0.0, 1.0);
     return mix(1.0, mix(0.93, lines, detail), amount) * cavity;
 }

@@ -7,7 +7,7 @@ in float in_occlusion;  // ambient visibility 0..1 (1 = open sky), per geometry 
 in float in_wrinkle;  // skin: wrinkle amount; lashes: root-to-tip coordinate
 #endif
 #ifdef USE_WRINKLE
-in float in_crease;   // distance across the creases (dm), see render.crease_phase
+in float in_crease;   // position across the creases in crease spacings, see render.crease_phase
 out float v_wrinkle;
 out float v_crease;
 #endif
