@@ -75,6 +75,11 @@ _PASSES = {
     "eyeball": ("REGION_EYEBALL", "USE_EYE"),
     "lashes": ("REGION_LASHES", "USE_LASH"),
 }
+#: Shader variants for frames without creases (no wrinkle field): the skin skips the crease
+#: code, which llvmpipe would otherwise run on every skin fragment.
+_CREASE_FREE = {name: name + "_plain" for name in ("skin", "skin_brows")}
+_VARIANTS = {**_PASSES, **{plain: tuple(d for d in _PASSES[name] if d != "USE_WRINKLE")
+                           for name, plain in _CREASE_FREE.items()}}
 #: Groups drawn with back faces culled (closed, outward-wound after _fix_winding); the rest
 #: are two-sided (teeth bands, lash cards, the inside of the mouth).
 _CULLED = ("skin", "skin_brows", "eyeball")
@@ -196,7 +201,7 @@ class Renderer:
         if name in self._programs:
             return self._programs[name], self._vaos[name]
         ctx = self._ctx
-        defines = dict.fromkeys(_PASSES[name], "")
+        defines = dict.fromkeys(_VARIANTS[name], "")
         prog = self._track(ctx.program(
             vertex_shader=_shader_source("face.vert.glsl", defines),
             fragment_shader=_shader_source("face.frag.glsl", defines)))
@@ -216,6 +221,10 @@ class Renderer:
             self._set_colors(name, self._appearance)
         return prog, vao
 
+    def _variant(self, name: str) -> str:
+        """The program that draws group ``name`` this frame."""
+        return name if self._creased else _CREASE_FREE.get(name, name)
+
     def _rebuild_draws(self) -> None:
         """Sort the triangles into draw groups and upload the index buffer."""
         names = list(_PASSES)
@@ -228,7 +237,7 @@ class Renderer:
         self._draws = [(names[i], int(starts[i]), int(counts[i]))
                        for i in range(len(names)) if counts[i]]
         for name, _, _ in self._draws:
-            self._program(name)
+            self._program(self._variant(name))
 
     def _fix_winding(self, p: np.ndarray) -> None:
         """Make skin and eyeballs wound counter-clockwise seen from outside (for culling).
@@ -257,6 +266,7 @@ class Renderer:
                                                    dynamic=True))
         self._ibo = self._track(ctx.buffer(reserve=self._faces.nbytes))
         self._programs, self._vaos = {}, {}
+        self._creased = False
         self._paint_tex = None
         self._rebuild_draws()
 
@@ -386,8 +396,11 @@ class Renderer:
             self._fix_winding(p)
             self._rebuild_draws()
         self._update_vertices(p, w_geo, phase, occ)
+        self._creased = w_geo is not None and bool(w_geo.any())
         if appearance is not self._appearance:
             self._upload_appearance(appearance)
+        for name, _, _ in self._draws:
+            self._program(self._variant(name))  # compiled before the camera's uniforms are set
         self._set_camera(camera, lighting or self.lighting)
         self._draw()
         return self._read()
@@ -458,7 +471,7 @@ class Renderer:
                 ctx.cull_face = "back"
             else:
                 ctx.disable(ctx.CULL_FACE)
-            self._vaos[name].render(ctx.TRIANGLES, vertices=3 * count, first=3 * first)
+            self._vaos[self._variant(name)].render(ctx.TRIANGLES, vertices=3 * count, first=3 * first)
         fbo.depth_mask = True
         ctx.disable(ctx.BLEND | ctx.CULL_FACE)
         if self._downsample is not None:

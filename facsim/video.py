@@ -84,10 +84,9 @@ class VideoWriter:
         elif self.format == "gif":
             self._gif_frames.append(_rgb(frame))
         else:
-            rgb = _rgb(frame)
             if self._encoder is None:
-                self._encoder = self._start(rgb.shape[1], rgb.shape[0])
-            self._encoder.send(np.ascontiguousarray(rgb))
+                self._encoder = self._start(frame.shape[1], frame.shape[0])
+            self._encoder.send(_opaque_rgba(frame))
         self.frames_written += 1
 
     def _start(self, width: int, height: int):
@@ -98,7 +97,7 @@ class VideoWriter:
         codec, extra = ("libx264", ["-preset", "veryfast", "-movflags", "+faststart"]) if self.format == "mp4" else ("libvpx-vp9", ["-row-mt", "1", "-deadline", "realtime", "-cpu-used", "8"])
         audio_codec = None if self.audio is None else ("aac" if self.format == "mp4" else "libopus")
         encoder = imageio_ffmpeg.write_frames(
-            str(self._tmp), (width, height), fps=self.fps, codec=codec, pix_fmt_out="yuv420p",
+            str(self._tmp), (width, height), fps=self.fps, codec=codec, pix_fmt_in="rgba", pix_fmt_out="yuv420p",
             quality=self.quality, macro_block_size=1, output_params=extra + (["-shortest"] if self.audio else []),
             audio_path=self.audio, audio_codec=audio_codec,
         )
@@ -147,6 +146,17 @@ class VideoWriter:
             self.close()
         else:
             self.abort()
+
+
+def _opaque_rgba(frame: np.ndarray) -> np.ndarray:
+    """The frame as contiguous opaque RGBA: what the encoders read (ffmpeg drops the alpha
+    itself, cheaper than copying the colour channels out of a renderer's RGBA frame)."""
+    if frame.shape[2] == 4 and frame[..., 3].min() == 255:
+        return np.ascontiguousarray(frame)
+    out = np.empty(frame.shape[:2] + (4,), np.uint8)
+    out[..., :3] = _rgb(frame)
+    out[..., 3] = 255
+    return out
 
 
 def _rgb(frame: np.ndarray) -> np.ndarray:

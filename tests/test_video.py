@@ -40,6 +40,23 @@ def test_video_has_the_timeline_frames_size_and_rate(tmp_path, face_of, short_cl
     assert [p.name for p in tmp_path.iterdir()] == [out.name]
 
 
+def test_frames_of_any_layout_encode_their_colours(tmp_path):
+    """RGB frames, opaque RGBA frames and see-through RGBA frames (composited over white)."""
+    red = np.zeros((32, 32, 4), np.uint8)
+    red[..., 0], red[..., 3] = 220, 255
+    clear = red.copy()
+    clear[..., 3] = 0
+    out = tmp_path / "colours.mp4"
+    with VideoWriter(out, 10) as writer:
+        for frame in (red[..., :3], red, clear):
+            writer.append(frame)
+    _, frames = _read(out)
+    means = [f.reshape(-1, 3).mean(0) for f in frames]
+    for rgb in means[:2]:
+        assert rgb[0] > 180 and rgb[1] < 60 and rgb[2] < 60, rgb
+    assert (means[2] > 235).all(), means[2]
+
+
 def test_gif_and_png_sequences(tmp_path, face_of, short_clip):
     gif = animate(short_clip, tmp_path / "clip.gif", face=face_of("ava"), size=48, progress=False)
     with Image.open(gif) as im:
