@@ -71,6 +71,13 @@ def main(argv=None) -> None:
     static = _median_time(lambda: engine(target), args.repeats)
     reg_static = _median_time(lambda: registers(target), max(args.repeats, 20))
     points = engine.model.count
+    engine(target)
+
+    def wrinkle_field():
+        engine._wrinkle = None  # drop the cached field so that it is computed again
+        return engine.last_wrinkle
+
+    wrinkles = _median_time(wrinkle_field, max(args.repeats, 10))
 
     print(f"muscle engine, {args.character}: {points} points ({engine.model.net.count} skin), "
           f"{len(engine.model.arc_rest)} arcs, {len(engine.model.layer.names)} muscles; one core")
@@ -79,6 +86,7 @@ def main(argv=None) -> None:
           f"register engine {reg_frame * 1e3:.2f} ms   ratio {per_frame / reg_frame:6.1f}x")
     print(f"  static expression from rest (engine(act)):  {static * 1e3:8.1f} ms   "
           f"register engine {reg_static * 1e3:.2f} ms   ratio {static / reg_static:6.1f}x")
+    print(f"  wrinkle field of a frame (for the renderer): {wrinkles * 1e3:8.2f} ms")
     print(f"  medians of {args.repeats} runs; {len(frames)} frames of '1+2+6+12' coming on over {ramp}")
 
 
