@@ -120,3 +120,16 @@ def test_cli_emotion_and_animate(tmp_path):
     assert not (tmp_path / "bad.mp4").exists()
     r = run("render", "--timeline", "s.yaml", "--time", "9", "-o", "late.png")
     assert r.returncode == 2 and "outside the timeline" in r.stderr
+
+
+def test_progress_into_a_log_writes_a_line_per_tenth(capsys):
+    from facsim.video import Progress
+
+    bar = Progress(90)
+    for done in range(1, 91):
+        bar.update(done)
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 10 and lines[-1].endswith("fps") and "90/90 frames" in lines[-1]
+    silent = Progress(90, enabled=False)
+    silent.update(90)
+    assert capsys.readouterr().err == ""
