@@ -44,8 +44,9 @@ import numpy as np
 
 from .camera import Camera, projection_matrix, view_matrix, _size_pair
 from .images import write_png
-from .render_geometry import (CREASES_PER_DM, _faces_touching, _orientation, crease_phase, lash_coordinates, normal_operator,
-                              region_components, sphere_centre, sphere_directions, vertex_normals)
+from .render_geometry import (CREASES_PER_DM, _faces_touching, _orientation, crease_phase, lash_coordinates,
+                              normal_operator, region_components, sphere_centre, sphere_directions,
+                              vertex_normals)
 from .render_gl import RenderError, _set_uniform, _shader_source, gl_context
 from .render_inputs import (COLOR_NAMES, DEFAULT_BROW_UV_FRAME, DEFAULT_COLORS, HM08_BROW_UV_FRAME, REGIONS,
                             Appearance, Lighting, RenderTopology, brow_uv_frame, srgb_to_linear)
@@ -55,8 +56,8 @@ __all__ = [
     "REGIONS", "COLOR_NAMES", "DEFAULT_COLORS", "RenderTopology", "Appearance", "Lighting",
     "Renderer", "RenderError", "normal_operator", "vertex_normals", "srgb_to_linear",
     "write_png", "gl_context", "region_components", "sphere_centre", "lash_coordinates",
-    "crease_phase", "CREASES_PER_DM", "AA_METHODS", "HM08_BROW_UV_FRAME", "DEFAULT_BROW_UV_FRAME", "brow_uv_frame",
-    "bake_occlusion", "sphere_directions",
+    "crease_phase", "CREASES_PER_DM", "AA_METHODS", "HM08_BROW_UV_FRAME", "DEFAULT_BROW_UV_FRAME",
+    "brow_uv_frame", "bake_occlusion", "sphere_directions",
 ]
 
 #: Anti-aliasing methods: multisampling (``antialias`` = samples) or supersampling
