@@ -45,6 +45,7 @@ def main(argv=None) -> None:
     from facsim.notation import parse
     from facsim.expression import activations
     from facsim.registers import RegisterEngine
+    from facsim.muscle.wrinkles import wrinkle_field
 
     face = Face(args.character, engine="muscle")
     head, data, character, base = face.head, face.data, face.character, face.base_positions
@@ -72,12 +73,8 @@ def main(argv=None) -> None:
     reg_static = _median_time(lambda: registers(target), max(args.repeats, 20))
     points = engine.model.count
     engine(target)
-
-    def wrinkle_field():
-        engine._wrinkle = None  # drop the cached field so that it is computed again
-        return engine.last_wrinkle
-
-    wrinkles = _median_time(wrinkle_field, max(args.repeats, 10))
+    skin = engine.last_state.points(0)[: engine.model.net.count]
+    wrinkles = _median_time(lambda: wrinkle_field(engine.wrinkles, skin), max(args.repeats, 10))
 
     print(f"muscle engine, {args.character}: {points} points ({engine.model.net.count} skin), "
           f"{len(engine.model.arc_rest)} arcs, {len(engine.model.layer.names)} muscles; one core")
