@@ -34,8 +34,9 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
 
     from facsim.face import Face
-    from facsim.timeline import sample_frames, stimulus_timeline
-    from facsim.video import animate
+    from facsim.timeline.sampling import sample_frames
+    from facsim.timeline.builders import stimulus_timeline
+    from facsim.pipeline import animate
 
     tmp = Path(tempfile.mkdtemp())
     cli = [sys.executable, "-m", "facsim.cli", "render", "6+12", "-o", str(tmp / "cold.png"), "--size", str(args.size)]
@@ -70,7 +71,7 @@ def main(argv=None) -> int:
         timeline = stimulus_timeline("happiness")  # 3 s, 30 fps: HapFACS's stimulus
         for aa, label in (("fxaa", "FXAA (video default)"), (args.antialias, f"{args.antialias}x MSAA")):
             video = median_time(lambda: animate(timeline, tmp / "happy.mp4", face=face, size=size,
-                                                antialias=aa, progress=False), max(3, args.repeats // 2))
+                                                antialias=aa), max(3, args.repeats // 2))
             print(f"3-s 30-fps {size}² MP4, {label}, end to end: {video:6.2f} s "
                   f"({video / timeline.length:.2f}x real time; {len(positions) / video:.1f} fps overall)")
     return 0

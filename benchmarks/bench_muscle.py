@@ -42,14 +42,14 @@ def main(argv=None) -> None:
     args = parser.parse_args(argv)
 
     from facsim.face import Face
-    from facsim.notation import parse
-    from facsim.expression import activations
-    from facsim.registers import RegisterEngine
-    from facsim.muscle.wrinkles import wrinkle_field
+    from facsim.facs.notation import parse
+    from facsim.facs.activations import activations
+    from facsim.engines.registers import RegisterEngine
+    from facsim.engines.muscle.wrinkles import wrinkle_field
 
     face = Face(args.character, engine="muscle")
     head, data, character, base = face.head, face.data, face.character, face.base_positions
-    from facsim.muscle import MuscleEngine, _MODELS
+    from facsim.engines.muscle import MuscleEngine, _MODELS
 
     _MODELS.clear()
     start = time.perf_counter()

@@ -22,8 +22,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from facsim.camera import Camera, frame_camera  # noqa: E402
-from facsim.render import (  # noqa: E402
+from facsim.render.camera import Camera, frame_camera  # noqa: E402
+from facsim.render.renderer import (  # noqa: E402
     DEFAULT_COLORS, REGIONS, Appearance, Renderer, RenderTopology,
 )
 

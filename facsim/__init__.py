@@ -11,17 +11,17 @@ __version__ = "0.1.0"
 #: Public names, imported on first use so ``import facsim`` stays light (no GL, no data).
 _LAZY = {
     "Face": "facsim.face",
-    "parse": "facsim.notation",
-    "format_expression": "facsim.notation",
-    "Expression": "facsim.notation",
-    "NotationError": "facsim.notation",
-    "activations": "facsim.expression",
-    "Activations": "facsim.expression",
-    "emotion": "facsim.emotions",
-    "Character": "facsim.character",
-    "load_timeline": "facsim.timeline_io",
-    "stimulus_timeline": "facsim.timeline",
-    "animate": "facsim.video",
+    "parse": "facsim.facs.notation",
+    "format_expression": "facsim.facs.notation",
+    "Expression": "facsim.facs.notation",
+    "NotationError": "facsim.facs.notation",
+    "activations": "facsim.facs.activations",
+    "Activations": "facsim.facs.activations",
+    "emotion": "facsim.facs.emotions",
+    "Character": "facsim.head.character",
+    "load_timeline": "facsim.timeline.io",
+    "stimulus_timeline": "facsim.timeline.builders",
+    "animate": "facsim.pipeline",
 }
 
 __all__ = sorted(_LAZY)

@@ -13,10 +13,10 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .assets import load_face_data
-from .character import Character, resolve_character
-from .expression import Activations, activations
-from .head import HeadModel, build_head
+from facsim.head.assets import load_face_data
+from facsim.head.character import Character, resolve_character
+from facsim.facs.activations import Activations, activations
+from facsim.head.mesh import HeadModel, build_head
 
 ENGINES = ("registers", "muscle")
 #: Framing uses the skin above this height below the chin (dm), so a portrait
@@ -35,11 +35,11 @@ def load_head() -> HeadModel:
 def engine_class(name: str):
     """The deformation engine class called ``name`` (imported lazily)."""
     if name == "registers":
-        from .registers import RegisterEngine
+        from facsim.engines.registers import RegisterEngine
 
         return RegisterEngine
     if name == "muscle":
-        from .muscle import MuscleEngine
+        from facsim.engines.muscle import MuscleEngine
 
         return MuscleEngine
     raise ValueError(f"unknown engine {name!r}; choose from {', '.join(ENGINES)}")
@@ -52,7 +52,7 @@ def to_activations(expression, *, intensities: str = "hapfacs") -> Activations:
     if isinstance(expression, Activations):
         return expression
     if isinstance(expression, str):
-        from .notation import parse
+        from facsim.facs.notation import parse
 
         expression = parse(expression, intensities=intensities)
     return activations(expression)
@@ -83,7 +83,7 @@ class Face:
     @cached_property
     def base_positions(self) -> np.ndarray:
         """The character's neutral base mesh (19158, 3)."""
-        from .character import character_offsets
+        from facsim.head.character import character_offsets
 
         return character_offsets(self.character, self.data)
 
@@ -99,7 +99,7 @@ class Face:
 
     @cached_property
     def appearance(self):
-        from .appearance import character_appearance
+        from facsim.head.appearance import character_appearance
 
         return character_appearance(self.character, self.head)
 
@@ -112,9 +112,9 @@ class Face:
         """
         import hashlib
 
-        from .assets import cache_dir
-        from .atomic import atomic_write
-        from .render_occlusion import bake_occlusion
+        from facsim.head.assets import cache_dir
+        from facsim.atomic import atomic_write
+        from facsim.render.occlusion import bake_occlusion
 
         key = hashlib.sha256(repr((OCCLUSION_VERSION, self.character.with_(name="", description="", colors={})))
                              .encode()).hexdigest()[:16]
@@ -139,7 +139,7 @@ class Face:
 
     @lru_cache(maxsize=16)  # noqa: B019 — a Face lives as long as its renders
     def _camera(self, view, yaw, pitch, projection, size, fov_deg):
-        from .camera import DEFAULT_FOV_DEG, frame_points
+        from facsim.render.camera import DEFAULT_FOV_DEG, frame_points
 
         skin = self.neutral[self.head.skin]
         chin = float(self.head.joint(self.base_positions, "joint-jaw")[1])
@@ -154,7 +154,7 @@ class Face:
         ``antialias``: MSAA samples (1 = off, 4 = llvmpipe's best) or ``"fxaa"``
         (post-process edge smoothing at about the cost of no AA).
         """
-        from .render import Renderer
+        from facsim.render.renderer import Renderer
 
         key = (tuple(size), antialias, None if background is None else tuple(background))
         if key not in self._renderers:
@@ -193,7 +193,7 @@ class Face:
 
     def save(self, path, expression=None, **render_options) -> np.ndarray:
         """Render and write a PNG atomically; returns the image."""
-        from .images import write_png
+        from facsim.media.images import write_png
 
         image = self.render(expression, **render_options)
         write_png(path, image)

@@ -16,7 +16,7 @@ def head():
 
 @pytest.fixture(scope="session")
 def marks(head):
-    from facsim.landmarks import landmarks
+    from facsim.head.landmarks import landmarks
 
     return landmarks(head)
 

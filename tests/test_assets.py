@@ -8,7 +8,7 @@ import zipfile
 import numpy as np
 import pytest
 
-from facsim import assets
+from facsim.head import assets
 
 
 def _tiny_wheel() -> bytes:

@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from facsim.camera import (
+from facsim.render.camera import (
     VIEWS, Camera, camera_basis, frame_camera, frame_points, project, projection_matrix,
     view_matrix,
 )

@@ -1,7 +1,7 @@
-"""facsim.catalogue: the FACS table and the intensity tables."""
+"""facsim.facs.catalogue: the FACS table and the intensity tables."""
 import pytest
 
-from facsim.catalogue import (INTENSITY_TABLES, KINDS, REGIONS, ActionUnitInfo, UnknownActionUnitError,
+from facsim.facs.catalogue import (INTENSITY_TABLES, KINDS, REGIONS, ActionUnitInfo, UnknownActionUnitError,
                               catalogue, describe_table, info, intensity_of, letter_of)
 
 ACTION_CODES = [1, 2, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20, 21, 22, 23, 24, 25, 26,

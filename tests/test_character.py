@@ -4,8 +4,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from facsim.assets import load_face_data
-from facsim.character import (Character, CharacterError, character_offsets, macro_weights, preset,
+from facsim.head.assets import load_face_data
+from facsim.head.character import (Character, CharacterError, character_offsets, macro_weights, preset,
                               preset_names, random_character, resolve_character)
 
 

@@ -4,7 +4,7 @@ from importlib import resources
 import numpy as np
 import pytest
 
-from facsim.easing import EASINGS, ease, get_easing
+from facsim.timeline.easing import EASINGS, ease, get_easing
 
 HALFWAY = {"linear": 0.5, "ease-in": 0.25, "ease-out": 0.75, "smoothstep": 0.5, "sigmoid": 0.5}
 

@@ -1,9 +1,9 @@
-"""facsim.emotions: preset tables, intensity scaling, blends."""
+"""facsim.facs.emotions: preset tables, intensity scaling, blends."""
 import pytest
 
-from facsim.expression import activations
-from facsim.notation import Expression, parse
-from facsim.emotions import blend, describe_emotions, emotion, emotion_names, preset_tables
+from facsim.facs.activations import activations
+from facsim.facs.notation import Expression, parse
+from facsim.facs.emotions import blend, describe_emotions, emotion, emotion_names, preset_tables
 
 EMOTIONS = ["happiness", "sadness", "surprise", "anger", "fear", "disgust", "contempt", "embarrassment",
             "pride", "neutral"]

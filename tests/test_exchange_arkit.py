@@ -8,9 +8,10 @@ import pytest
 
 from facsim.exchange import ExchangeError, load_any_timeline, read_arkit_csv, write_arkit_csv
 from facsim.exchange.arkit import arkit_weights, csv_columns, inverse_map, shape_names
-from facsim.expression import Activations
-from facsim.registers import register_table
-from facsim.timeline import Envelope, Hold, Segment, Timeline, Track, activation_curves, frame_times
+from facsim.facs.activations import Activations
+from facsim.engines.registers import register_table
+from facsim.timeline.model import Envelope, Hold, Segment, Timeline, Track
+from facsim.timeline.sampling import activation_curves, frame_times
 
 #: The Live Link Face app's CSV header (JawRight before JawLeft, MouthRight before MouthLeft, as the app writes).
 LIVE_LINK_FACE_HEADER = (

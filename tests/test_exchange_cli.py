@@ -7,21 +7,6 @@ import sys
 
 import pytest
 
-#: Until cli.build_parser registers the exchange commands, run cli.main with them added.
-_SHIM = """
-import argparse, sys
-from facsim import cli, exchange_cli
-build = cli.build_parser
-def with_exchange():
-    parser = build()
-    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
-    if "export" not in sub.choices:
-        exchange_cli.add_commands(sub, cli.add_view_options)
-    return parser
-cli.build_parser = with_exchange
-sys.exit(cli.main(sys.argv[1:]))
-"""
-
 TIMELINE = """facsim-notation 1
 fps: 10
 duration: 1.2
@@ -32,7 +17,7 @@ AU12L        0.2:0>0.6:0.4~smoothstep>1:0
 
 
 def facsim(*args, cwd=None):
-    return subprocess.run([sys.executable, "-c", _SHIM, *args], capture_output=True, text=True, cwd=cwd)
+    return subprocess.run([sys.executable, "-m", "facsim", *args], capture_output=True, text=True, cwd=cwd)
 
 
 @pytest.fixture()

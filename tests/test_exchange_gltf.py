@@ -16,8 +16,9 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from facsim.exchange.gltf import METRES, glb_bytes, morph_target_keys, target_name
-from facsim.expression import Activations
-from facsim.timeline import Envelope, Hold, Timeline, Track, frame_count, frame_times, sample
+from facsim.facs.activations import Activations
+from facsim.timeline.model import Envelope, Hold, Timeline, Track
+from facsim.timeline.sampling import frame_count, frame_times, sample
 
 VALIDATOR_DIR = Path(__file__).parent / "gltf_validator"
 _COMPONENTS = {5126: np.float32, 5121: np.uint8, 5123: np.uint16, 5125: np.uint32}
@@ -218,7 +219,7 @@ def test_eyes_are_separate_nodes_at_the_eye_centres(face, animated):
 
 
 def _head_geometry_vertices(face):
-    from facsim.render import REGIONS
+    from facsim.render.renderer import REGIONS
 
     topo = face.head.topology
     return topo.render_to_geo[topo.region != REGIONS.index("eyeball")]

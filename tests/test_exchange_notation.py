@@ -8,7 +8,8 @@ import pytest
 
 from facsim.exchange import (NotationFileError, dumps_notation, load_any_timeline, loads_notation, read_notation,
                              save_any_timeline, write_notation)
-from facsim.timeline import Blinks, Envelope, Hold, Segment, Timeline, Track, load_timeline
+from facsim.timeline.model import Blinks, Envelope, Hold, Segment, Timeline, Track
+from facsim.timeline.io import load_timeline
 
 EXAMPLES = sorted((Path(__file__).parents[1] / "examples").glob("*.*"))
 

@@ -6,7 +6,7 @@ import pytest
 
 from facsim.exchange import ExchangeError, load_any_timeline, read_openface_csv
 from facsim.exchange.openface import intensity_levels
-from facsim.timeline import activation_curves, frame_count, frame_times
+from facsim.timeline.sampling import activation_curves, frame_count, frame_times
 
 OPENFACE_AUS = (1, 2, 4, 5, 6, 7, 9, 10, 12, 14, 15, 17, 20, 23, 25, 26, 45)
 HEADER = (["frame", "face_id", "timestamp", "confidence", "success",
@@ -95,8 +95,8 @@ def test_malformed_files_give_one_clear_error(tmp_path, mangle, message):
 
 
 def test_a_performance_plays_on_another_character(tmp_path, performance, face_of):
-    from facsim.video import animate
+    from facsim.pipeline import animate
 
     tl = read_openface_csv(performance)
-    out = animate(tl, tmp_path / "frames", face=face_of("kwame"), fps=5, size=32, antialias=1, progress=False)
+    out = animate(tl, tmp_path / "frames", face=face_of("kwame"), fps=5, size=32, antialias=1)
     assert len(list(out.glob("*.png"))) == 10

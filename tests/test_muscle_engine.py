@@ -4,9 +4,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from facsim.catalogue import catalogue
-from facsim.expression import Activations, activations
-from facsim.notation import parse
+from facsim.facs.catalogue import catalogue
+from facsim.facs.activations import Activations, activations
+from facsim.facs.notation import parse
 
 X, Y, Z = 0, 1, 2
 #: AU → checks (landmark on the character's left, axis, sign): the FACS manual's appearance changes.
@@ -83,10 +83,10 @@ def engine(face):
 
 @pytest.fixture(scope="module")
 def marks(head, engine):
-    from facsim.landmarks import landmarks
-    from facsim.muscle.net import anatomy
+    from facsim.head.landmarks import landmarks
+    from facsim.engines.muscle.net import anatomy
 
-    from facsim.muscle.net import resolve_vertex
+    from facsim.engines.muscle.net import resolve_vertex
 
     found = dict(landmarks(head))
     found["lip_corner_left"] = anatomy(head).mouth_corner
@@ -99,7 +99,7 @@ def marks(head, engine):
 @pytest.fixture(scope="module")
 def single(engine):
     """Every simulated code at E, solved in one batch: code → positions."""
-    from facsim.muscle import simulated_codes
+    from facsim.engines.muscle import simulated_codes
 
     codes = sorted(simulated_codes())
     acts = [activations(parse(str(code))) for code in codes]
@@ -107,7 +107,7 @@ def single(engine):
 
 
 def test_every_simulated_au_is_checked_or_is_an_eye_turn():
-    from facsim.muscle import simulated_codes
+    from facsim.engines.muscle import simulated_codes
 
     assert simulated_codes() - set(DIRECTIONS) <= {61, 62, 65, 66}
 
@@ -131,7 +131,7 @@ def test_eyes_turn_left_on_61_and_right_on_62(single, head):
 
 
 def test_every_catalogue_action_is_simulated_or_explained():
-    from facsim.muscle import coverage, simulated_codes
+    from facsim.engines.muscle import coverage, simulated_codes
 
     explained = coverage()
     for code, info in catalogue().items():
@@ -186,7 +186,7 @@ def test_a_step_applies_only_the_change(engine):
         held = engine.step(act)
     again = engine.step(act)  # nothing changed: the face stays where it is
     assert np.abs(again - held).max() < 0.003
-    from facsim.landmarks import landmarks
+    from facsim.head.landmarks import landmarks
 
     brow = landmarks(engine.head)["inner_brow_left"]
     first = engine.step(act.scaled(0.5))  # half the action: the brows start back up at once ...

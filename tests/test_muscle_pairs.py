@@ -14,8 +14,8 @@ from itertools import combinations
 import numpy as np
 import pytest
 
-from facsim.expression import activations
-from facsim.notation import parse
+from facsim.facs.activations import activations
+from facsim.facs.notation import parse
 
 BLOCK = 8
 #: The blocks are solved in this many parts, so ``pytest -n`` can share them out.
@@ -45,7 +45,7 @@ def covering_blocks(codes, size: int) -> list[tuple[int, ...]]:
 
 @pytest.fixture(scope="module")
 def codes():
-    from facsim.muscle import simulated_codes
+    from facsim.engines.muscle import simulated_codes
 
     return sorted(simulated_codes())
 
@@ -64,7 +64,7 @@ def _text(block) -> str:
 
 @pytest.mark.parametrize("part", range(PARTS))
 def test_every_pair_of_aus_at_e_solves_to_a_valid_face(face_of, head, codes, part):
-    from facsim.muscle import solver
+    from facsim.engines.muscle import solver
 
     engine = face_of("ava", "muscle").engine
     model = engine.model
@@ -100,6 +100,6 @@ def test_every_pair_of_aus_at_e_solves_to_a_valid_face(face_of, head, codes, par
 
 def _one(drive, b):
     """Configuration ``b`` of a batched Drive."""
-    from facsim.muscle.muscles import Drive
+    from facsim.engines.muscle.muscles import Drive
 
     return Drive(drive.muscle[b:b + 1], drive.pressure[b:b + 1], drive.lip_pressure[b:b + 1], drive.tongue[b:b + 1])

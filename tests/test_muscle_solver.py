@@ -4,8 +4,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from facsim.expression import Activations, activations
-from facsim.notation import parse
+from facsim.facs.activations import Activations, activations
+from facsim.facs.notation import parse
 
 
 @pytest.fixture(scope="module")
@@ -19,14 +19,14 @@ def model(engine):
 
 
 def _drive(model, text):
-    from facsim.muscle.muscles import drive
+    from facsim.engines.muscle.muscles import drive
 
     return drive(model.layer, activations(parse(text)) if text else Activations())
 
 
 @pytest.mark.parametrize("text", ["12", "4+6", "26", "33", "19", "24+17", "43"])
 def test_gradient_matches_finite_differences(model, text):
-    from facsim.muscle import solver
+    from facsim.engines.muscle import solver
 
     rng = np.random.default_rng(7)
     ld = solver.loads(model, _drive(model, text))
@@ -39,7 +39,7 @@ def test_gradient_matches_finite_differences(model, text):
 
 
 def test_rest_is_an_equilibrium(model):
-    from facsim.muscle import solver
+    from facsim.engines.muscle import solver
 
     state = solver.rest_state(model)
     ld = solver.loads(model, state.drive)
@@ -65,7 +65,7 @@ def test_the_stiffness_is_factorised_once_and_reused(engine, monkeypatch):
 def test_a_character_model_is_built_once_and_shared(face_of):
     """A second engine for the same character reuses the net, muscles and factorisation;
     another character gets its own (bench_muscle.py times the build)."""
-    from facsim.muscle import MuscleEngine
+    from facsim.engines.muscle import MuscleEngine
 
     face = face_of("ava", "muscle")
     again = MuscleEngine(face.head, face.data, face.character, face.base_positions)
@@ -82,7 +82,7 @@ def test_batched_solves_equal_single_ones(engine):
 
 
 def test_jaw_statics(model):
-    from facsim.muscle.muscles import jaw_pose
+    from facsim.engines.muscle.muscles import jaw_pose
 
     def pose(text):
         return jaw_pose(model.layer, _drive(model, text).muscle, model.jaw_spec)[0]
@@ -96,8 +96,8 @@ def test_jaw_statics(model):
 
 
 def test_muscle_data_is_consistent(model):
-    from facsim.muscle import au_table
-    from facsim.muscle.net import load_spec
+    from facsim.engines.muscle import au_table
+    from facsim.engines.muscle.net import load_spec
 
     spec = load_spec()
     names = set(spec["muscles"])
@@ -131,8 +131,8 @@ def test_improved_muscles_bend_over_bone(model):
 
 
 def test_coverage_lists_every_facial_action(engine):
-    from facsim.catalogue import catalogue
-    from facsim.muscle import coverage, simulated_codes
+    from facsim.facs.catalogue import catalogue
+    from facsim.engines.muscle import coverage, simulated_codes
 
     explained = coverage()
     actions = [c for c, info in catalogue().items() if info.kind in ("action", "head", "eye")]
@@ -146,7 +146,7 @@ def _wrinkles(engine, text):
 
 
 def test_wrinkles_appear_where_the_skin_is_squeezed(engine, head):
-    from facsim.landmarks import landmarks
+    from facsim.head.landmarks import landmarks
 
     marks = landmarks(head)
     rest = engine.neutral
@@ -165,8 +165,8 @@ def test_wrinkles_appear_where_the_skin_is_squeezed(engine, head):
 def test_wrinkle_lines_run_across_the_compression(engine, head):
     """On 1+2 the forehead is squeezed vertically, so its lines run horizontally; on 4 the
     glabella is squeezed sideways, so its furrows run vertically."""
-    from facsim.landmarks import landmarks
-    from facsim.muscle.wrinkles import principal_compression
+    from facsim.head.landmarks import landmarks
+    from facsim.engines.muscle.wrinkles import principal_compression
 
     marks = landmarks(head)
     model = engine.wrinkles
@@ -188,7 +188,7 @@ def test_wrinkle_lines_run_across_the_compression(engine, head):
 def test_furrow_phase_counts_furrows_across_the_compression(engine, head):
     """The renderer draws a furrow at each whole phase: on 4 the glabella's phase climbs
     sideways by about one per glabellar furrow spacing, and hardly at all upward."""
-    from facsim.landmarks import landmarks
+    from facsim.head.landmarks import landmarks
 
     marks = landmarks(head)
     engine(activations(parse("4")))

@@ -1,12 +1,12 @@
-"""facsim.notation: parsing, canonical formatting, errors with positions."""
+"""facsim.facs.notation: parsing, canonical formatting, errors with positions."""
 import pickle
 import random
 
 import pytest
 
-from facsim.catalogue import catalogue
-from facsim.expression import UNILATERAL_DEFAULT_SIDE, activations
-from facsim.notation import (ActionUnit, Expression, NotationError, format_expression, parse,
+from facsim.facs.catalogue import catalogue
+from facsim.facs.activations import UNILATERAL_DEFAULT_SIDE, activations
+from facsim.facs.notation import (ActionUnit, Expression, NotationError, format_expression, parse,
                              parse_intensity)
 
 

@@ -3,8 +3,10 @@ from pathlib import Path
 
 import pytest
 
-from facsim.plot import plot_timeline
-from facsim.timeline import Blinks, Timeline, load_timeline, stimulus_timeline
+from facsim.timeline.plot import plot_timeline
+from facsim.timeline.model import Blinks, Timeline
+from facsim.timeline.builders import stimulus_timeline
+from facsim.timeline.io import load_timeline
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
@@ -58,10 +60,10 @@ def test_does_not_switch_pyplot_backend(tmp_path):
 
 
 def test_identical_curves_share_one_legend_entry(tmp_path):
-    from facsim.plot import _identical_groups
+    from facsim.timeline.plot import _identical_groups
 
     tl = load_timeline(EXAMPLES / "surprise_sequence.yaml")
-    from facsim.timeline import frame_times, intensity_curves
+    from facsim.timeline.sampling import frame_times, intensity_curves
 
     groups = _identical_groups(intensity_curves(tl, frame_times(tl)))
     assert groups == [["AU1", "AU2", "AU26"], ["AU5"]]

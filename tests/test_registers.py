@@ -4,10 +4,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from facsim.catalogue import catalogue
-from facsim.expression import Activations, activations
-from facsim.notation import parse
-from facsim.registers import combine_registers, register_table, register_weights, simulated_codes
+from facsim.facs.catalogue import catalogue
+from facsim.facs.activations import Activations, activations
+from facsim.facs.notation import parse
+from facsim.engines.registers import combine_registers, register_table, register_weights, simulated_codes
 
 X, Y, Z = 0, 1, 2
 #: AU → checks (landmark on the character's left, axis, sign): the FACS manual's appearance changes.
@@ -121,7 +121,7 @@ def test_eq1_sums_shared_registers_and_clamps_to_the_smallest_max():
 
 
 def test_every_register_names_a_real_target(face_of):
-    from facsim.expression import SIDES
+    from facsim.facs.activations import SIDES
     engine = face_of("sofia").engine
     for code in register_table()["action_units"]:
         for side in SIDES:
@@ -137,7 +137,7 @@ def test_every_catalogue_action_is_simulated_or_explained():
 
 
 def test_emotions_differ_from_neutral_where_their_aus_act(face_of):
-    from facsim.emotions import emotion, emotion_names
+    from facsim.facs.emotions import emotion, emotion_names
     face = face_of("amara")
     neutral = face.render(size=128).astype(int)
     for name in emotion_names():

@@ -11,8 +11,8 @@ import math
 import numpy as np
 import pytest
 
-from facsim.camera import Camera, frame_camera, project
-from facsim.render import (
+from facsim.render.camera import Camera, frame_camera, project
+from facsim.render.renderer import (
     COLOR_NAMES, DEFAULT_BROW_UV_FRAME, DEFAULT_COLORS, REGIONS, Appearance, Lighting,
     CREASES_PER_DM, RenderError, Renderer, RenderTopology, bake_occlusion, brow_uv_frame, crease_phase,
     lash_coordinates,
@@ -514,7 +514,7 @@ def test_sphere_centre_and_components(scene):
 
 
 def test_brow_frame_default_matches_the_head_paint_box():
-    from facsim.assets import PAINT_UV_BOX
+    from facsim.head.assets import PAINT_UV_BOX
 
     assert np.allclose(brow_uv_frame(PAINT_UV_BOX), DEFAULT_BROW_UV_FRAME)
 

@@ -7,13 +7,12 @@ import numpy as np
 import pytest
 import yaml
 
-from facsim.expression import UNILATERAL_DEFAULT_SIDE, Activations
-from facsim.notation import parse
-from facsim.timeline import (
-    BLINK_AU, Blinks, Envelope, Hold, Segment, Timeline, TimelineError, Track,
-    activation_curves, blink_times, frame_count, frame_times, intensity_curves, load_timeline, sample,
-    sample_frames, save_timeline, stimulus_timeline, timeline_from_dict, timeline_schema, timeline_to_dict,
-)
+from facsim.facs.activations import UNILATERAL_DEFAULT_SIDE, Activations
+from facsim.facs.notation import parse
+from facsim.timeline.model import BLINK_AU, Blinks, Envelope, Hold, Segment, Timeline, TimelineError, Track
+from facsim.timeline.sampling import activation_curves, blink_times, frame_count, frame_times, intensity_curves, sample, sample_frames
+from facsim.timeline.builders import stimulus_timeline
+from facsim.timeline.io import load_timeline, save_timeline, timeline_from_dict, timeline_schema, timeline_to_dict
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 EXAMPLE_FILES = sorted(p for p in EXAMPLES.iterdir() if p.suffix in (".yaml", ".yml", ".json"))
@@ -169,7 +168,7 @@ def test_facs_letters_follow_the_intensities_table():
 
 @pytest.mark.parametrize("name, table, code", [("happiness", "hapfacs", 25), ("surprise", "emfacs", 5)])
 def test_emotion_track_scales_its_aus(name, table, code):
-    from facsim.emotions import emotion
+    from facsim.facs.emotions import emotion
 
     expected = {u.code: u.intensity for u in emotion(name, table=table).units}
     tl = one_track({"emotion": name, "table": table, "start": 0, "onset": 1, "apex": 1, "offset": 1,
@@ -391,9 +390,9 @@ def test_surprise_example():
 def test_module_docstring_example_loads():
     import textwrap
 
-    import facsim.timeline
+    import facsim.timeline.model
 
-    block = facsim.timeline.__doc__.split("(read through ``intensities``)::")[1].split("Each track has")[0]
+    block = facsim.timeline.model.__doc__.split("(read through ``intensities``)::")[1].split("Each track has")[0]
     tl = timeline_from_dict(yaml.safe_load(textwrap.dedent(block)))
     assert [t.label for t in tl.tracks] == ["AU12 (L)", "1+2+5B+26", "happiness"]
 

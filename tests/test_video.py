@@ -9,8 +9,9 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from facsim.timeline import stimulus_timeline
-from facsim.video import VideoWriter, animate, video_format
+from facsim.timeline.builders import stimulus_timeline
+from facsim.pipeline import animate
+from facsim.media.video import VideoWriter, video_format
 
 
 def _read(path):
@@ -30,7 +31,7 @@ def short_clip():
 @pytest.mark.parametrize("suffix", [".mp4", ".webm"])
 def test_video_has_the_timeline_frames_size_and_rate(tmp_path, face_of, short_clip, suffix):
     out = tmp_path / f"clip{suffix}"
-    animate(short_clip, out, face=face_of("ava"), size=64, progress=False)
+    animate(short_clip, out, face=face_of("ava"), size=64)
     meta, frames = _read(out)
     assert len(frames) == 6 and meta["size"] == (64, 64) and meta["fps"] == pytest.approx(12)
     if suffix == ".mp4":
@@ -58,7 +59,7 @@ def test_frames_of_any_layout_encode_their_colours(tmp_path):
 
 
 def test_gif_and_png_sequences(tmp_path, face_of, short_clip):
-    gif = animate(short_clip, tmp_path / "clip.gif", face=face_of("ava"), size=48, progress=False)
+    gif = animate(short_clip, tmp_path / "clip.gif", face=face_of("ava"), size=48)
     with Image.open(gif) as im:
         assert im.n_frames == 6 and im.size == (48, 48)
         total = 0
@@ -66,7 +67,7 @@ def test_gif_and_png_sequences(tmp_path, face_of, short_clip):
             im.seek(i)
             total += im.info["duration"]
         assert total == pytest.approx(500, abs=10)  # 6 frames at 12 fps, in whole centiseconds
-    folder = animate(short_clip, tmp_path / "frames", face=face_of("ava"), size=48, progress=False)
+    folder = animate(short_clip, tmp_path / "frames", face=face_of("ava"), size=48)
     names = sorted(p.name for p in folder.iterdir())
     assert names == [f"frame_{i:05d}.png" for i in range(6)]
 
@@ -75,7 +76,7 @@ def test_audio_track_is_muxed(tmp_path, face_of, short_clip):
     wav = tmp_path / "tone.wav"
     ffmpeg = imageio_ffmpeg.get_ffmpeg_exe()
     subprocess.run([ffmpeg, "-v", "error", "-f", "lavfi", "-i", "sine=frequency=440:duration=1", str(wav)], check=True)
-    out = animate(short_clip, tmp_path / "talk.mp4", face=face_of("ava"), size=64, audio=wav, progress=False)
+    out = animate(short_clip, tmp_path / "talk.mp4", face=face_of("ava"), size=64, audio=wav)
     probe = subprocess.run([ffmpeg, "-i", str(out)], capture_output=True, text=True).stderr
     assert "Audio: aac" in probe and "Video: h264" in probe
 
@@ -95,8 +96,8 @@ def test_bad_outputs_are_refused(tmp_path, name, message):
 
 
 def test_muscle_state_or_registers_reproduce_the_same_video(tmp_path, face_of, short_clip):
-    a = animate(short_clip, tmp_path / "a", face=face_of("ava"), size=48, progress=False)
-    b = animate(short_clip, tmp_path / "b", face=face_of("ava"), size=48, progress=False)
+    a = animate(short_clip, tmp_path / "a", face=face_of("ava"), size=48)
+    b = animate(short_clip, tmp_path / "b", face=face_of("ava"), size=48)
     for fa, fb in zip(sorted(a.iterdir()), sorted(b.iterdir())):
         assert np.array_equal(np.asarray(Image.open(fa)), np.asarray(Image.open(fb)))
 
@@ -123,7 +124,7 @@ def test_cli_emotion_and_animate(tmp_path):
 
 
 def test_progress_into_a_log_writes_a_line_per_tenth(capsys):
-    from facsim.video import Progress
+    from facsim.cli.progress import Progress
 
     bar = Progress(90)
     for done in range(1, 91):

@@ -21,15 +21,14 @@ imports them. Errors in input files are :class:`ExchangeError` (a
 ``ValueError``): one line naming the file, the line (and column where it
 helps) and what is wrong.
 
-This module also holds what the formats share: :func:`timeline_from_samples`
-(recorded curves → a timeline of linear segments) and the rigid motions of
+This module also holds what the formats share: CSV helpers and the rigid motions of
 the register engine (head 51–58, eyes 61–66) as rotation vectors and back.
 """
 from __future__ import annotations
 
 from importlib import import_module
 from pathlib import Path
-from typing import Callable, Mapping
+from typing import Callable
 
 import numpy as np
 
@@ -125,7 +124,7 @@ def load_any_timeline(path):
         return __getattr__("read_notation")(path)
     if suffix == ".csv":
         return (__getattr__("read_arkit_csv") if _csv_kind(path) == "arkit" else __getattr__("read_openface_csv"))(path)
-    from facsim.timeline_io import load_timeline
+    from facsim.timeline.io import load_timeline
 
     return load_timeline(path)
 
@@ -135,7 +134,7 @@ def save_any_timeline(timeline, path) -> Path:
     path = Path(path)
     if path.suffix.lower() == ".facs":
         return __getattr__("write_notation")(timeline, path)
-    from facsim.timeline_io import save_timeline
+    from facsim.timeline.io import save_timeline
 
     return save_timeline(timeline, path)
 
@@ -193,78 +192,10 @@ def require_columns(header: list[str], required, path, what: str) -> dict[str, i
 
 # ------------------------------------------------------ recorded curves ---
 
-def timeline_from_samples(times, curves: Mapping[tuple[int, str], np.ndarray], *, fps: float,
-                          decimals: int = 4, **settings):
-    """A timeline that passes through recorded levels at ``times``.
-
-    Each (code, side) curve becomes linear segments from frame to frame
-    (collinear runs merged, runs of zero left out), so sampling the timeline
-    at ``times[i]`` gives ``curves[key][i]`` (rounded to ``decimals``). The
-    last frame holds for one frame interval, which is where the timeline ends.
-
-    Parameters
-    ----------
-    times : (n,) array
-        Seconds, strictly increasing, the first >= 0.
-    curves : mapping (code, "left" | "right" | "both") → (n,) array of levels
-        Left and right curves of one AU that are equal become one ``both``
-        track, as does an AU that cannot act on one side (from its larger
-        side); otherwise each side is a track of its own.
-    fps : float
-        The timeline's frame rate (the last frame's length is ``1 / fps``).
-    **settings
-        ``character``, ``engine``, ``description``, ``intensities``.
-    """
-    from facsim.catalogue import info
-    from facsim.timeline import Segment, Timeline, Track
-
-    times = np.asarray(times, dtype=float)
-    if times.ndim != 1 or times.size == 0:
-        raise ValueError("times must be a non-empty 1-D array of seconds")
-    if times[0] < 0 or np.any(np.diff(times) <= 0):
-        raise ValueError("times must start at 0 s or later and increase strictly")
-    end = float(times[-1] + 1.0 / fps)
-    knots = np.append(times, end)
-    by_code: dict[int, dict[str, np.ndarray]] = {}
-    for (code, side), values in curves.items():
-        by_code.setdefault(int(code), {})[side] = np.clip(np.round(np.asarray(values, float), decimals), 0.0, 1.0)
-    tracks = []
-    for code in sorted(by_code):
-        sides = by_code[code]
-        left, right = sides.get("left"), sides.get("right")
-        twins = left is not None and right is not None and np.array_equal(left, right)
-        if "both" in sides or twins or not info(code).unilateral:
-            parts = [s for s in (sides.get("both"), left, right) if s is not None]
-            sides = {"both": np.max(parts, axis=0)}
-        for side in ("both", "left", "right"):
-            if side in sides:
-                segments = _linear_segments(knots, np.append(sides[side], sides[side][-1]), Segment)
-                if segments:
-                    tracks.append(Track(au=code, side=side, timing=segments))
-    return Timeline(tuple(tracks), duration=end, fps=fps, **settings)
-
-
-def _linear_segments(knots: np.ndarray, levels: np.ndarray, segment) -> tuple:
-    """Segments through (knots[i], levels[i]); collinear points merged, flat zero runs dropped."""
-    keep = np.ones(len(knots), bool)
-    if len(knots) > 2:
-        t0, t1, t2 = knots[:-2], knots[1:-1], knots[2:]
-        v0, v1, v2 = levels[:-2], levels[1:-1], levels[2:]
-        straight = np.abs(v0 + (v2 - v0) * (t1 - t0) / (t2 - t0) - v1) <= 1e-12
-        keep[1:-1] = ~straight
-    idx = np.flatnonzero(keep)
-    out = []
-    for a, b in zip(idx[:-1], idx[1:]):
-        if levels[a] == 0.0 and levels[b] == 0.0:
-            continue
-        out.append(segment(float(knots[a]), float(knots[b]), float(levels[a]), float(levels[b])))
-    return tuple(out)
-
-
 # ------------------------------------------------------- rigid motions ---
 
 def _table():
-    from facsim.registers import register_table
+    from facsim.engines.registers import register_table
 
     return register_table()
 
@@ -333,5 +264,5 @@ def eye_levels(left_degrees, right_degrees) -> dict[int, float]:
 __all__ = [
     "ExchangeError", "TIMELINE_SUFFIXES", "csv_number", "eye_levels", "eye_motion", "head_levels", "head_motion",
     "load_any_timeline", "read_csv_rows", "require_columns", "save_any_timeline",
-    "timeline_from_samples", "write_file", *sorted(_LAZY),
+    "write_file", *sorted(_LAZY),
 ]

@@ -26,7 +26,7 @@ ARKit → AUs
     moving the head forward and back, have no ARKit column); eye
     angles, when the file has any, give 61–66, else 61–64 come from the
     eyeLook shapes. The levels become a timeline of linear segments from
-    frame to frame (:func:`facsim.exchange.timeline_from_samples`).
+    frame to frame (:func:`facsim.timeline.builders.timeline_from_samples`).
 
 CSV layout
     ``Timecode, BlendShapeCount``, the 52 shapes in Live Link Face order
@@ -49,8 +49,9 @@ from pathlib import Path
 
 import numpy as np
 
-from . import (ExchangeError, csv_number, eye_levels, eye_motion, head_levels, head_motion, read_csv_rows,
-               require_columns, timeline_from_samples, write_file)
+from facsim.exchange import (ExchangeError, csv_number, eye_levels, eye_motion, head_levels, head_motion, read_csv_rows,
+                             require_columns, write_file)
+from facsim.timeline.builders import timeline_from_samples
 
 REGISTER_PREFIX = "faceunits/"
 #: Frame rates a Live Link Face take's frame numbers are snapped up to.
@@ -91,7 +92,7 @@ def angle_names() -> tuple[str, ...]:
 
 def arkit_weights(act) -> dict[str, float]:
     """The 52 ARKit weights (0..1, by camelCase name) of one frame's :class:`~facsim.expression.Activations`."""
-    from facsim.registers import register_weights
+    from facsim.engines.registers import register_weights
 
     table = arkit_table()
     weights = dict.fromkeys(shape_names(), 0.0)
@@ -140,7 +141,7 @@ def _number(value: float) -> str:
 
 def dumps_arkit_csv(timeline, *, fps: float | None = None) -> str:
     """The timeline's frames as Live Link Face CSV text (header :func:`csv_columns`)."""
-    from facsim.timeline import sample_frames
+    from facsim.timeline.sampling import sample_frames
 
     fps = fps or timeline.fps
     names, angles = shape_names(), angle_names()
@@ -174,9 +175,9 @@ def inverse_map() -> tuple[tuple[tuple[int, str], ...], np.ndarray]:
     matrix : (52, len(unknowns)) array
         ARKit weights of each unknown at level 1.
     """
-    from facsim.catalogue import info
-    from facsim.expression import Activations
-    from facsim.registers import register_table
+    from facsim.facs.catalogue import info
+    from facsim.facs.activations import Activations
+    from facsim.engines.registers import register_table
 
     table = register_table()
     excluded = set(arkit_table()["inverse"]["excluded"])

@@ -39,9 +39,9 @@ from pathlib import Path
 
 import numpy as np
 
-from facsim.expression import Activations
+from facsim.facs.activations import Activations
 
-from . import eye_motion, head_motion, write_file
+from facsim.exchange import eye_motion, head_motion, write_file
 
 #: facsim decimetres → glTF metres.
 METRES = 0.1
@@ -138,14 +138,14 @@ def _png(rgb: np.ndarray) -> bytes:
 
 def _srgb8(linear: np.ndarray) -> np.ndarray:
     """Linear light (0..1) → 8-bit sRGB, through a 4096-step table (exact to the 8-bit step)."""
-    from facsim.appearance import linear_to_srgb
+    from facsim.head.appearance import linear_to_srgb
 
     table = np.clip(linear_to_srgb(np.linspace(0.0, 1.0, 4096)) * 255 + 0.5, 0, 255).astype(np.uint8)
     return table[np.clip(np.rint(np.asarray(linear) * 4095), 0, 4095).astype(np.intp)]
 
 
 def _linear(colour) -> np.ndarray:
-    from facsim.render_inputs import srgb_to_linear
+    from facsim.render.inputs import srgb_to_linear
 
     return srgb_to_linear(np.asarray(colour, float))
 
@@ -159,7 +159,7 @@ def skin_texture(appearance) -> np.ndarray:
     lids, lips, then brow hair at its average coverage); the one-texel border
     is plain skin, which UVs outside the box clamp to.
     """
-    from facsim.appearance import _resize
+    from facsim.head.appearance import _resize
 
     colours = {k: _linear(v).astype(np.float32) for k, v in appearance.colors.items()}
     paint = appearance.paint.astype(np.float32) / 255 if appearance.paint is not None else None
@@ -210,8 +210,8 @@ def morph_target_keys(aus="all") -> list[tuple[int, str]]:
 
     ``aus`` is ``"all"`` or AU codes to keep (the register engine's morph AUs only).
     """
-    from facsim.catalogue import info
-    from facsim.registers import register_table
+    from facsim.facs.catalogue import info
+    from facsim.engines.registers import register_table
 
     codes = sorted(register_table()["action_units"])
     if aus != "all":
@@ -289,9 +289,9 @@ def _floats(values) -> list[float]:
 
 def _face_mesh(b: GlbBuilder, face, keys, pivot, material_index: dict, normals: bool) -> dict:
     """Mesh ``face``: the head without eyeballs, skinned to neck/head, one primitive per material, AU targets."""
-    from facsim.registers import RegisterEngine, register_table
-    from facsim.render_geometry import vertex_normals
-    from facsim.render_inputs import REGIONS
+    from facsim.engines.registers import RegisterEngine, register_table
+    from facsim.render.geometry import vertex_normals
+    from facsim.render.inputs import REGIONS
 
     head, topo = face.head, face.head.topology
     engine = face.engine if face.engine_name == "registers" else RegisterEngine(
@@ -395,7 +395,7 @@ def _eye_mesh(b: GlbBuilder, topo, eye_geo, radius: float, material: int, suffix
 
 
 def _animation(b: GlbBuilder, timeline, keys, fps, interpolation: str) -> dict:
-    from facsim.timeline import frame_times, sample_frames
+    from facsim.timeline.sampling import frame_times, sample_frames
 
     times = frame_times(timeline, fps)
     frames = sample_frames(timeline, fps)

@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import write_file
+from facsim.exchange import write_file
 
 #: facsim decimetres → metres.
 METRES = 0.1
@@ -36,7 +36,7 @@ SUFFIXES = (".obj", ".ply")
 
 def deformed_frame(face, expression=None) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
     """Positions (N_geo, 3) in metres, unit normals (N_geo, 3) and the wrinkle (N_geo,) or None."""
-    from facsim.render_geometry import vertex_normals
+    from facsim.render.geometry import vertex_normals
 
     from facsim.face import to_activations
 
@@ -70,7 +70,7 @@ def ply_bytes(positions, normals, triangles, wrinkle=None, *, comments=()) -> by
 
 def obj_text(positions, normals, topology, wrinkle=None) -> str:
     """A comment-free OBJ: vertices (with grey wrinkle colour), skin UVs, normals, a group per region."""
-    from facsim.render_inputs import REGIONS
+    from facsim.render.inputs import REGIONS
 
     out = io.StringIO()
     if wrinkle is None:

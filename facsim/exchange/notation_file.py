@@ -59,7 +59,7 @@ import json
 import re
 from pathlib import Path
 
-from . import ExchangeError, write_file
+from facsim.exchange import ExchangeError, write_file
 
 HEADER = "facsim-notation"
 VERSION = "1"
@@ -105,7 +105,7 @@ def _ends(level: float, easing: str = "linear") -> str:
 
 
 def _timing_text(timing) -> str:
-    from facsim.timeline import Envelope, Hold
+    from facsim.timeline.model import Envelope, Hold
 
     if isinstance(timing, Hold):
         return f"{_num(timing.start)}-{_num(timing.end)}{_ends(timing.intensity)}"
@@ -223,7 +223,7 @@ def _strip_comment(text: str) -> str:
 
 
 def _level(line: _Line, table: str) -> float:
-    from facsim.catalogue import intensity_of
+    from facsim.facs.catalogue import intensity_of
 
     start = line.pos
     letter = re.compile(r"[A-Ea-e](?![A-Za-z0-9])").match(line.text, line.pos)
@@ -241,7 +241,7 @@ def _level(line: _Line, table: str) -> float:
 
 
 def _easing(line: _Line) -> str:
-    from facsim.easing import EASINGS
+    from facsim.timeline.easing import EASINGS
 
     start = line.pos
     name = line.match(_WORD, "an easing name").group()
@@ -251,7 +251,7 @@ def _easing(line: _Line) -> str:
 
 
 def _segments(line: _Line, table: str) -> tuple:
-    from facsim.timeline import Segment, TimelineError
+    from facsim.timeline.model import Segment, TimelineError
 
     segments = []
     line.segment_starts = []                 # where each segment's start point is, for Track's errors
@@ -281,7 +281,7 @@ def _segments(line: _Line, table: str) -> tuple:
 
 
 def _timing(line: _Line, table: str):
-    from facsim.timeline import Envelope, Hold, TimelineError
+    from facsim.timeline.model import Envelope, Hold, TimelineError
 
     start = line.pos
     first = line.number("a timing: START-END, START+ONSET/APEX/OFFSET or TIME:LEVEL>TIME:LEVEL")
@@ -316,7 +316,7 @@ def _timing(line: _Line, table: str):
 
 
 def _track(line: _Line, table: str):
-    from facsim.timeline import Track, TimelineError
+    from facsim.timeline.model import Track, TimelineError
 
     start = line.pos
     source: dict = {}
@@ -354,8 +354,8 @@ def _track(line: _Line, table: str):
 
 
 def _setting_value(line: _Line, key: str, settings: dict):
-    from facsim.catalogue import INTENSITY_TABLES
-    from facsim.timeline import Blinks, TimelineError
+    from facsim.facs.catalogue import INTENSITY_TABLES
+    from facsim.timeline.model import Blinks, TimelineError
 
     start = line.pos
     if key in ("fps", "duration"):
@@ -397,7 +397,7 @@ def loads_notation(text: str):
     NotationFileError
         Naming the line and column and what is wrong.
     """
-    from facsim.timeline import DEFAULT_FPS, DEFAULT_INTENSITIES, Timeline, TimelineError
+    from facsim.timeline.model import DEFAULT_FPS, DEFAULT_INTENSITIES, Timeline, TimelineError
 
     rows = text.splitlines()
     first = next((i for i, row in enumerate(rows) if _strip_comment(row).strip()), None)

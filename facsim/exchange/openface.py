@@ -32,7 +32,7 @@ Conversions
       recorded ones.
 
 Each AU becomes a track of linear segments from frame to frame
-(:func:`facsim.exchange.timeline_from_samples`).
+(:func:`facsim.timeline.builders.timeline_from_samples`).
 """
 from __future__ import annotations
 
@@ -41,7 +41,8 @@ from pathlib import Path
 
 import numpy as np
 
-from . import ExchangeError, csv_number, eye_levels, head_levels, read_csv_rows, require_columns, timeline_from_samples
+from facsim.exchange import ExchangeError, csv_number, eye_levels, head_levels, read_csv_rows, require_columns
+from facsim.timeline.builders import timeline_from_samples
 
 #: Frame rates the measured one is snapped to (within 1 %).
 COMMON_FPS = (15, 24, 25, 30, 48, 50, 60, 90, 100, 120)
@@ -58,7 +59,7 @@ def intensity_levels(values, table: str = "hapfacs") -> np.ndarray:
     >>> intensity_levels([0, 1, 3, 4.5, 7]).tolist()
     [0.0, 0.15, 0.55, 0.925, 1.0]
     """
-    from facsim.catalogue import INTENSITY_TABLES, LETTERS
+    from facsim.facs.catalogue import INTENSITY_TABLES, LETTERS
 
     knots = [0.0] + [INTENSITY_TABLES[table][letter] for letter in LETTERS]
     return np.interp(np.clip(np.asarray(values, float), 0.0, 5.0), np.arange(6.0), knots)

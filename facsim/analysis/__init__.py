@@ -1,0 +1,1 @@
+"""The camera processor (Platt & Badler Fig. 1): images and video of faces → FACS."""

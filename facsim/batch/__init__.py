@@ -1,0 +1,1 @@
+"""Stimulus sets: one spec → many labelled stimuli, on one machine or a Dask cluster."""

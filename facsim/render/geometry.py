@@ -1,0 +1,235 @@
+"""Mesh geometry for rendering, in numpy alone (no GL): normals, regions, lashes, creases.
+
+Pure functions on positions, faces and UVs: area-weighted vertex normals through a
+precomputed sparse face -> vertex matrix (:func:`normal_operator`, :func:`vertex_normals`),
+the connected pieces of a region (:func:`region_components`), lash root-to-tip coordinates
+(:func:`lash_coordinates`), where across a crease each vertex lies (:func:`crease_phase`),
+evenly spread directions for occlusion baking (:func:`sphere_directions`), and the winding
+and UV-coverage checks :class:`~facsim.render.Renderer` makes.
+
+Examples
+--------
+>>> faces = np.array([[0, 1, 2]])
+>>> vertex_normals(np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]]), faces).tolist()
+[[0.0, 0.0, 1.0], [0.0, 0.0, 1.0], [0.0, 0.0, 1.0]]
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import scipy.sparse as sp
+
+from facsim.render.inputs import REGIONS, RenderTopology
+
+
+def normal_operator(faces: np.ndarray, n_vertices: int) -> sp.csr_matrix:
+    """Sparse (n_vertices, M) float32 matrix summing each face's value onto its 3 vertices.
+
+    ``operator @ face_normals`` with unnormalised face normals (cross products, length =
+    twice the area) gives area-weighted vertex normals.
+    """
+    faces = np.asarray(faces, dtype=np.int64)
+    m = len(faces)
+    rows = faces.reshape(-1)
+    cols = np.repeat(np.arange(m), 3)
+    data = np.ones(len(rows), dtype=np.float32)
+    return sp.csr_matrix((data, (rows, cols)), shape=(n_vertices, m), dtype=np.float32)
+
+
+def vertex_normals(positions: np.ndarray, faces: np.ndarray,
+                   operator: sp.csr_matrix | None = None) -> np.ndarray:
+    """Area-weighted unit vertex normals.
+
+    Parameters
+    ----------
+    positions : (N, 3) float
+    faces : (M, 3) int, indices into positions
+    operator : the :func:`normal_operator` of ``faces`` (pass it to avoid rebuilding)
+
+    Returns
+    -------
+    (N, 3) float32; vertices on no face (or only degenerate ones) get (0, 0, 1).
+    """
+    p = np.asarray(positions, dtype=np.float32)
+    if operator is None:
+        operator = normal_operator(faces, len(p))
+    a = p[faces[:, 0]]
+    e1 = p[faces[:, 1]] - a
+    e2 = p[faces[:, 2]] - a
+    fn = np.empty_like(e1)
+    fn[:, 0] = e1[:, 1] * e2[:, 2] - e1[:, 2] * e2[:, 1]
+    fn[:, 1] = e1[:, 2] * e2[:, 0] - e1[:, 0] * e2[:, 2]
+    fn[:, 2] = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+    vn = operator @ fn
+    length = np.sqrt(np.einsum("ij,ij->i", vn, vn))
+    bad = length < 1e-20
+    length[bad] = 1.0
+    vn /= length[:, None]
+    if bad.any():
+        vn[bad] = (0.0, 0.0, 1.0)
+    return vn.astype(np.float32, copy=False)
+
+
+def region_components(topology: RenderTopology, region: str) -> list[np.ndarray]:
+    """Geometry-vertex index arrays of the connected pieces of one region (e.g. each eyeball)."""
+    from scipy.sparse.csgraph import connected_components
+
+    faces = topology.geo_faces[topology.face_regions() == REGIONS.index(region)]
+    if len(faces) == 0:
+        return []
+    verts, local = np.unique(faces, return_inverse=True)
+    local = local.reshape(-1, 3)
+    edges = np.concatenate([local[:, [0, 1]], local[:, [1, 2]], local[:, [2, 0]]])
+    graph = sp.coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])),
+                          shape=(len(verts), len(verts)))
+    n, labels = connected_components(graph, directed=False)
+    return [verts[labels == i] for i in range(n)]
+
+
+def sphere_centre(points: np.ndarray) -> np.ndarray:
+    """Least-squares centre of a sphere through ``points`` (N >= 4, not coplanar)."""
+    p = np.asarray(points, dtype=float)
+    a = np.c_[2.0 * p, np.ones(len(p))]
+    b = np.einsum("ij,ij->i", p, p)
+    sol, *_ = np.linalg.lstsq(a, b, rcond=None)
+    return sol[:3]
+
+
+def lash_coordinates(positions: np.ndarray, eyes: list[np.ndarray],
+                     lashes: list[np.ndarray]) -> np.ndarray:
+    """Root-to-tip coordinate (0 at the lid, 1 at the tip) of every lash vertex.
+
+    Each lash piece is measured from the centre of the nearest eyeball (a sphere fitted to
+    its vertices) and normalised over the piece.
+
+    Returns
+    -------
+    (K,) float32 for ``np.concatenate(lashes)``; zeros when there are no eyeballs.
+    """
+    if not lashes:
+        return np.zeros(0, dtype=np.float32)
+    if not eyes:
+        return np.zeros(sum(len(piece) for piece in lashes), dtype=np.float32)
+    p = np.asarray(positions, dtype=np.float64)
+    centres = np.array([sphere_centre(p[e]) if len(e) >= 4 else p[e].mean(0) for e in eyes])
+    out = []
+    for piece in lashes:
+        q = p[piece]
+        c = centres[np.argmin(np.linalg.norm(centres - q.mean(0), axis=1))]
+        d = np.linalg.norm(q - c, axis=1)
+        span = d.max() - d.min()
+        out.append((d - d.min()) / span if span > 0 else np.zeros_like(d))
+    return np.concatenate(out).astype(np.float32)
+
+
+CREASES_PER_DM = 11.0  # spacing of the creases drawn along a wrinkle field's contours: about 9 mm
+
+
+def crease_phase(positions: np.ndarray, uv: np.ndarray, faces: np.ndarray,
+                 wrinkle: np.ndarray, operator: sp.csr_matrix | None = None) -> np.ndarray:
+    """Where across a crease each vertex lies, in crease spacings, so creases can run along
+    the contours of ``wrinkle`` (for a wrinkle field that comes without its own phase): the
+    distance from the UV centre along the direction in which the wrinkle changes most,
+    times :data:`CREASES_PER_DM`.
+
+    Worked out in UV space, where the face is flat (a 3-D distance would bend the lines
+    over the curved forehead): the direction is the principal axis of the area-weighted
+    structure tensor of the wrinkle's UV gradient around each vertex (sign-free, so it
+    holds on a crease's crest, where the gradient flips), and UV distance is converted to
+    surface distance with the mesh's local UV metric. The origin is fixed, so the lines do
+    not swim as the wrinkle grows.
+
+    Parameters
+    ----------
+    positions : (R, 3) render-vertex positions
+    uv : (R, 2) render-vertex UVs
+    faces : (M, 3) render triangles
+    wrinkle : (R,) render-vertex wrinkle
+    operator : :func:`normal_operator` of ``faces`` (face -> vertex sums)
+
+    Returns
+    -------
+    (R,) float32, unsigned; 0 where the wrinkle is 0 all around or the UVs are degenerate.
+    """
+    p = np.asarray(positions, dtype=np.float64)
+    t = np.asarray(uv, dtype=np.float64)
+    w = np.asarray(wrinkle, dtype=np.float64)
+    faces = np.asarray(faces)
+    phase = np.zeros(len(p), dtype=np.float32)
+    live = np.flatnonzero((w[faces] > 0).any(axis=1))
+    if len(live) == 0:
+        return phase
+    f = faces[live]
+    du1, du2 = t[f[:, 1]] - t[f[:, 0]], t[f[:, 2]] - t[f[:, 0]]
+    det = du1[:, 0] * du2[:, 1] - du2[:, 0] * du1[:, 1]
+    ok = np.abs(det) > 1e-12
+    f, du1, du2, det, live = f[ok], du1[ok], du2[ok], det[ok], live[ok]
+    if len(f) == 0:
+        return phase
+    # Gradients per unit u and v: invert [[du1.u, du2.u], [du1.v, du2.v]] by hand (batched
+    # einsum on 2x2s is slow): d/du = (e1 du2.v - e2 du1.v) / det,
+    # d/dv = (e2 du1.u - e1 du2.u) / det.
+    cu1, cv1 = du1[:, 0] / det, du1[:, 1] / det
+    cu2, cv2 = du2[:, 0] / det, du2[:, 1] / det
+    dw1, dw2 = w[f[:, 1]] - w[f[:, 0]], w[f[:, 2]] - w[f[:, 0]]
+    g = np.stack([dw1 * cv2 - dw2 * cv1, dw2 * cu1 - dw1 * cu2], axis=1)   # dw/d(u, v)
+    e1, e2 = p[f[:, 1]] - p[f[:, 0]], p[f[:, 2]] - p[f[:, 0]]
+    ju = e1 * cv2[:, None] - e2 * cv1[:, None]                            # d(xyz)/du
+    jv = e2 * cu1[:, None] - e1 * cu2[:, None]                            # d(xyz)/dv
+    metric = np.stack([(ju * ju).sum(1), (jv * jv).sum(1), (ju * jv).sum(1)], axis=1)
+    area = 0.5 * np.abs(det)                                      # UV area as the weight
+    rows = np.zeros((len(faces), 7))
+    rows[live] = area[:, None] * np.stack([
+        g[:, 0] ** 2, g[:, 1] ** 2, g[:, 0] * g[:, 1],
+        metric[:, 0], metric[:, 1], metric[:, 2], np.ones(len(f))], axis=1)
+    if operator is None:
+        operator = normal_operator(faces, len(p))
+    acc = operator @ rows
+    verts = np.flatnonzero(acc[:, 0] + acc[:, 1] > 0)
+    a = acc[verts]
+    angle = 0.5 * np.arctan2(2.0 * a[:, 2], a[:, 0] - a[:, 1])  # principal axis of [[a0 a2][a2 a1]]
+    d = np.stack([np.cos(angle), np.sin(angle)], 1)
+    g00, g11, g01 = a[:, 3] / a[:, 6], a[:, 4] / a[:, 6], a[:, 5] / a[:, 6]
+    scale = np.sqrt(np.maximum(d[:, 0] ** 2 * g00 + 2 * d[:, 0] * d[:, 1] * g01
+                               + d[:, 1] ** 2 * g11, 0.0))        # dm per UV unit along d
+    phase[verts] = np.abs(((t[verts] - 0.5) * d).sum(axis=1)) * scale * CREASES_PER_DM
+    return phase
+
+
+def sphere_directions(n: int) -> np.ndarray:
+    """(n, 3) unit vectors spread evenly over the sphere (Fibonacci lattice)."""
+    i = np.arange(n) + 0.5
+    z = 1.0 - 2.0 * i / n
+    phi = i * math.pi * (3.0 - math.sqrt(5.0))
+    r = np.sqrt(1.0 - z * z)
+    return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)
+
+
+def _orientation(p: np.ndarray, faces: np.ndarray) -> float:
+    """> 0 when the triangles' winding normals point away from their centroid (outward)."""
+    a, b, c = p[faces[:, 0]], p[faces[:, 1]], p[faces[:, 2]]
+    normals = np.cross(b - a, c - a)
+    centres = (a + b + c) / 3.0
+    area = np.linalg.norm(normals, axis=1)
+    centroid = (centres * area[:, None]).sum(0) / max(area.sum(), 1e-30)
+    return float(np.einsum("ij,ij->", centres - centroid, normals))
+
+
+def _faces_touching(face_uv: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """(M,) whether each triangle's UV bounding box covers any set texel of ``mask``.
+
+    ``mask`` is (H, W) in GL row order (row 0 = v = 0); a summed-area table answers each
+    box in four look-ups. Conservative: a box may hold set texels the triangle misses.
+    """
+    h, w = mask.shape
+    sat = np.zeros((h + 1, w + 1), dtype=np.int64)
+    sat[1:, 1:] = np.cumsum(np.cumsum(mask, axis=0), axis=1)
+    lo = face_uv.min(axis=1)
+    hi = face_uv.max(axis=1)
+    c0 = np.clip(np.floor(lo[:, 0] * w).astype(np.int64) - 1, 0, w)
+    c1 = np.clip(np.ceil(hi[:, 0] * w).astype(np.int64) + 1, 0, w)
+    r0 = np.clip(np.floor(lo[:, 1] * h).astype(np.int64) - 1, 0, h)
+    r1 = np.clip(np.ceil(hi[:, 1] * h).astype(np.int64) + 1, 0, h)
+    count = sat[r1, c1] - sat[r0, c1] - sat[r1, c0] + sat[r0, c0]
+    return count > 0

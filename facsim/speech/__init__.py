@@ -1,0 +1,1 @@
+"""Speaking characters: text or recorded speech → phones → visemes → AUs."""

@@ -1,0 +1,1 @@
+"""facsim studio: the browser workbench (a web server and one page)."""

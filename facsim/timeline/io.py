@@ -1,0 +1,386 @@
+"""Timeline files and plain data: YAML/JSON text <-> dict <-> :class:`~facsim.timeline.Timeline`.
+
+The file format itself (fields, timings, intensities) is described in
+:mod:`facsim.timeline.model`, whose data types this module builds and takes apart.
+Here live the ways in and out:
+
+* :func:`timeline_from_dict` / :func:`timeline_to_dict`: parsed YAML/JSON
+  (plain dicts and lists) to a :class:`~facsim.timeline.Timeline` and back,
+  equal after the round trip;
+* :func:`load_timeline` / :func:`save_timeline`: ``.yaml``/``.yml`` and
+  ``.json`` files, by suffix, written atomically;
+* :func:`timeline_schema`: the JSON Schema (``facsim/data/timeline.schema.json``,
+  draft 2020-12) every dict is checked against first.
+
+Whatever goes wrong (a schema violation, malformed YAML or JSON, a value the
+data types refuse) comes out as one :class:`~facsim.timeline.TimelineError`
+naming the file, the line where known, the field path and what is wrong.
+
+Examples
+--------
+>>> tl = timeline_from_dict({"tracks": [{"au": 12, "start": 0, "end": 1}]})
+>>> timeline_to_dict(tl)["tracks"]
+[{'au': 12, 'side': 'both', 'start': 0, 'end': 1, 'intensity': 1}]
+"""
+from __future__ import annotations
+
+import difflib
+import json
+import os
+from functools import lru_cache
+from importlib import resources
+from pathlib import Path
+from typing import Any, Mapping, Sequence
+
+from facsim.atomic import atomic_write
+from facsim.timeline.model import ENVELOPE_KEYS, SIDE_ONLY_FOR_AU, TABLE_ONLY_FOR_EMOTION, DEFAULT_FPS, DEFAULT_INTENSITIES, Blinks, Envelope, Hold, Segment, Timeline, TimelineError, Timing, Track, intensities_table, parse_level, source_problem
+
+SCHEMA_FILE = "timeline.schema.json"
+_SUFFIXES = {".yaml": "yaml", ".yml": "yaml", ".json": "json"}
+
+
+# --------------------------------------------------------- dict <-> data ---
+
+@lru_cache(maxsize=1)
+def _schema_text() -> str:
+    return resources.files("facsim").joinpath("data", SCHEMA_FILE).read_text(encoding="utf-8")
+
+
+def timeline_schema() -> dict:
+    """The timeline JSON Schema (draft 2020-12), as a fresh dict.
+
+    Examples
+    --------
+    >>> timeline_schema()["$schema"]
+    'https://json-schema.org/draft/2020-12/schema'
+    """
+    return json.loads(_schema_text())
+
+
+@lru_cache(maxsize=1)
+def _validator():
+    from jsonschema import Draft202012Validator
+
+    schema = timeline_schema()
+    Draft202012Validator.check_schema(schema)
+    return Draft202012Validator(schema)
+
+
+_TYPE_NAMES = {"number": "a number", "integer": "an integer", "string": "a string", "object": "a mapping",
+               "array": "a list", "boolean": "true or false"}
+
+
+def _timing_problem(track: Mapping) -> str:
+    keys = set(track)
+    envelope = keys & set(ENVELOPE_KEYS)
+    if "segments" in keys:
+        extra = sorted(keys & {"start", "end", "onset", "apex", "offset", "intensity", "easing"})
+        return (f"'segments' gives the whole timing; drop {', '.join(map(repr, extra))} "
+                "(each segment has its own start, end and easing)")
+    if envelope and "end" in keys:
+        return "give either 'end' (a constant hold) or an envelope ('onset', 'apex', 'offset'), not both"
+    if envelope:
+        missing = [k for k in ENVELOPE_KEYS if k not in keys]
+        return f"an envelope needs 'onset', 'apex' and 'offset'; missing {', '.join(map(repr, missing))} " \
+               "(0 is allowed)"
+    if "end" in keys and "easing" in keys:
+        return "'easing' has no effect on a constant hold ('start' to 'end'); use an envelope or segments"
+    return ("no timing: give 'segments', an envelope ('start', 'onset', 'apex', 'offset') "
+            "or 'start' and 'end' for a constant hold")
+
+
+def _source_problem_in(track: Mapping) -> str:
+    given = [k for k in ("au", "emotion", "facs") if k in track]
+    if len(given) != 1:
+        return source_problem(given)
+    if "side" in track and "au" not in track:
+        return SIDE_ONLY_FOR_AU
+    return TABLE_ONLY_FOR_EMOTION
+
+
+def _intensity_problem(value: Any) -> str:
+    try:
+        parse_level(value, "intensity", DEFAULT_INTENSITIES)
+    except TimelineError as exc:
+        return exc.problem
+    return f"expected an intensity (a fraction 0..1, a percentage or a letter A-E), got {value!r}"
+
+
+def _schema_problem(error) -> tuple[tuple, str]:
+    """Turn one jsonschema error into (field path, problem)."""
+    location = tuple(error.absolute_path)
+    schema = error.schema if isinstance(error.schema, dict) else {}
+    marker, kind, value = schema.get("x-facsim"), error.validator, error.validator_value
+    instance = error.instance
+    name = next((k for k in reversed(location) if isinstance(k, str)), "value")
+    if marker == "intensity":
+        return location, _intensity_problem(instance)
+    if marker == "track-timing":
+        return location, _timing_problem(instance)
+    if marker == "track-source" or "dependentSchemas" in error.schema_path:
+        return location, _source_problem_in(instance)
+    if kind == "additionalProperties":
+        allowed = list(schema.get("properties", {}))
+        extra = sorted(k for k in instance if k not in allowed)[0]
+        close = difflib.get_close_matches(str(extra), allowed, n=1)
+        hint = f"; did you mean {close[0]!r}?" if close else f"; known fields are {', '.join(allowed)}"
+        return location, f"unknown field {extra!r}{hint}"
+    if kind == "required":
+        missing = [k for k in value if k not in instance]
+        return location, f"missing field {missing[0]!r}"
+    if kind == "type":
+        expected = " or ".join(_TYPE_NAMES.get(t, t) for t in ([value] if isinstance(value, str) else value))
+        return location, f"expected {expected}, got {instance!r}"
+    if kind == "enum":
+        return location, f"unknown {name} {instance!r}; choose one of {', '.join(map(str, value))}"
+    if kind == "minimum" and name in ("start", "end", "onset", "apex", "offset"):
+        return location, (f"negative time {instance:g} s; times are seconds from the start of the video "
+                          "and must be >= 0")
+    if kind in ("minimum", "exclusiveMinimum", "maximum", "exclusiveMaximum"):
+        sign = {"minimum": ">=", "exclusiveMinimum": ">", "maximum": "<=", "exclusiveMaximum": "<"}[kind]
+        return location, f"must be {sign} {value:g}, got {instance!r}"
+    if kind in ("minItems", "minLength"):
+        return location, "must not be empty"
+    return location, error.message
+
+
+def _location_key(location: tuple) -> tuple:
+    return tuple((0, k, "") if isinstance(k, int) else (1, 0, str(k)) for k in location)
+
+
+_FIRST = {"additionalProperties": 0, "type": 1}
+
+
+def _check_schema(data: Any) -> None:
+    errors = list(_validator().iter_errors(data))
+    if not errors:
+        return
+    first = min(errors, key=lambda e: (_location_key(tuple(e.absolute_path)), _FIRST.get(e.validator, 2)))
+    location, problem = _schema_problem(first)
+    raise TimelineError(problem, location=location)
+
+
+def _segments_from(items: Sequence[Mapping], table: str) -> tuple[Segment, ...]:
+    segments, previous = [], 0.0
+    for j, item in enumerate(items):
+        try:
+            start_level = parse_level(item["from"], "from", table) if "from" in item else previous
+            seg = Segment(item["start"], item["end"], start_level, parse_level(item["to"], "to", table),
+                          item.get("easing", "linear"))
+        except TimelineError as exc:
+            raise exc.within("segments", j) from None
+        segments.append(seg)
+        previous = seg.to
+    return tuple(segments)
+
+
+def _track_from_dict(data: Mapping, table: str) -> Track:
+    if "segments" in data:
+        timing = _segments_from(data["segments"], table)
+    else:
+        intensity = parse_level(data.get("intensity", 1.0), "intensity", table)
+        if all(k in data for k in ENVELOPE_KEYS) and "end" not in data:
+            timing = Envelope(data.get("start", 0.0), data["onset"], data["apex"], data["offset"], intensity,
+                              data.get("easing", "linear"))
+        elif "end" in data and not any(k in data for k in (*ENVELOPE_KEYS, "easing")):
+            timing = Hold(data.get("start", 0.0), data["end"], intensity)
+        else:
+            raise TimelineError(_timing_problem(data))
+    return Track(au=data.get("au"), side=data.get("side", "both"), facs=data.get("facs"),
+                 emotion=data.get("emotion"), table=data.get("table"), timing=timing)
+
+
+def timeline_from_dict(data: Mapping) -> Timeline:
+    """Build a :class:`Timeline` from parsed YAML/JSON (see the module docstring).
+
+    Raises
+    ------
+    TimelineError
+        Naming the field path and what is wrong (schema violations, unknown
+        codes or emotions, reversed or overlapping times...).
+
+    Examples
+    --------
+    >>> tl = timeline_from_dict({"tracks": [{"au": 12, "start": 0, "end": 1, "intensity": "C"}]})
+    >>> tl.tracks[0].timing
+    Hold(start=0.0, end=1.0, intensity=0.55)
+    >>> timeline_from_dict({"tracks": [{"au": 12, "segments": [{"start": 1.4, "end": 0.2, "to": 1}]}]})
+    Traceback (most recent call last):
+    ...
+    facsim.timeline.model.TimelineError: tracks[0].segments[0].end: must be after start (1.4 s), got 0.2 s
+    """
+    if not isinstance(data, Mapping):
+        what = "nothing (the file is empty)" if data is None else type(data).__name__
+        raise TimelineError(f"expected a mapping with 'tracks' at the top level, got {what}")
+    _check_schema(data)
+    table = data.get("intensities", DEFAULT_INTENSITIES)
+    intensities_table(table)
+    blinks = None
+    if "blinks" in data:
+        try:
+            blinks = Blinks(**data["blinks"])
+        except TimelineError as exc:
+            raise exc.within("blinks") from None
+    tracks = []
+    for i, item in enumerate(data.get("tracks", [])):
+        try:
+            tracks.append(_track_from_dict(item, table))
+        except TimelineError as exc:
+            raise exc.within("tracks", i) from None
+    return Timeline(tuple(tracks), duration=data.get("duration"), fps=data.get("fps", DEFAULT_FPS),
+                    character=data.get("character"), engine=data.get("engine"), blinks=blinks,
+                    intensities=table, description=data.get("description"))
+
+
+def _number(value: float) -> float | int:
+    """Integral floats as ints, for tidy files (``30`` rather than ``30.0``)."""
+    return int(value) if float(value).is_integer() else float(value)
+
+
+def _timing_to_dict(timing: Timing) -> dict:
+    if isinstance(timing, Envelope):
+        return {"start": _number(timing.start), "onset": _number(timing.onset), "apex": _number(timing.apex),
+                "offset": _number(timing.offset), "intensity": _number(timing.intensity),
+                "easing": timing.easing}
+    if isinstance(timing, Hold):
+        return {"start": _number(timing.start), "end": _number(timing.end),
+                "intensity": _number(timing.intensity)}
+    return {"segments": [{"start": _number(s.start), "end": _number(s.end), "from": _number(s.from_),
+                          "to": _number(s.to), "easing": s.easing} for s in timing]}
+
+
+def timeline_to_dict(timeline: Timeline) -> dict:
+    """The timeline as plain data for YAML/JSON; :func:`timeline_from_dict` reads it back equal.
+
+    Intensities are written as fractions (letters read from a file become
+    numbers); unset optional fields are left out.
+
+    Examples
+    --------
+    >>> tl = Timeline.from_facs("12C", end=1.0)
+    >>> timeline_to_dict(tl)["tracks"]
+    [{'facs': '12C', 'start': 0, 'end': 1, 'intensity': 1}]
+    >>> timeline_from_dict(timeline_to_dict(tl)) == tl
+    True
+    """
+    out: dict[str, Any] = {}
+    if timeline.description is not None:
+        out["description"] = timeline.description
+    if timeline.duration is not None:
+        out["duration"] = _number(timeline.duration)
+    out["fps"] = _number(timeline.fps)
+    for name in ("character", "engine"):
+        if getattr(timeline, name) is not None:
+            out[name] = getattr(timeline, name)
+    out["intensities"] = timeline.intensities
+    if timeline.blinks is not None:
+        b = timeline.blinks
+        out["blinks"] = {"rate_per_minute": _number(b.rate_per_minute), "duration": _number(b.duration),
+                         "seed": b.seed, "min_interval": _number(b.min_interval)}
+    tracks = []
+    for track in timeline.tracks:
+        item: dict[str, Any] = {}
+        if track.au is not None:
+            item["au"] = track.au
+            item["side"] = track.side
+        elif track.facs is not None:
+            item["facs"] = track.facs
+        else:
+            item["emotion"] = track.emotion
+            if track.table is not None:
+                item["table"] = track.table
+        item.update(_timing_to_dict(track.timing))
+        tracks.append(item)
+    out["tracks"] = tracks
+    return out
+
+
+# ------------------------------------------------------------------ files ---
+
+def _format_of(path: Path) -> str:
+    try:
+        return _SUFFIXES[path.suffix.lower()]
+    except KeyError:
+        raise TimelineError(f"unsupported file type {path.suffix or '(none)'!r}; use .yaml, .yml or .json",
+                            file=path) from None
+
+
+def _yaml_line(text: str, location: Sequence[str | int]) -> int | None:
+    """1-based line of the YAML node at ``location`` (or its nearest parent)."""
+    import yaml
+
+    try:
+        node = yaml.compose(text, Loader=yaml.SafeLoader)
+    except yaml.YAMLError:
+        return None
+    line = None
+    for key in location:
+        if node is None:
+            break
+        line = node.start_mark.line + 1
+        if isinstance(node, yaml.MappingNode):
+            node = next((v for k, v in node.value if k.value == key), None)
+        elif isinstance(node, yaml.SequenceNode) and isinstance(key, int) and key < len(node.value):
+            node = node.value[key]
+        else:
+            node = None
+    if node is not None:
+        line = node.start_mark.line + 1
+    return line
+
+
+def load_timeline(path: str | os.PathLike) -> Timeline:
+    """Read a timeline from ``.yaml``/``.yml`` or ``.json`` (by suffix).
+
+    Raises
+    ------
+    TimelineError
+        One line naming the file, the line where known, the field path and
+        what is wrong (malformed YAML/JSON included).
+    FileNotFoundError
+        If there is no such file.
+    """
+    import yaml
+
+    path = Path(path)
+    kind = _format_of(path)
+    text = path.read_text(encoding="utf-8")
+    if kind == "yaml":
+        try:
+            data = yaml.safe_load(text)
+        except yaml.YAMLError as exc:
+            mark = getattr(exc, "problem_mark", None)
+            problem = " ".join(str(getattr(exc, "problem", None) or exc).split())
+            raise TimelineError(f"malformed YAML: {problem}", file=path,
+                                line=None if mark is None else mark.line + 1) from None
+    else:
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise TimelineError(f"malformed JSON: {exc.msg} (column {exc.colno})", file=path,
+                                line=exc.lineno) from None
+    try:
+        return timeline_from_dict(data)
+    except TimelineError as exc:
+        line = _yaml_line(text, exc.location) if kind == "yaml" and exc.location else None
+        raise exc.in_file(path, line) from None
+
+
+def save_timeline(timeline: Timeline, path: str | os.PathLike) -> Path:
+    """Write a timeline as YAML or JSON (by suffix), atomically; returns the path.
+
+    :func:`load_timeline` reads it back equal to ``timeline``.
+    """
+    import yaml
+
+    path = Path(path)
+    kind = _format_of(path)
+    data = timeline_to_dict(timeline)
+    if kind == "yaml":
+        text = yaml.safe_dump(data, sort_keys=False, default_flow_style=None, allow_unicode=True, width=100)
+    else:
+        text = json.dumps(data, indent=2, ensure_ascii=False) + "\n"
+    return atomic_write(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
+
+
+__all__ = ["load_timeline", "save_timeline", "timeline_from_dict", "timeline_schema", "timeline_to_dict"]

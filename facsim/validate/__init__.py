@@ -1,0 +1,1 @@
+"""The closed loop: render known expressions, read them back, report per AU."""
