@@ -7,7 +7,7 @@ Run::
 Prints, for the full head (every skin point of the net, ~4.5k points with the
 muscle points): the model's build time, the animation path's time per frame
 (``engine.step``: one frame applies the change since the previous frame, as
-Platt & Badler's simulator does), the static solve's time (``engine(act)``: an
+Platt & Badler's simulator does), the static solve's time (``engine.deform(act)``: an
 expression from rest in n increments), and the register engine's evaluation
 time for the same activations, measured in the same run — medians of several
 runs, and their ratios.
@@ -68,12 +68,12 @@ def main(argv=None) -> None:
             engine.step(act)
 
     per_frame = _median_time(animate, args.repeats) / len(frames)
-    reg_frame = _median_time(lambda: [registers(a) for a in frames], args.repeats) / len(frames)
-    static = _median_time(lambda: engine(target), args.repeats)
-    reg_static = _median_time(lambda: registers(target), max(args.repeats, 20))
+    reg_frame = _median_time(lambda: [registers.deform(a) for a in frames], args.repeats) / len(frames)
+    static = _median_time(lambda: engine.deform(target), args.repeats)
+    reg_static = _median_time(lambda: registers.deform(target), max(args.repeats, 20))
     points = engine.model.count
-    engine(target)
-    skin = engine.last_state.points(0)[: engine.model.net.count]
+    _, state, index = next(engine.static_states([target]))
+    skin = state.points(index)[: engine.model.net.count]
     wrinkles = _median_time(lambda: wrinkle_field(engine.wrinkles, skin), max(args.repeats, 10))
 
     print(f"muscle engine, {args.character}: {points} points ({engine.model.net.count} skin), "
@@ -81,7 +81,7 @@ def main(argv=None) -> None:
     print(f"  model build (net, muscles, factorisation):  {build * 1e3:8.1f} ms")
     print(f"  animation, per frame (engine.step):         {per_frame * 1e3:8.2f} ms   "
           f"register engine {reg_frame * 1e3:.2f} ms   ratio {per_frame / reg_frame:6.1f}x")
-    print(f"  static expression from rest (engine(act)):  {static * 1e3:8.1f} ms   "
+    print(f"  static expression from rest (engine.deform):  {static * 1e3:8.1f} ms   "
           f"register engine {reg_static * 1e3:.2f} ms   ratio {static / reg_static:6.1f}x")
     print(f"  wrinkle field of a frame (for the renderer): {wrinkles * 1e3:8.2f} ms")
     print(f"  medians of {args.repeats} runs; {len(frames)} frames of '1+2+6+12' coming on over {ramp}")

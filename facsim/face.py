@@ -9,16 +9,17 @@ Examples
 from __future__ import annotations
 
 from functools import cached_property, lru_cache
-from typing import NamedTuple
 
 import numpy as np
 
+from facsim.engines import DEFAULT_ENGINE, engine_class
+from facsim.engines.base import Deformation, Engine
+from facsim.facs.activations import Activations, activations
 from facsim.head.assets import load_face_data
 from facsim.head.character import Character, resolve_character
-from facsim.facs.activations import Activations, activations
 from facsim.head.mesh import HeadModel, build_head
+from facsim.render.options import RenderOptions
 
-ENGINES = ("registers", "muscle")
 #: Framing uses the skin above this height below the chin (dm), so a portrait
 #: shows the whole head with a little neck, the same in every frame.
 NECK_SHOWN = 0.45
@@ -30,19 +31,6 @@ OCCLUSION_VERSION = 1
 def load_head() -> HeadModel:
     """The head model, built once per process from the cached face data."""
     return build_head(load_face_data())
-
-
-def engine_class(name: str):
-    """The deformation engine class called ``name`` (imported lazily)."""
-    if name == "registers":
-        from facsim.engines.registers import RegisterEngine
-
-        return RegisterEngine
-    if name == "muscle":
-        from facsim.engines.muscle import MuscleEngine
-
-        return MuscleEngine
-    raise ValueError(f"unknown engine {name!r}; choose from {', '.join(ENGINES)}")
 
 
 def to_activations(expression, *, intensities: str = "hapfacs") -> Activations:
@@ -66,13 +54,21 @@ class Face:
     character : str, mapping or Character
         A preset name (``facsim characters``), ``"random:SEED"``, or parameters.
     engine : {"registers", "muscle"}
-        How AUs move the face: HapFACS-style morph targets, or the muscle engine.
+        How AUs move the face: HapFACS-style morph targets, or the muscle engine
+        (see :data:`facsim.engines.ENGINES`).
+    intensities : {"hapfacs", "facshuman"}
+        What the letters A–E of FACS strings given to this face mean.
     """
 
-    def __init__(self, character="ava", *, engine: str = "registers"):
+    def __init__(self, character="ava", *, engine: str = DEFAULT_ENGINE, intensities: str = "hapfacs"):
+        from facsim.facs.catalogue import INTENSITY_TABLES
+
+        if intensities not in INTENSITY_TABLES:
+            raise ValueError(f"intensities must be one of {', '.join(INTENSITY_TABLES)}, got {intensities!r}")
         self.character: Character = resolve_character(character)
         self.head = load_head()
         self.engine_name = engine
+        self.intensities = intensities
         self._engine_class = engine_class(engine)
         self._renderers: dict = {}
 
@@ -83,13 +79,13 @@ class Face:
     @cached_property
     def base_positions(self) -> np.ndarray:
         """The character's neutral base mesh (19158, 3)."""
-        from facsim.head.character import character_offsets
+        from facsim.head.character import character_positions
 
-        return character_offsets(self.character, self.data)
+        return character_positions(self.character, self.data)
 
     @cached_property
-    def engine(self):
-        """The engine: a callable ``activations -> geometry positions``."""
+    def engine(self) -> Engine:
+        """The deformation engine, built once for this character."""
         return self._engine_class(self.head, self.data, self.character, self.base_positions)
 
     @cached_property
@@ -112,8 +108,8 @@ class Face:
         """
         import hashlib
 
-        from facsim.head.assets import cache_dir
         from facsim.atomic import atomic_write
+        from facsim.head.assets import cache_dir
         from facsim.render.occlusion import bake_occlusion
 
         key = hashlib.sha256(repr((OCCLUSION_VERSION, self.character.with_(name="", description="", colors={})))
@@ -128,14 +124,19 @@ class Face:
         atomic_write(path, lambda tmp: tmp.write_bytes(_npy_bytes(occlusion)))
         return occlusion
 
-    def deform(self, expression=None) -> np.ndarray:
-        """Geometry positions (N_geo, 3) showing ``expression`` (FACS string, Expression or Activations)."""
-        act = to_activations(expression)
-        return self.engine(act) if act else self.neutral
+    def activations(self, expression=None) -> Activations:
+        """Activations from a FACS string (read with this face's ``intensities``), an Expression or Activations."""
+        return to_activations(expression, intensities=self.intensities)
+
+    def deform(self, expression=None) -> Deformation:
+        """The face showing ``expression`` (FACS string, Expression or Activations), reached from neutral."""
+        act = self.activations(expression)
+        return self.engine.deform(act) if act else Deformation(self.neutral)
 
     def camera(self, *, view: str = "front", yaw=None, pitch=None, projection="perspective", size=(512, 512), fov_deg=None):
         """A camera framing this character's neutral head and upper neck (the same for every frame)."""
-        return self._camera(view, yaw, pitch, projection, tuple(size), fov_deg)
+        options = RenderOptions(view=view, yaw=yaw, pitch=pitch, projection=projection, size=size)
+        return self._camera(options.view, options.yaw, options.pitch, options.projection, options.size, fov_deg)
 
     @lru_cache(maxsize=16)  # noqa: B019 — a Face lives as long as its renders
     def _camera(self, view, yaw, pitch, projection, size, fov_deg):
@@ -148,48 +149,44 @@ class Face:
         return frame_points(skin[keep], view=view, yaw=yaw, pitch=pitch, projection=projection,
                             fov_deg=fov_deg or DEFAULT_FOV_DEG, margin=0.06, aspect=width / height)
 
-    def renderer(self, size=(512, 512), *, antialias=4, background=(1.0, 1.0, 1.0)):
-        """A renderer for this head (cached per size, anti-aliasing and background).
-
-        ``antialias``: MSAA samples (1 = off, 4 = llvmpipe's best) or ``"fxaa"``
-        (post-process edge smoothing at about the cost of no AA).
-        """
+    def renderer(self, options: RenderOptions | None = None, **option_values):
+        """A renderer for this head (cached per size, anti-aliasing and background)."""
         from facsim.render.renderer import Renderer
 
-        key = (tuple(size), antialias, None if background is None else tuple(background))
+        options = _options(options, option_values)
+        key = (options.size, options.antialias, options.background)
         if key not in self._renderers:
-            method = "fxaa" if antialias == "fxaa" else "msaa"
-            self._renderers[key] = Renderer(self.head.topology, size=tuple(size), background=background,
-                                            antialias=1 if method == "fxaa" else int(antialias), aa_method=method)
+            self._renderers[key] = Renderer(self.head.topology, size=options.size, background=options.background,
+                                            **options.renderer_settings())
         return self._renderers[key]
 
-    def render(self, expression=None, *, view: str = "front", yaw=None, pitch=None, size=512,
-               projection: str = "perspective", background=(1.0, 1.0, 1.0), antialias=4,
-               positions=None, wrinkle=None, crease_phase=None) -> np.ndarray:
+    def render(self, expression=None, *, options: RenderOptions | None = None, deformation: Deformation | None = None,
+               positions=None, wrinkle=None, crease_phase=None, **option_values) -> np.ndarray:
         """Render ``expression`` to an (H, W, 4) uint8 RGBA image.
 
-        ``background=None`` gives a transparent background. ``positions`` renders
-        given geometry instead of deforming (e.g. from another engine), with its
-        ``wrinkle`` and ``crease_phase`` if it has them (see :meth:`Renderer.render`).
+        Options are a :class:`RenderOptions` or its fields as keywords (view,
+        yaw, pitch, size, projection, background — None for transparent —,
+        antialias). ``deformation`` renders a given :class:`Deformation` (e.g.
+        an animation frame) instead of deforming; ``positions`` (with its
+        ``wrinkle`` and ``crease_phase``) renders raw geometry.
         """
-        size = _size_pair(size)
-        if positions is None:
-            act = to_activations(expression)
-            positions = self.engine(act) if act else self.neutral
-            if wrinkle is None and act:  # the neutral face has no creases
-                wrinkle = getattr(self.engine, "last_wrinkle", None)
-                crease_phase = getattr(self.engine, "last_crease_phase", None)
-        camera = self.camera(view=view, yaw=yaw, pitch=pitch, projection=projection, size=size)
-        return self.renderer(size, antialias=antialias, background=background).render(
-            np.asarray(positions, np.float32), appearance=self.appearance, camera=camera, wrinkle=wrinkle,
-            crease_phase=crease_phase, occlusion=self.occlusion,
+        options = _options(options, option_values)
+        if positions is not None:
+            deformation = Deformation(np.asarray(positions, np.float32),
+                                      creases=None if wrinkle is None else (lambda: (wrinkle, crease_phase)))
+        elif deformation is None:
+            deformation = self.deform(expression)
+        camera = self.camera(view=options.view, yaw=options.yaw, pitch=options.pitch, projection=options.projection,
+                             size=options.size)
+        return self.renderer(options).render(
+            np.asarray(deformation.positions, np.float32), appearance=self.appearance, camera=camera,
+            wrinkle=deformation.wrinkle, crease_phase=deformation.crease_phase, occlusion=self.occlusion,
         )
 
-    def start_animation(self) -> "Animation":
-        """A frame stepper for videos (engines with state apply only each frame's change)."""
-        if hasattr(self.engine, "reset"):
-            self.engine.reset()
-        return Animation(self.engine)
+    def start_animation(self) -> Engine:
+        """The engine, back at the neutral face: call ``.step(activations)`` per frame for :class:`Deformation` s."""
+        self.engine.reset()
+        return self.engine
 
     def save(self, path, expression=None, **render_options) -> np.ndarray:
         """Render and write a PNG atomically; returns the image."""
@@ -211,39 +208,16 @@ class Face:
         self.close()
 
 
+def _options(options: RenderOptions | None, values: dict) -> RenderOptions:
+    """One RenderOptions from an object and/or keyword values (keywords override)."""
+    if options is None:
+        return RenderOptions(**values)
+    return options.replace(**values) if values else options
+
+
 def _npy_bytes(array: np.ndarray) -> bytes:
     import io
 
     buf = io.BytesIO()
     np.save(buf, array)
     return buf.getvalue()
-
-
-class Frame(NamedTuple):
-    """One deformed frame: what :meth:`Face.render` takes as ``**frame._asdict()``."""
-
-    positions: np.ndarray
-    wrinkle: np.ndarray | None = None        # skin compression (muscle engine)
-    crease_phase: np.ndarray | None = None   # where across its furrows each vertex lies
-
-
-class Animation:
-    """Steps an engine frame by frame: ``frame = animation.step(activations)``, a :class:`Frame`."""
-
-    def __init__(self, engine):
-        self.engine = engine
-        self._stateful = hasattr(engine, "step")
-
-    def step(self, act: Activations) -> Frame:
-        positions = self.engine.step(act) if self._stateful else self.engine(act)
-        return Frame(positions, getattr(self.engine, "last_wrinkle", None),
-                     getattr(self.engine, "last_crease_phase", None))
-
-
-def _size_pair(size) -> tuple[int, int]:
-    if isinstance(size, (int, np.integer)):
-        size = (int(size), int(size))
-    width, height = (int(v) for v in size)
-    if not (16 <= width <= 8192 and 16 <= height <= 8192):
-        raise ValueError(f"image size must be between 16 and 8192 pixels per side, got {width}x{height}")
-    return width, height

@@ -62,9 +62,9 @@ def animate(timeline, path, *, face=None, character=None, engine=None, fps: floa
     frames = sample_frames(timeline, fps)
     try:
         with VideoWriter(path, fps, audio=audio) as writer:
-            state = face.start_animation()
+            engine = face.start_animation()
             for i, act in enumerate(frames):
-                writer.append(face.render(**state.step(act)._asdict(), **render_options))
+                writer.append(face.render(deformation=engine.step(act), **render_options))
                 if on_frame is not None:
                     on_frame(i + 1, len(frames))
         return writer.path

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from facsim.head.assets import load_face_data
-from facsim.head.character import (Character, CharacterError, character_offsets, macro_weights, preset,
+from facsim.head.character import (Character, CharacterError, character_positions, macro_weights, preset,
                               preset_names, random_character, resolve_character)
 
 
@@ -28,13 +28,13 @@ def test_presets_cover_sex_ethnicity_and_age():
 
 @pytest.mark.parametrize("name", preset_names())
 def test_every_preset_builds(name, head):
-    base = character_offsets(preset(name), load_face_data())
+    base = character_positions(preset(name), load_face_data())
     p = head.positions(base)
     assert np.isfinite(p).all() and p.shape == (head.vertex_count, 3)
 
 
 def _marks_positions(character, head, marks):
-    return head.positions(character_offsets(character, load_face_data()))
+    return head.positions(character_positions(character, load_face_data()))
 
 
 def test_older_characters_have_deeper_nasolabial_folds(head, marks):
@@ -54,8 +54,8 @@ def test_men_have_wider_jaws(head, marks):
 
 def test_face_sliders_move_their_region(head, marks):
     data = load_face_data()
-    a = head.positions(character_offsets(Character(), data))
-    b = head.positions(character_offsets(Character(face={"nose/nose-scale-horiz": 1.0}), data))
+    a = head.positions(character_positions(Character(), data))
+    b = head.positions(character_positions(Character(face={"nose/nose-scale-horiz": 1.0}), data))
     moved = np.linalg.norm(a - b, axis=1)
     assert moved[marks["nose_wing_left"]] > 0.01 and moved[marks["inner_brow_left"]] < 1e-3
 
@@ -78,4 +78,4 @@ def test_random_characters_are_reproducible():
 def test_bad_characters_are_refused(spec, message):
     with pytest.raises(CharacterError, match=message):
         c = resolve_character(spec)
-        character_offsets(c, load_face_data())
+        character_positions(c, load_face_data())

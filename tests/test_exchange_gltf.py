@@ -135,7 +135,7 @@ def test_a_morph_target_is_the_register_engine_at_that_au_minus_neutral(face, an
     base = accessor(doc, blob, primitive["attributes"]["POSITION"])
     delta = accessor(doc, blob, primitive["targets"][names.index("AU12_L")]["POSITION"])
     geo = _head_geometry_vertices(face)
-    expected = np.asarray(face.engine(Activations({(12, "left"): 1.0})), float)[geo] * METRES
+    expected = np.asarray(face.engine.deform(Activations({(12, "left"): 1.0})).positions, float)[geo] * METRES
     assert np.abs(base + delta - expected).max() < 1e-6
     assert np.abs(base - np.asarray(face.neutral, float)[geo] * METRES).max() < 1e-6
 
@@ -191,7 +191,7 @@ def test_skin_follows_the_engines_neck_blend(face, animated):
     base = accessor(doc, blob, primitive["attributes"]["POSITION"]).astype(float)
     turned = Rotation.from_rotvec([0, np.radians(35), 0]).apply(base - pivot) + pivot
     skinned = weights[:, :1] * base + weights[:, 1:2] * turned
-    expected = np.asarray(face.engine(act), float)[_head_geometry_vertices(face)] * METRES
+    expected = np.asarray(face.engine.deform(act).positions, float)[_head_geometry_vertices(face)] * METRES
     rigid = (weights[:, 1] > 1 - 1e-6) | (weights[:, 1] < 1e-6)
     assert rigid.mean() > 0.8 and np.abs(skinned[rigid] - expected[rigid]).max() < 1e-5
 
@@ -219,7 +219,7 @@ def test_eyes_are_separate_nodes_at_the_eye_centres(face, animated):
 
 
 def _head_geometry_vertices(face):
-    from facsim.render.renderer import REGIONS
+    from facsim.head.mesh import REGIONS
 
     topo = face.head.topology
     return topo.render_to_geo[topo.region != REGIONS.index("eyeball")]

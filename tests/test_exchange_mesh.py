@@ -29,7 +29,7 @@ def test_ply_holds_the_deformed_frame_in_metres(tmp_path, face_of):
     face = face_of("ava")
     props, vertices, faces, header = read_ply(write_mesh(face, "6+12", tmp_path / "smile.ply"))
     assert props == ["x", "y", "z", "nx", "ny", "nz"]                   # registers: no wrinkle
-    expected = np.asarray(face.engine(Activations({(c, s): 1.0 for c in (6, 12) for s in ("left", "right")})))
+    expected = np.asarray(face.engine.deform(Activations({(c, s): 1.0 for c in (6, 12) for s in ("left", "right")})).positions)
     assert np.abs(vertices[:, :3] - expected * 0.1).max() < 1e-6
     assert np.allclose(np.linalg.norm(vertices[:, 3:6], axis=1), 1, atol=1e-4)
     assert np.all(faces["n"] == 3) and np.array_equal(faces["v"], face.head.triangles)
@@ -65,7 +65,7 @@ def test_muscle_engine_wrinkle_goes_into_both_formats(tmp_path, face_of):
     face = face_of("ava", "muscle")
     props, vertices, _, _ = read_ply(write_mesh(face, "4+6+12", tmp_path / "m.ply"))
     assert props[-1] == "wrinkle"
-    assert np.array_equal(vertices[:, 6], np.asarray(face.engine.last_wrinkle, np.float32))
+    assert np.array_equal(vertices[:, 6], np.asarray(face.deform("4+6+12").wrinkle, np.float32))
     first_v = next(line for line in write_mesh(face, "4", tmp_path / "m.obj").read_text().splitlines()
                    if line.startswith("v "))
     assert len(first_v.split()) == 7                                    # v x y z r g b

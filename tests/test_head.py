@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from facsim.render.renderer import REGIONS
+from facsim.head.mesh import REGIONS
 
 
 def test_head_is_symmetric_and_has_every_part(head):

@@ -173,8 +173,8 @@ def test_animation_path_converges_to_the_static_solve(engine):
     for k in range(1, 9):  # the expression comes on over 8 frames, then is held
         engine.step(target.scaled(k / 8))
     for _ in range(20):
-        held = engine.step(target)
-    direct = engine(target)
+        held = engine.step(target).positions
+    direct = engine.deform(target).positions
     gap = np.linalg.norm(held - direct, axis=1)
     assert gap.max() < 0.04 and gap.mean() < 0.002  # within 4 mm anywhere and 0.2 mm on average
 
@@ -183,24 +183,25 @@ def test_a_step_applies_only_the_change(engine):
     act = activations(parse("4"))
     engine.reset()
     for _ in range(40):  # reach the expression and hold it
-        held = engine.step(act)
-    again = engine.step(act)  # nothing changed: the face stays where it is
+        held = engine.step(act).positions
+    again = engine.step(act).positions  # nothing changed: the face stays where it is
     assert np.abs(again - held).max() < 0.003
     from facsim.head.landmarks import landmarks
 
     brow = landmarks(engine.head)["inner_brow_left"]
-    first = engine.step(act.scaled(0.5))  # half the action: the brows start back up at once ...
+    first = engine.step(act.scaled(0.5)).positions  # half the action: the brows start back up at once ...
     for _ in range(10):
-        later = engine.step(act.scaled(0.5))
+        later = engine.step(act.scaled(0.5)).positions
     assert first[brow, 1] > held[brow, 1] + 0.0005
     assert later[brow, 1] > first[brow, 1] + 0.005  # ... and keep rising over the next frames
 
 
 def test_engine_api(face, engine, head):
     assert engine.name == "muscle"
-    p = engine(activations(parse("4+6")))
+    d = engine.deform(activations(parse("4+6")))
+    p = d.positions
     assert p.shape == (head.vertex_count, 3) and p.dtype == np.float32
-    w = engine.last_wrinkle
+    w = d.wrinkle
     assert w.shape == (head.vertex_count,) and w.dtype == np.float32 and (w >= 0).all()
     assert w.max() > 0.2  # 4+6 creases the skin
 

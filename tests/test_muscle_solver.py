@@ -58,7 +58,7 @@ def test_the_stiffness_is_factorised_once_and_reused(engine, monkeypatch):
     engine.reset()
     for k in range(1, 6):
         engine.step(activations(parse("12")).scaled(k / 5))
-    engine(activations(parse("4")))
+    engine.deform(activations(parse("4"))).positions
     assert calls == []  # frames and static solves only back-substitute
 
 
@@ -78,7 +78,7 @@ def test_batched_solves_equal_single_ones(engine):
     acts = [activations(parse(t)) for t in ("1", "15", "26")]
     together = engine.solve_many(acts)
     for act, batched in zip(acts, together):
-        assert np.abs(engine(act) - batched).max() < 1e-5
+        assert np.abs(engine.deform(act).positions - batched).max() < 1e-5
 
 
 def test_jaw_statics(model):
@@ -141,8 +141,7 @@ def test_coverage_lists_every_facial_action(engine):
 
 
 def _wrinkles(engine, text):
-    engine(activations(parse(text)))
-    return engine.last_wrinkle
+    return engine.deform(activations(parse(text))).wrinkle
 
 
 def test_wrinkles_appear_where_the_skin_is_squeezed(engine, head):
@@ -177,8 +176,8 @@ def test_wrinkle_lines_run_across_the_compression(engine, head):
         "4": (0, np.linalg.norm(centre - engine.neutral[marks["glabella"]], axis=1) < 0.1),
     }
     for text, (axis, region) in regions.items():
-        engine(activations(parse(text)))
-        skin = engine.last_state.points(0)[: engine.model.net.count]
+        _, state, index = next(engine.static_states([activations(parse(text))]))
+        skin = state.points(index)[: engine.model.net.count]
         squeeze, direction, _ = principal_compression(model, skin)
         weights = squeeze * region
         along = (np.abs(direction[:, axis]) * weights).sum() / weights.sum()
@@ -191,8 +190,7 @@ def test_furrow_phase_counts_furrows_across_the_compression(engine, head):
     from facsim.head.landmarks import landmarks
 
     marks = landmarks(head)
-    engine(activations(parse("4")))
-    phase = engine.last_crease_phase
+    phase = engine.deform(activations(parse("4"))).crease_phase
     rest = engine.neutral
     region = head.skin[np.linalg.norm(rest[head.skin] - rest[marks["glabella"]], axis=1) < 0.12]
     design = np.c_[rest[region, :2], np.ones(len(region))]

@@ -9,7 +9,7 @@ def _color(text: str):
     named = {"white": "#ffffff", "black": "#000000", "grey": "#808080", "gray": "#808080"}
     if text == "transparent":
         return None
-    from facsim.head.appearance import hex_to_rgb
+    from facsim.head.colour import hex_to_rgb
 
     try:
         return hex_to_rgb(named.get(text, text))

@@ -17,14 +17,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import lru_cache
-from importlib import resources
 from typing import Iterable
 
 import numpy as np
-import yaml
-from scipy.spatial.transform import Rotation
 
-from facsim.facs.activations import SIDES, Activations
+from facsim._data import load_yaml
+from facsim.engines.base import Deformation
+from facsim.engines.rigid import RigidMotion, rigid_codes, rigid_table
+from facsim.facs.activations import Activations
+from facsim.head.surface import smoothstep
 
 #: Half-width (dm) of the smooth left/right split of two-sided targets at the midline.
 MIDLINE_BLEND = 0.06
@@ -37,13 +38,12 @@ SIDED_REACH = (0.05, 0.15)
 @lru_cache(maxsize=1)
 def register_table() -> dict:
     """The parsed ``registers.yaml`` (the one source of the mapping)."""
-    return yaml.safe_load(resources.files("facsim").joinpath("data/registers.yaml").read_text())
+    return load_yaml("registers.yaml")
 
 
 def simulated_codes() -> set[int]:
     """AU codes this engine renders."""
-    t = register_table()
-    return set(t["action_units"]) | set(t["head_motions"]) | set(t["eye_rotations"])
+    return set(register_table()["action_units"]) | rigid_codes()
 
 
 def combine_registers(contributions: Iterable[tuple[float, float]]) -> float:
@@ -99,7 +99,7 @@ def register_weights(act: Activations) -> dict[Column, float]:
 
 
 class RegisterEngine:
-    """Callable engine: :class:`Activations` → geometry positions (N_geo, 3).
+    """The register engine (an :class:`~facsim.engines.base.Engine`): Activations → :class:`Deformation`.
 
     Parameters
     ----------
@@ -118,14 +118,11 @@ class RegisterEngine:
         self.base_positions = np.asarray(base_positions, np.float32)
         self.ethnicity = character.ethnicity
         self.neutral = head.positions(self.base_positions)
-        self._geo_of_base = np.full(len(data.base_vertices), -1, np.int64)
-        self._geo_of_base[head.base_index] = np.arange(len(head.base_index))
         x = self.base_positions[head.base_index, 0]
-        self._half = _smoothstep(-MIDLINE_BLEND, MIDLINE_BLEND, x)
-        self._reach = _smoothstep(-SIDED_REACH[1], -SIDED_REACH[0], x)  # left-side targets
+        self._half = smoothstep(-MIDLINE_BLEND, MIDLINE_BLEND, x).astype(np.float32)
+        self._reach = smoothstep(-SIDED_REACH[1], -SIDED_REACH[0], x).astype(np.float32)  # left-side targets
         self._columns: dict[Column, np.ndarray] = {}
-        self._table = register_table()
-        self.last_wrinkle = None  # this engine computes no skin compression
+        self.rigid = RigidMotion(head, self.base_positions)
 
     def column(self, col: Column) -> np.ndarray:
         """Offsets (N_base_geo, 3) of one column, mixed by ethnicity and split by side.
@@ -143,67 +140,41 @@ class RegisterEngine:
             for ethnicity, weight in mixes:
                 name = col.target.replace("{ethnicity}", ethnicity) if ethnicity else col.target
                 idx, delta = self.data.target(name)
-                geo = self._geo_of_base[idx]
+                geo = self.head.geo_of_base[idx]
                 keep = geo >= 0
                 offsets[geo[keep]] += weight * delta[keep]
             offsets *= (self._reach if col.sided else self._half)[:, None]
             self._columns[col] = offsets
         return self._columns[col]
 
-    def __call__(self, act: Activations) -> np.ndarray:
+    def deform(self, act: Activations) -> Deformation:
+        """The expression ``act``: targets weighted by Eq. 1, then the eyes and the head moved rigidly."""
+        if not act:
+            return Deformation(self.neutral)
         base = self.base_positions[self.head.base_index]  # a copy (fancy indexing)
         for col, weight in register_weights(act).items():
             if weight:
                 base += weight * self.column(col)
         morphed = np.array(self.base_positions, copy=True)
         morphed[self.head.base_index] = base
-        positions = self.head.positions(morphed, neutral_base=self.base_positions, eye_rotations=self.eye_rotations(act))
+        positions = self.head.positions(morphed, neutral_base=self.base_positions,
+                                        eye_rotations=self.rigid.eye_rotations(act))
         self.head.keep_skin_off_eyes(positions, self.neutral, self.base_positions)
-        return self.move_head(positions, act)
+        return Deformation(self.rigid.move_head(positions, act))
 
-    def eye_rotations(self, act: Activations) -> dict[str, np.ndarray]:
-        """3×3 rotation per eye from codes 61–66 (summed as rotation vectors)."""
-        rotvec = {side: np.zeros(3) for side in SIDES}
-        for code, spec in self._table["eye_rotations"].items():
-            level = act.level(code)
-            if level:
-                for side in SIDES:
-                    rotvec[side] += np.radians(spec[side] * level) * np.asarray(spec["axis"], float)
-        return {side: Rotation.from_rotvec(v).as_matrix() for side, v in rotvec.items()}
+    def reset(self) -> None:
+        """Nothing to do: the register engine keeps no state between frames."""
 
-    def move_head(self, positions: np.ndarray, act: Activations) -> np.ndarray:
-        """Rigid head motion (51–58) blended smoothly into the neck."""
-        rotvec, shift = np.zeros(3), np.zeros(3)
-        for code, spec in self._table["head_motions"].items():
-            level = act.level(code)
-            if not level:
-                continue
-            if "translate" in spec:
-                shift += level * np.asarray(spec["translate"], float)
-            else:
-                rotvec += np.radians(spec["degrees"] * level) * np.asarray(spec["axis"], float)
-        if not rotvec.any() and not shift.any():
-            return positions
-        pivot = self.head.joint(self.base_positions, "joint-neck")
-        blend = self._table["neck_blend"]
-        height = self.neutral[:, 1] - pivot[1]
-        weight = _smoothstep(blend["none_below"], blend["full_above"], height)[:, None]
-        # Interpolate the rotation angle per vertex (not the moved positions), so the neck twists smoothly.
-        rel = positions - pivot
-        moved = Rotation.from_rotvec(weight * rotvec[None, :]).apply(rel) + pivot + weight * shift
-        return moved.astype(np.float32)
-
-
-def _smoothstep(edge0: float, edge1: float, x: np.ndarray) -> np.ndarray:
-    t = np.clip((x - edge0) / (edge1 - edge0), 0, 1)
-    return (t * t * (3 - 2 * t)).astype(np.float32)
+    def step(self, act: Activations) -> Deformation:
+        """An animation frame: the same as :meth:`deform` (each frame is independent)."""
+        return self.deform(act)
 
 
 def coverage() -> dict[int, str]:
     """AU code → one line on how this engine renders it (or why it cannot)."""
-    table = register_table()
+    table, rigid = register_table(), rigid_table()
     out = {code: spec["why"] for code, spec in table["action_units"].items()}
-    out.update({code: spec["why"] for code, spec in table["head_motions"].items()})
-    out.update({code: spec["why"] for code, spec in table["eye_rotations"].items()})
+    out.update({code: spec["why"] for code, spec in rigid["head_motions"].items()})
+    out.update({code: spec["why"] for code, spec in rigid["eye_rotations"].items()})
     out.update({code: "not simulated: " + why for code, why in table["not_simulated"].items()})
     return dict(sorted(out.items()))

@@ -21,14 +21,14 @@ imports them. Errors in input files are :class:`ExchangeError` (a
 ``ValueError``): one line naming the file, the line (and column where it
 helps) and what is wrong.
 
-This module also holds what the formats share: CSV helpers and the rigid motions of
-the register engine (head 51–58, eyes 61–66) as rotation vectors and back.
+This module also holds what the formats share: reading and writing files, CSV helpers.
+Rigid motions (head 51–58, eyes 61–66) as rotation vectors and back are
+:mod:`facsim.engines.rigid`'s.
 """
 from __future__ import annotations
 
 from importlib import import_module
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
@@ -190,79 +190,8 @@ def require_columns(header: list[str], required, path, what: str) -> dict[str, i
     return lookup
 
 
-# ------------------------------------------------------ recorded curves ---
-
-# ------------------------------------------------------- rigid motions ---
-
-def _table():
-    from facsim.engines.registers import register_table
-
-    return register_table()
-
-
-def head_motion(levels: Callable[[int], float]) -> tuple[np.ndarray, np.ndarray]:
-    """Head rotation vector (radians) and shift (dm) from codes 51–58, as the register engine sums them.
-
-    ``levels(code)`` gives each code's intensity (e.g. ``Activations.level``).
-    """
-    rotvec, shift = np.zeros(3), np.zeros(3)
-    for code, spec in _table()["head_motions"].items():
-        level = levels(code)
-        if level:
-            if "translate" in spec:
-                shift += level * np.asarray(spec["translate"], float)
-            else:
-                rotvec += np.radians(spec["degrees"] * level) * np.asarray(spec["axis"], float)
-    return rotvec, shift
-
-
-def eye_motion(levels: Callable[[int], float]) -> dict[str, np.ndarray]:
-    """Rotation vector (radians) per eye ("left", "right") from codes 61–66, as the engine sums them."""
-    rotvec = {"left": np.zeros(3), "right": np.zeros(3)}
-    for code, spec in _table()["eye_rotations"].items():
-        level = levels(code)
-        if level:
-            for side in rotvec:
-                rotvec[side] += np.radians(spec[side] * level) * np.asarray(spec["axis"], float)
-    return rotvec
-
-
-def head_levels(rotvec_degrees) -> dict[int, float]:
-    """Levels of the head-turn codes that give rotation vector ``rotvec_degrees`` (clipped to 1).
-
-    Each code takes the component of the rotation along its axis, divided by
-    its angle at intensity 1; the opposite code of a pair gets 0.
-    """
-    rotvec = np.asarray(rotvec_degrees, float)
-    out = {}
-    for code, spec in _table()["head_motions"].items():
-        if "degrees" in spec:
-            axis = np.asarray(spec["axis"], float)
-            out[code] = float(np.clip(rotvec @ axis / spec["degrees"], 0.0, 1.0))
-    return out
-
-
-def eye_levels(left_degrees, right_degrees) -> dict[int, float]:
-    """Levels of codes 61–66 from each eye's rotation vector in degrees (clipped to 1).
-
-    Codes that turn both eyes the same way (61–64) take the eyes' mean
-    rotation along their axis; codes that turn them apart (65, 66) take half
-    the difference.
-    """
-    left, right = np.asarray(left_degrees, float), np.asarray(right_degrees, float)
-    out = {}
-    for code, spec in _table()["eye_rotations"].items():
-        axis = np.asarray(spec["axis"], float)
-        if spec["left"] == spec["right"]:
-            amount, full = (left + right) @ axis / 2, spec["left"]
-        else:
-            amount, full = (left - right) @ axis / 2, (spec["left"] - spec["right"]) / 2
-        out[code] = float(np.clip(amount / full, 0.0, 1.0))
-    return out
-
-
 __all__ = [
-    "ExchangeError", "TIMELINE_SUFFIXES", "csv_number", "eye_levels", "eye_motion", "head_levels", "head_motion",
+    "ExchangeError", "TIMELINE_SUFFIXES", "csv_number",
     "load_any_timeline", "read_csv_rows", "require_columns", "save_any_timeline",
     "write_file", *sorted(_LAZY),
 ]

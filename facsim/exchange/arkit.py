@@ -49,8 +49,8 @@ from pathlib import Path
 
 import numpy as np
 
-from facsim.exchange import (ExchangeError, csv_number, eye_levels, eye_motion, head_levels, head_motion, read_csv_rows,
-                             require_columns, write_file)
+from facsim.engines.rigid import eye_levels, eye_motion, head_levels, head_motion, rigid_table
+from facsim.exchange import ExchangeError, csv_number, read_csv_rows, require_columns, write_file
 from facsim.timeline.builders import timeline_from_samples
 
 REGISTER_PREFIX = "faceunits/"
@@ -183,7 +183,7 @@ def inverse_map() -> tuple[tuple[tuple[int, str], ...], np.ndarray]:
     excluded = set(arkit_table()["inverse"]["excluded"])
     codes = {code for code, spec in table["action_units"].items()
              if any(r["target"].startswith(REGISTER_PREFIX) for r in spec.get("registers", []))}
-    codes |= {code for code, spec in table["eye_rotations"].items() if spec["left"] or spec["right"]}
+    codes |= {code for code, spec in rigid_table()["eye_rotations"].items() if spec["left"] or spec["right"]}
     names = shape_names()
     unknowns, columns = [], []
     for code in sorted(codes - excluded):

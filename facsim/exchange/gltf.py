@@ -41,7 +41,8 @@ import numpy as np
 
 from facsim.facs.activations import Activations
 
-from facsim.exchange import eye_motion, head_motion, write_file
+from facsim.engines.rigid import eye_motion, head_motion
+from facsim.exchange import write_file
 
 #: facsim decimetres → glTF metres.
 METRES = 0.1
@@ -138,14 +139,14 @@ def _png(rgb: np.ndarray) -> bytes:
 
 def _srgb8(linear: np.ndarray) -> np.ndarray:
     """Linear light (0..1) → 8-bit sRGB, through a 4096-step table (exact to the 8-bit step)."""
-    from facsim.head.appearance import linear_to_srgb
+    from facsim.head.colour import linear_to_srgb
 
     table = np.clip(linear_to_srgb(np.linspace(0.0, 1.0, 4096)) * 255 + 0.5, 0, 255).astype(np.uint8)
     return table[np.clip(np.rint(np.asarray(linear) * 4095), 0, 4095).astype(np.intp)]
 
 
 def _linear(colour) -> np.ndarray:
-    from facsim.render.inputs import srgb_to_linear
+    from facsim.head.colour import srgb_to_linear
 
     return srgb_to_linear(np.asarray(colour, float))
 
@@ -171,7 +172,9 @@ def skin_texture(appearance) -> np.ndarray:
             paint = _resize(paint, SKIN_TEXTURE_SIZE)
         for channel, name in ((3, "cheek"), (2, "eyelid"), (1, "lips")):
             albedo += (colours[name] - albedo) * paint[..., channel:channel + 1]
-        hair = 0.75 * _smoothstep(0.0, 0.5, paint[..., 0:1])           # the shader's mean strand coverage
+        from facsim.head.surface import smoothstep
+
+        hair = 0.75 * smoothstep(0.0, 0.5, paint[..., 0:1])           # the shader's mean strand coverage
         albedo += (colours["brows"] - albedo) * hair
     albedo[[0, -1], :] = colours["skin"]
     albedo[:, [0, -1]] = colours["skin"]
@@ -234,11 +237,6 @@ def target_weights(act, keys) -> np.ndarray:
     return np.array([act.level(code) if side == "both" else act[code, side] for code, side in keys], np.float32)
 
 
-def _smoothstep(edge0, edge1, x):
-    t = np.clip((x - edge0) / (edge1 - edge0), 0, 1)
-    return t * t * (3 - 2 * t)
-
-
 def _quaternions(rotvecs: np.ndarray) -> np.ndarray:
     from scipy.spatial.transform import Rotation
 
@@ -289,9 +287,10 @@ def _floats(values) -> list[float]:
 
 def _face_mesh(b: GlbBuilder, face, keys, pivot, material_index: dict, normals: bool) -> dict:
     """Mesh ``face``: the head without eyeballs, skinned to neck/head, one primitive per material, AU targets."""
-    from facsim.engines.registers import RegisterEngine, register_table
-    from facsim.render.geometry import vertex_normals
-    from facsim.render.inputs import REGIONS
+    from facsim.engines.registers import RegisterEngine
+    from facsim.engines.rigid import neck_weight
+    from facsim.head.mesh import REGIONS
+    from facsim.head.surface import vertex_normals
 
     head, topo = face.head, face.head.topology
     engine = face.engine if face.engine_name == "registers" else RegisterEngine(
@@ -308,9 +307,8 @@ def _face_mesh(b: GlbBuilder, face, keys, pivot, material_index: dict, normals: 
     if normals:
         attributes["NORMAL"] = b.accessor(rest_normals, "VEC3", target=ARRAY_BUFFER)
     attributes["TEXCOORD_0"] = b.accessor(topo.uv[keep], "VEC2", target=ARRAY_BUFFER)
-    blend = register_table()["neck_blend"]
     weights = np.zeros((len(keep), 4), np.float32)
-    weights[:, 1] = _smoothstep(blend["none_below"], blend["full_above"], neutral[geo, 1] - pivot[1])
+    weights[:, 1] = neck_weight(head, neutral, face.base_positions)[geo]
     weights[:, 0] = 1.0 - weights[:, 1]
     joints = np.zeros((len(keep), 4), np.uint8)
     joints[:, 1] = weights[:, 1] > 0                                  # an unused slot names joint 0
@@ -320,7 +318,7 @@ def _face_mesh(b: GlbBuilder, face, keys, pivot, material_index: dict, normals: 
     targets = []
     for code, side in keys:
         sides = ("left", "right") if side == "both" else (side,)
-        moved = np.asarray(engine(Activations({(code, s): 1.0 for s in sides})), np.float64)
+        moved = np.asarray(engine.deform(Activations({(code, s): 1.0 for s in sides})).positions, np.float64)
         target = {"POSITION": b.delta_accessor((moved[geo] - neutral[geo]) * METRES)}
         if normals:
             target["NORMAL"] = b.delta_accessor(normals_of(moved) - rest_normals)

@@ -4,7 +4,7 @@ Both hold the head's geometry vertices (skin, teeth, tongue, lashes, eyeballs,
 neck cap; one vertex per mesh point) in metres (facsim's decimetres × 0.1),
 with facsim's axes (+Y up, the face looks toward +Z, +X the character's left),
 smooth normals, and the triangles. When the engine computes skin compression
-(an engine whose ``last_wrinkle`` is not None: the muscle engine; 0 = none,
+(a :class:`~facsim.engines.base.Deformation` with a wrinkle: the muscle engine; 0 = none,
 1 = a deep fold) it goes along per vertex, for any expression but neutral:
 
 PLY (binary little-endian)
@@ -36,18 +36,11 @@ SUFFIXES = (".obj", ".ply")
 
 def deformed_frame(face, expression=None) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
     """Positions (N_geo, 3) in metres, unit normals (N_geo, 3) and the wrinkle (N_geo,) or None."""
-    from facsim.render.geometry import vertex_normals
+    from facsim.head.surface import vertex_normals
 
-    from facsim.face import to_activations
-
-    act = to_activations(expression)
-    positions = np.asarray(face.engine(act) if act else face.neutral, np.float64)
-    wrinkle = getattr(face.engine, "last_wrinkle", None) if act else None
-    if wrinkle is not None:
-        wrinkle = np.asarray(wrinkle, np.float32).reshape(-1)
-        if len(wrinkle) != len(positions):
-            raise ValueError(f"the {face.engine_name} engine's wrinkle has {len(wrinkle)} values for "
-                             f"{len(positions)} vertices")
+    deformation = face.deform(expression)
+    positions = np.asarray(deformation.positions, np.float64)
+    wrinkle = None if deformation.wrinkle is None else np.asarray(deformation.wrinkle, np.float32)
     normals = vertex_normals(positions, face.head.topology.geo_faces)
     return (positions * METRES).astype(np.float32), normals, wrinkle
 
@@ -70,7 +63,7 @@ def ply_bytes(positions, normals, triangles, wrinkle=None, *, comments=()) -> by
 
 def obj_text(positions, normals, topology, wrinkle=None) -> str:
     """A comment-free OBJ: vertices (with grey wrinkle colour), skin UVs, normals, a group per region."""
-    from facsim.render.inputs import REGIONS
+    from facsim.head.mesh import REGIONS
 
     out = io.StringIO()
     if wrinkle is None:

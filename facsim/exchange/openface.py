@@ -17,12 +17,12 @@ Conversions
       frame turned 180° about x, so the head's rotation vector is
       (rx, −ry, −rz) of the camera one; its share along each head-turn axis
       over the register engine's full angle gives 51–56
-      (:func:`facsim.exchange.head_levels`).
+      (:func:`facsim.engines.rigid.head_levels`).
     * Gaze: ``gaze_angle_x/y`` are radians in the camera frame (x > 0: the
       person looks to the image's right, their own left; y > 0: down).
       The gaze is turned into the head's frame (so a turned head looking
       at the camera has its eyes turned back), then its yaw and pitch give
-      61–64 with the engine's eye angles (:func:`facsim.exchange.eye_levels`).
+      61–64 with the engine's eye angles (:func:`facsim.engines.rigid.eye_levels`).
     * Frames with ``success`` 0 (and, with ``min_confidence``, less confident
       ones) hold the last good frame's values (neutral before the first).
     * Times are ``timestamp`` minus the first one. The frame rate is
@@ -41,7 +41,8 @@ from pathlib import Path
 
 import numpy as np
 
-from facsim.exchange import ExchangeError, csv_number, eye_levels, head_levels, read_csv_rows, require_columns
+from facsim.engines.rigid import eye_levels, head_levels
+from facsim.exchange import ExchangeError, csv_number, read_csv_rows, require_columns
 from facsim.timeline.builders import timeline_from_samples
 
 #: Frame rates the measured one is snapped to (within 1 %).

@@ -17,8 +17,73 @@ import numpy as np
 
 from facsim.head.assets import cache_dir
 from facsim.atomic import atomic_write
-from facsim.head.character import COLOR_KEYS, Character
-from facsim.render.inputs import Appearance
+from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import Mapping
+
+from facsim.head.character import COLOR_NAMES, Character
+from facsim.head.colour import hex_to_rgb, linear_to_srgb, srgb_to_linear
+from facsim.head.surface import smoothstep
+
+#: A plausible default appearance (light-medium skin, brown eyes), display sRGB.
+DEFAULT_COLORS: Mapping[str, tuple[float, float, float]] = MappingProxyType({
+    "skin": (0.85, 0.68, 0.60),
+    "lips": (0.72, 0.42, 0.40),
+    "brows": (0.22, 0.15, 0.11),
+    "lashes": (0.07, 0.05, 0.04),
+    "sclera": (0.90, 0.88, 0.85),
+    "iris": (0.36, 0.24, 0.14),
+    "pupil": (0.02, 0.02, 0.02),
+    "teeth": (0.90, 0.87, 0.78),
+    "tongue": (0.76, 0.40, 0.40),
+    "mouth_interior": (0.36, 0.11, 0.11),
+    "eyelid": (0.78, 0.58, 0.52),
+    "cheek": (0.90, 0.56, 0.52),
+})
+
+
+@dataclass(frozen=True, eq=False)
+class Appearance:
+    """How a character looks: colours and a paint texture in skin-UV space.
+
+    Parameters
+    ----------
+    colors : mapping name -> (r, g, b)
+        Display sRGB in [0, 1] for every name in :data:`COLOR_NAMES` (extra names are an
+        error, to catch typos). See :data:`DEFAULT_COLORS`.
+    paint : (H, W, 4) uint8, optional
+        R = eyebrow hair density, G = lip mask, B = eyelid mask, A = cheek/blush mask.
+        Rows run with v UPWARD: row 0 is v = 0 (GL texture order, as ``facsim.assets``
+        stores its masks; flip an image file's rows with ``paint[::-1]``). Each mask is the
+        weight of its colour over the skin colour (255 = the colour itself), so the blush
+        or eyelid strength is painted into the mask. ``None`` = no paint.
+    """
+
+    colors: Mapping[str, tuple[float, float, float]] = field(default_factory=lambda: DEFAULT_COLORS)
+    paint: np.ndarray | None = None
+
+    def __post_init__(self):
+        colors = dict(self.colors)
+        missing = [k for k in COLOR_NAMES if k not in colors]
+        extra = [k for k in colors if k not in COLOR_NAMES]
+        if missing or extra:
+            raise ValueError(f"colors must give exactly {COLOR_NAMES}; missing {missing}, "
+                             f"unknown {extra}")
+        clean = {}
+        for k in COLOR_NAMES:
+            c = np.asarray(colors[k], dtype=float).reshape(-1)
+            if c.shape != (3,) or not np.all((c >= 0) & (c <= 1)):
+                raise ValueError(f"colors[{k!r}] must be 3 numbers in [0, 1], got {colors[k]!r}")
+            clean[k] = tuple(float(v) for v in c)
+        object.__setattr__(self, "colors", MappingProxyType(clean))
+        if self.paint is not None:
+            paint = np.asarray(self.paint)
+            if paint.ndim != 3 or paint.shape[2] != 4 or paint.dtype != np.uint8:
+                raise ValueError(f"paint must be an (H, W, 4) uint8 array, got "
+                                 f"{paint.dtype} {paint.shape}")
+            object.__setattr__(self, "paint", paint)
+
+
 
 #: Young-adult colours per ethnicity (sRGB). Sources: typical values of the
 #: Fitzpatrick II / IV / V–VI skin types; brows and irises the commonest shade.
@@ -50,25 +115,8 @@ BROW = {
 }
 
 
-def srgb_to_linear(rgb):
-    rgb = np.asarray(rgb, float)
-    return np.where(rgb <= 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4)
-
-
-def linear_to_srgb(rgb):
-    rgb = np.clip(np.asarray(rgb, float), 0, 1)
-    return np.where(rgb <= 0.0031308, rgb * 12.92, 1.055 * rgb ** (1 / 2.4) - 0.055)
-
-
-def hex_to_rgb(text: str) -> tuple[float, float, float]:
-    text = text.lstrip("#")
-    if len(text) != 6 or any(c not in "0123456789abcdefABCDEF" for c in text):
-        raise ValueError(f"colours are '#rrggbb' hex strings, got {'#' + text!r}")
-    return tuple(int(text[i : i + 2], 16) / 255 for i in (0, 2, 4))
-
-
 def character_colors(character: Character) -> dict[str, tuple[float, float, float]]:
-    """sRGB colours (0 … 1) for every key in :data:`COLOR_KEYS`."""
+    """sRGB colours (0 … 1) for every key in :data:`COLOR_NAMES`."""
     mix = character.ethnicity
 
     def blend(key):
@@ -91,7 +139,7 @@ def character_colors(character: Character) -> dict[str, tuple[float, float, floa
     if older:  # teeth yellow with age
         colors["teeth"] = tuple(np.array(colors["teeth"]) * (1 - 0.08 * older * np.array([0.0, 0.3, 1.0])))
     colors.update({k: hex_to_rgb(v) for k, v in character.colors.items()})
-    assert set(colors) == set(COLOR_KEYS)
+    assert set(colors) == set(COLOR_NAMES)
     return colors
 
 
@@ -129,8 +177,8 @@ def brow_density(positions: np.ndarray) -> np.ndarray:
     centre = eye_y + c["lift"] + c["arch"] * rise - 0.015 * (s < 0.15) * (0.15 - s) / 0.15
     half = c["half_height_head"] * (1 - s) ** 0.7 + c["half_height_tail"] * s
     across = np.abs(y - centre) / half
-    density = _smooth(1.15, 0.75, across) * _smooth(-0.02, 0.08, along) * _smooth(1.02, 0.88, along)
-    density *= _smooth(eye_z - 0.1, eye_z + 0.05, z)  # front of the head only
+    density = smoothstep(1.15, 0.75, across) * smoothstep(-0.02, 0.08, along) * smoothstep(1.02, 0.88, along)
+    density *= smoothstep(eye_z - 0.1, eye_z + 0.05, z)  # front of the head only
     return np.where(np.isfinite(density), density, 0.0).astype(np.float32)
 
 
@@ -145,11 +193,6 @@ def cheek_density(positions: np.ndarray) -> np.ndarray:
 
 #: hm08's left eye centre (joint-l-eye), decimetres.
 _EYE_CENTRE = np.array([0.308, 7.284, 1.245])
-
-
-def _smooth(edge0, edge1, x):
-    t = np.clip((x - edge0) / (edge1 - edge0), 0, 1)
-    return t * t * (3 - 2 * t)
 
 
 def _resize(image: np.ndarray, size: tuple[int, int]) -> np.ndarray:

@@ -1,6 +1,6 @@
 """Characters: who the face belongs to, as MakeHuman macro and face-shape weights.
 
-A :class:`Character` is plain parameters; :func:`character_offsets` turns them
+A :class:`Character` is plain parameters; :func:`character_positions` turns them
 into base-mesh offsets (``base + offsets`` is that person's neutral face).
 
 Macro weighting (MakeHuman / MPFB scheme, ``targets/macrodetails/macro.json``):
@@ -16,7 +16,7 @@ Target ``{race}-{gender}-{age}`` gets race·gender·age; target
 ``universal-{gender}-{age}-{muscle}-{weight}`` gets gender·age·muscle·weight —
 products of the factor weights, exactly as MakeHuman combines them. The
 MakeHuman expression units exist per ethnicity; they are mixed by the same
-ethnicity weights (:func:`ethnic_mix`).
+ethnicity weights (``Character.ethnicity``).
 
 Face-shape sliders are named after the target files without their direction:
 ``"nose/nose-hump": 0.4`` applies ``nose/nose-hump-incr`` at 0.4, −0.4 applies
@@ -35,11 +35,11 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field, replace
 from functools import lru_cache
-from importlib import resources
 from typing import Mapping
 
 import numpy as np
-import yaml
+
+from facsim._data import load_yaml
 
 ETHNICITIES = ("african", "asian", "caucasian")
 #: Age anchors: MakeHuman slider value ↔ years.
@@ -50,7 +50,9 @@ FACE_SHAPE_FOLDERS = ("head", "nose", "mouth", "chin", "cheek", "eyes", "eyebrow
 #: Which end of a slider pair is negative.
 _NEGATIVE_ENDS = ("decr", "down", "in", "backward", "concave", "compress")
 _POSITIVE_ENDS = ("incr", "up", "out", "forward", "convex", "uncompress")
-COLOR_KEYS = ("skin", "lips", "brows", "iris", "lashes", "sclera", "pupil", "teeth", "tongue", "mouth_interior", "eyelid", "cheek")
+#: The colours a character has (display sRGB, 0..1), each overridable in ``colors``.
+COLOR_NAMES = ("skin", "lips", "brows", "lashes", "sclera", "iris", "pupil", "teeth", "tongue",
+               "mouth_interior", "eyelid", "cheek")
 
 
 class CharacterError(ValueError):
@@ -74,7 +76,7 @@ class Character:
     face : mapping
         Face-shape sliders, ``{"nose/nose-hump": 0.4, ...}``, each in [-1, 1].
     colors : mapping
-        Colour overrides, ``{"iris": "#3b6ea5", ...}``; keys in :data:`COLOR_KEYS`.
+        Colour overrides, ``{"iris": "#3b6ea5", ...}``; keys in :data:`COLOR_NAMES`.
     name : str
         Preset name, or "" for a custom character.
     """
@@ -102,8 +104,8 @@ class Character:
             if not -1.0 <= float(value) <= 1.0:
                 raise CharacterError(f"face-shape slider {key!r} must be in [-1, 1], got {value}")
         for key in self.colors:
-            if key not in COLOR_KEYS:
-                raise CharacterError(f"unknown colour {key!r}; choose from {', '.join(COLOR_KEYS)}")
+            if key not in COLOR_NAMES:
+                raise CharacterError(f"unknown colour {key!r}; choose from {', '.join(COLOR_NAMES)}")
         object.__setattr__(self, "face", dict(self.face))
         object.__setattr__(self, "colors", dict(self.colors))
 
@@ -206,11 +208,6 @@ def slider_names(available) -> list[str]:
     return sorted(names)
 
 
-def ethnic_mix(character: Character) -> dict[str, float]:
-    """Ethnicity weights, used to mix per-ethnicity expression units."""
-    return character.ethnicity
-
-
 def character_weights(character: Character, available: set[str]) -> dict[str, float]:
     """All target weights (macro + face shape) for ``character``."""
     weights = {f"macrodetails/{k}": v for k, v in macro_weights(character).items()}
@@ -227,7 +224,7 @@ def apply_targets(base: np.ndarray, data, weights: Mapping[str, float]) -> np.nd
     return out
 
 
-def character_offsets(character: Character, data) -> np.ndarray:
+def character_positions(character: Character, data) -> np.ndarray:
     """Morphed base vertices (19158, 3) for ``character``."""
     return apply_targets(data.base_vertices, data, character_weights(character, set(data.target_names)))
 
@@ -237,8 +234,7 @@ def character_offsets(character: Character, data) -> np.ndarray:
 
 @lru_cache(maxsize=1)
 def _preset_table() -> dict:
-    text = resources.files("facsim").joinpath("data/characters.yaml").read_text()
-    return yaml.safe_load(text)
+    return load_yaml("characters.yaml")
 
 
 def preset_names() -> list[str]:

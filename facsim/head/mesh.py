@@ -23,7 +23,87 @@ from functools import cached_property
 import numpy as np
 
 from facsim.head.assets import PAINT_UV_BOX
-from facsim.render.inputs import REGIONS, RenderTopology
+
+#: Region names; ``RenderTopology.region`` holds indices into this tuple.
+REGIONS = ("skin", "mouth_interior", "teeth", "tongue", "eyeball", "lashes")
+
+
+@dataclass(frozen=True, eq=False)
+class RenderTopology:
+    """Static mesh description, uploaded once per :class:`~facsim.render.Renderer`.
+
+    Parameters
+    ----------
+    faces : (M, 3) uint32
+        Triangles as indices into render vertices.
+    render_to_geo : (R,) int
+        Render vertex -> geometry vertex. Render vertices are split at UV seams; normals are
+        computed on geometry vertices so seams do not show.
+    uv : (R, 2) float32
+        Skin UVs (MakeHuman layout, v up, [0, 1]); unused (zeros, say) for non-skin.
+    region : (R,) uint8
+        Index into :data:`REGIONS` per render vertex. A triangle takes the region most of
+        its vertices have (the first vertex's when all three differ).
+    eye_coord : (R, 3) float32
+        For eyeball vertices, the unit direction from the eye centre in the eye's own
+        (unrotated) frame, +Z = gaze; zeros elsewhere.
+    """
+
+    faces: np.ndarray
+    render_to_geo: np.ndarray
+    uv: np.ndarray
+    region: np.ndarray
+    eye_coord: np.ndarray
+
+    def __post_init__(self):
+        faces = np.ascontiguousarray(self.faces, dtype=np.uint32)
+        r2g = np.ascontiguousarray(self.render_to_geo, dtype=np.int64)
+        if faces.ndim != 2 or faces.shape[1] != 3 or len(faces) == 0:
+            raise ValueError(f"faces must be a non-empty (M, 3) array, got shape {faces.shape}")
+        if r2g.ndim != 1 or len(r2g) == 0:
+            raise ValueError(f"render_to_geo must be a non-empty (R,) array, got {r2g.shape}")
+        n = len(r2g)
+        if faces.max() >= n:
+            raise ValueError(f"faces index render vertex {faces.max()}, but there are only "
+                             f"{n} (len(render_to_geo))")
+        if r2g.min() < 0:
+            raise ValueError("render_to_geo must be >= 0")
+        uv = np.ascontiguousarray(self.uv, dtype=np.float32)
+        region = np.ascontiguousarray(self.region, dtype=np.uint8)
+        eye = np.ascontiguousarray(self.eye_coord, dtype=np.float32)
+        for name, arr, shape in (("uv", uv, (n, 2)), ("region", region, (n,)),
+                                 ("eye_coord", eye, (n, 3))):
+            if arr.shape != shape:
+                raise ValueError(f"{name} must have shape {shape} (one row per render vertex), "
+                                 f"got {arr.shape}")
+        if region.max() >= len(REGIONS):
+            raise ValueError(f"region values must index REGIONS (0..{len(REGIONS) - 1}), "
+                             f"got {region.max()}")
+        for name, arr in (("faces", faces), ("render_to_geo", r2g), ("uv", uv),
+                          ("region", region), ("eye_coord", eye)):
+            arr.setflags(write=False)
+            object.__setattr__(self, name, arr)
+
+    @property
+    def n_render(self) -> int:
+        """Number of render vertices R."""
+        return len(self.render_to_geo)
+
+    @property
+    def n_geo(self) -> int:
+        """Number of geometry vertices referenced (positions need at least this many rows)."""
+        return int(self.render_to_geo.max()) + 1
+
+    @property
+    def geo_faces(self) -> np.ndarray:
+        """(M, 3) the triangles as geometry-vertex indices."""
+        return self.render_to_geo[self.faces]
+
+    def face_regions(self) -> np.ndarray:
+        """(M,) region index of each triangle (majority of its vertices)."""
+        r = self.region[self.faces]
+        return np.where((r[:, 1] == r[:, 2]) & (r[:, 0] != r[:, 1]), r[:, 1], r[:, 0])
+
 
 #: Segmentation labels that make up the head surface, its mouth and eye sockets.
 HEAD_LABELS = ("head", "mouth_cavity", "eye_cavity.L", "eye_cavity.R")
@@ -68,7 +148,7 @@ class HeadModel:
     triangles : (M, 3) int
         Geometry triangles (for physics and exports).
     region : (N_geo,) uint8
-        Index into :data:`facsim.render_types.REGIONS` per geometry vertex.
+        Index into :data:`REGIONS` per geometry vertex.
     eye_vertices : dict side -> (K,) int
         Geometry indices of each generated eyeball.
     eye_local : (K, 3) float32
@@ -100,6 +180,19 @@ class HeadModel:
     @property
     def vertex_count(self) -> int:
         return len(self.region)
+
+    @cached_property
+    def geo_of_base(self) -> np.ndarray:
+        """(19158,) geometry index of each base vertex, -1 where the head model leaves it out."""
+        out = np.full(len(self.base_vertices), -1, np.int64)
+        out[self.base_index] = np.arange(len(self.base_index))
+        out.setflags(write=False)
+        return out
+
+    def group_geometry(self, data, group: str) -> np.ndarray:
+        """Geometry indices of a base-mesh vertex group (e.g. "helper-lower-teeth") kept in the head."""
+        ids = self.geo_of_base[data.group_vertices(group)]
+        return ids[ids >= 0]
 
     @cached_property
     def skin(self) -> np.ndarray:

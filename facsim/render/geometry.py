@@ -20,55 +20,8 @@ import math
 import numpy as np
 import scipy.sparse as sp
 
-from facsim.render.inputs import REGIONS, RenderTopology
-
-
-def normal_operator(faces: np.ndarray, n_vertices: int) -> sp.csr_matrix:
-    """Sparse (n_vertices, M) float32 matrix summing each face's value onto its 3 vertices.
-
-    ``operator @ face_normals`` with unnormalised face normals (cross products, length =
-    twice the area) gives area-weighted vertex normals.
-    """
-    faces = np.asarray(faces, dtype=np.int64)
-    m = len(faces)
-    rows = faces.reshape(-1)
-    cols = np.repeat(np.arange(m), 3)
-    data = np.ones(len(rows), dtype=np.float32)
-    return sp.csr_matrix((data, (rows, cols)), shape=(n_vertices, m), dtype=np.float32)
-
-
-def vertex_normals(positions: np.ndarray, faces: np.ndarray,
-                   operator: sp.csr_matrix | None = None) -> np.ndarray:
-    """Area-weighted unit vertex normals.
-
-    Parameters
-    ----------
-    positions : (N, 3) float
-    faces : (M, 3) int, indices into positions
-    operator : the :func:`normal_operator` of ``faces`` (pass it to avoid rebuilding)
-
-    Returns
-    -------
-    (N, 3) float32; vertices on no face (or only degenerate ones) get (0, 0, 1).
-    """
-    p = np.asarray(positions, dtype=np.float32)
-    if operator is None:
-        operator = normal_operator(faces, len(p))
-    a = p[faces[:, 0]]
-    e1 = p[faces[:, 1]] - a
-    e2 = p[faces[:, 2]] - a
-    fn = np.empty_like(e1)
-    fn[:, 0] = e1[:, 1] * e2[:, 2] - e1[:, 2] * e2[:, 1]
-    fn[:, 1] = e1[:, 2] * e2[:, 0] - e1[:, 0] * e2[:, 2]
-    fn[:, 2] = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
-    vn = operator @ fn
-    length = np.sqrt(np.einsum("ij,ij->i", vn, vn))
-    bad = length < 1e-20
-    length[bad] = 1.0
-    vn /= length[:, None]
-    if bad.any():
-        vn[bad] = (0.0, 0.0, 1.0)
-    return vn.astype(np.float32, copy=False)
+from facsim.head.mesh import REGIONS, RenderTopology
+from facsim.head.surface import normal_operator, vertex_normals  # noqa: F401 — re-exported for the renderer
 
 
 def region_components(topology: RenderTopology, region: str) -> list[np.ndarray]:

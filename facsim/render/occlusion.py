@@ -11,7 +11,7 @@ import numpy as np
 
 from facsim.render.geometry import sphere_directions, vertex_normals
 from facsim.render.gl import gl_context
-from facsim.render.inputs import RenderTopology
+from facsim.head.mesh import RenderTopology
 
 _DEPTH_VS = """
 in vec3 in_pos;

@@ -360,7 +360,7 @@ class Renderer:
             Skin compression; creases and cavity darkening are drawn where it is > 0.
         crease_phase : (N_geo,) float, optional
             Where across its creases each vertex lies, in crease spacings (a crease is drawn
-            at each whole number), e.g. the muscle engine's ``last_crease_phase``. Default:
+            at each whole number), e.g. a muscle-engine Deformation's ``crease_phase``. Default:
             creases along the contours of ``wrinkle`` (:func:`crease_phase`).
         occlusion : (N_geo,) float in [0, 1], optional
             Ambient visibility per geometry vertex (1 = open), e.g. from

@@ -12,13 +12,17 @@ Examples
 >>> face = Face("ava", engine="muscle")                   # doctest: +SKIP
 >>> face.save("/tmp/m46.png", "4+6")                      # doctest: +SKIP
 >>> engine = face.engine                                  # doctest: +SKIP
+>>> engine.reset()                                        # doctest: +SKIP
 >>> frames = [engine.step(a) for a in timeline_frames]    # doctest: +SKIP
+>>> frames[-1].wrinkle                                    # doctest: +SKIP
 """
 from __future__ import annotations
 
 import numpy as np
 from scipy.spatial import cKDTree
 
+from facsim.engines.base import Deformation
+from facsim.engines.rigid import RigidMotion
 from facsim.facs.activations import Activations
 from facsim.engines.muscle import solver
 from facsim.engines.muscle.muscles import au_table, build_muscles, build_tongue, drive, jaw_pose, pressure_patches
@@ -57,10 +61,7 @@ class _Parts:
     """How the rigid and attached parts follow the net: teeth, tongue, eyes, lashes, neck cap."""
 
     def __init__(self, head, data, neutral, net):
-        geo_of_base = np.full(len(head.base_vertices), -1, np.int64)
-        geo_of_base[head.base_index] = np.arange(len(head.base_index))
-        lower = geo_of_base[data.group_vertices("helper-lower-teeth")]
-        self.lower_teeth = lower[lower >= 0]
+        self.lower_teeth = head.group_geometry(data, "helper-lower-teeth")
         self.neutral = neutral
         # Lashes ride the lid vertex nearest their root, turning with its local frame.
         lids = np.flatnonzero(anatomy(head).kind == LID)
@@ -110,12 +111,12 @@ def _frames(positions, triples) -> np.ndarray:
 
 
 class MuscleEngine:
-    """Callable engine: :class:`Activations` → geometry positions (N_geo, 3) float32.
+    """The muscle engine (an :class:`~facsim.engines.base.Engine`): Activations → :class:`Deformation`.
 
-    ``engine(act)`` solves from rest (a static expression); ``engine.step(act)``
+    :meth:`deform` solves an expression from rest (n increments); :meth:`step`
     is the animation path: it keeps the face's state between calls and applies
-    only the change from the previous frame's activations. ``last_wrinkle``
-    holds the skin compression (N_geo,) of the last result, for the renderer.
+    only the change from the previous frame's activations. Each result carries
+    the skin's creases (computed when a renderer first asks for them).
 
     Parameters
     ----------
@@ -129,37 +130,45 @@ class MuscleEngine:
     name = "muscle"
 
     def __init__(self, head, data, character, base_positions):
-        from facsim.engines.registers import RegisterEngine
-
         self.head = head
         base_positions = np.asarray(base_positions, np.float32)
         self.model, self.wrinkles, neutral = _built(head, data, base_positions)
         self.neutral = neutral.astype(np.float32)
         self.parts = _Parts(head, data, neutral, self.model.net)
-        # Rigid head (51–58) and eye (61–66) motions are the register engine's, shared by both engines.
-        self.rigid = RegisterEngine(head, data, character, base_positions)
+        self.rigid = RigidMotion(head, base_positions)
         self.state = solver.rest_state(self.model)
-        self._wrinkle_of = None  # (state, index) whose wrinkles ``last_wrinkle`` computes on demand
-        self._wrinkle = None
-        self.last_state = self.state
 
-    # -- public API
-    def __call__(self, act: Activations) -> np.ndarray:
+    # -- the Engine protocol
+    def deform(self, act: Activations) -> Deformation:
         """Static solve: the expression ``act`` reached from rest in n increments."""
-        return self.solve_many([act])[0]
+        return self.deform_many([act])[0]
 
-    def solve_many(self, acts, *, steps: int = STATIC_STEPS, iterations: int = STATIC_ITERATIONS) -> np.ndarray:
-        """Static solves of several expressions at once (batched): positions (B, N_geo, 3) float32.
+    def reset(self) -> None:
+        """Back to the neutral face (the next :meth:`step` starts from rest)."""
+        self.state = solver.rest_state(self.model)
 
-        ``last_wrinkle`` and ``last_state`` then describe the last expression.
+    def step(self, act: Activations, *, iterations: int = FRAME_ITERATIONS) -> Deformation:
+        """One animation frame: apply the change since the previous frame and relax the net.
+
+        The state (positions, applied activations and the minimiser's memory)
+        carries over between calls, so a held expression keeps converging.
         """
+        self.state = solver.solve(self.model, self.state, drive(self.model.layer, act), steps=1,
+                                  iterations=iterations, settle=False)
+        return self._deformation(self.state, act, 0)
+
+    # -- batches
+    def deform_many(self, acts, *, steps: int = STATIC_STEPS, iterations: int = STATIC_ITERATIONS) -> list[Deformation]:
+        """Static solves of several expressions at once (batched), in order."""
         acts = list(acts)
         out = [None] * len(acts)
         for k, state, b in self.static_states(acts, steps=steps, iterations=iterations):
-            out[k] = self.geometry(state, acts[k], b)
-            if k == len(acts) - 1:
-                self._remember(state, b)
-        return np.stack(out)
+            out[k] = self._deformation(state, acts[k], b)
+        return out
+
+    def solve_many(self, acts, **options) -> np.ndarray:
+        """Positions (B, N_geo, 3) float32 of :meth:`deform_many`."""
+        return np.stack([d.positions for d in self.deform_many(acts, **options)])
 
     def static_states(self, acts, *, steps: int = STATIC_STEPS, iterations: int = STATIC_ITERATIONS):
         """Yield ``(k, state, b)``: expression ``k`` of ``acts`` solved from rest is configuration
@@ -186,55 +195,18 @@ class MuscleEngine:
         pose = jaw_pose(self.model.layer, target.muscle, self.model.jaw_spec)
         return int(np.degrees(pose[:, 0]).max() // JAW_DEGREES_PER_STEP)
 
-    def step(self, act: Activations, *, iterations: int = FRAME_ITERATIONS) -> np.ndarray:
-        """One animation frame: apply the change since the previous frame and relax the net.
-
-        The state (positions, applied activations and the minimiser's memory)
-        carries over between calls, so a held expression keeps converging.
-        """
-        self.state = solver.solve(self.model, self.state, drive(self.model.layer, act), steps=1,
-                                  iterations=iterations, settle=False)
-        self._remember(self.state, 0)
-        return self.geometry(self.state, act)
-
-    def animate(self, frames):
-        """Yield positions for each Activations in ``frames`` (the stateful path, from rest)."""
-        self.reset()
-        for act in frames:
-            yield self.step(act)
-
-    def reset(self) -> None:
-        """Back to the neutral face (the next ``step`` starts from rest)."""
-        self.state = solver.rest_state(self.model)
-
     # -- geometry
-    def _remember(self, state: solver.State, index: int) -> None:
-        self.last_state = state
-        self._wrinkle_of, self._wrinkle = (state, index), None
+    def _deformation(self, state: solver.State, act: Activations, index: int) -> Deformation:
+        return Deformation(self.geometry(state, act, index), creases=lambda: self._creases(state, index))
 
-    @property
-    def last_wrinkle(self) -> np.ndarray | None:
-        """Skin compression of the last result (N_geo,) float32 ≥ 0, for the renderer's creases.
-
-        Computed when first asked for (a render needs it; a solve does not).
-        """
-        return self._creases()[0]
-
-    @property
-    def last_crease_phase(self) -> np.ndarray | None:
-        """Where across its furrows each vertex of the last result lies (N_geo,) float32, in
-        furrow spacings: the renderer draws the furrows of ``last_wrinkle`` at whole numbers."""
-        return self._creases()[1]
-
-    def _creases(self):
-        if self._wrinkle is None and self._wrinkle_of is not None:
-            state, index = self._wrinkle_of
-            skin = state.points(index)[: self.model.net.count]
-            strength, phase = wrinkle_field(self.wrinkles, skin)
-            self._wrinkle = tuple(np.zeros(self.head.vertex_count, np.float32) for _ in range(2))
-            self._wrinkle[0][: len(skin)] = strength
-            self._wrinkle[1][: len(skin)] = phase
-        return self._wrinkle or (None, None)
+    def _creases(self, state: solver.State, index: int) -> tuple[np.ndarray, np.ndarray]:
+        """Skin compression (N_geo,) ≥ 0 and furrow phase (N_geo,) of configuration ``index``."""
+        skin = state.points(index)[: self.model.net.count]
+        strength, phase = wrinkle_field(self.wrinkles, skin)
+        wrinkle, crease_phase = (np.zeros(self.head.vertex_count, np.float32) for _ in range(2))
+        wrinkle[: len(skin)] = strength
+        crease_phase[: len(skin)] = phase
+        return wrinkle, crease_phase
 
     def geometry(self, state: solver.State, act: Activations, index: int = 0) -> np.ndarray:
         """Geometry positions (N_geo, 3) float32 of configuration ``index`` of a state."""
@@ -291,10 +263,5 @@ def _build_all(head, data, base_positions):
 
 def _teeth_rows(head, data, neutral) -> dict:
     """Rest positions of the upper and lower tooth rows (geometry vertices of hm08's teeth helpers)."""
-    geo_of_base = np.full(len(head.base_vertices), -1, np.int64)
-    geo_of_base[head.base_index] = np.arange(len(head.base_index))
-    rows = {}
-    for name, group in (("upper", "helper-upper-teeth"), ("lower", "helper-lower-teeth")):
-        ids = geo_of_base[data.group_vertices(group)]
-        rows[name] = neutral[ids[ids >= 0]]
-    return rows
+    return {name: neutral[head.group_geometry(data, group)]
+            for name, group in (("upper", "helper-upper-teeth"), ("lower", "helper-lower-teeth"))}

@@ -507,7 +507,7 @@ class TongueModel:
 
 def build_tongue(head, anat: Anatomy, net: TensionNet, spec: dict, positions: np.ndarray) -> TongueModel:
     """The tongue of a character (positions: its neutral geometry, (N_geo, 3))."""
-    from facsim.render.renderer import REGIONS
+    from facsim.head.mesh import REGIONS
 
     t = spec["tongue"]
     ids = np.flatnonzero(head.region == REGIONS.index("tongue"))

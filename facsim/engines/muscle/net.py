@@ -32,7 +32,8 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from facsim.head.landmarks import landmarks
-from facsim.render.renderer import REGIONS
+from facsim.head.mesh import REGIONS
+from facsim.head.surface import smoothstep, vertex_normals
 
 SPEC_FILE = "muscles.yaml"
 #: Tissue properties blended per vertex from the zones of ``muscles.yaml``.
@@ -80,17 +81,6 @@ def bending_pairs(triangles: np.ndarray) -> np.ndarray:
     return np.unique(np.sort(pairs, axis=1), axis=0)
 
 
-def vertex_normals(positions: np.ndarray, triangles: np.ndarray, count: int) -> np.ndarray:
-    """(count, 3) area-weighted unit normals (outward for hm08's winding)."""
-    face = np.cross(positions[triangles[:, 1]] - positions[triangles[:, 0]],
-                    positions[triangles[:, 2]] - positions[triangles[:, 0]])
-    normals = np.zeros((count, 3))
-    for k in range(3):
-        np.add.at(normals, triangles[:, k], face)
-    length = np.linalg.norm(normals, axis=1, keepdims=True)
-    return normals / np.where(length > 0, length, 1.0)
-
-
 def vertex_areas(positions: np.ndarray, triangles: np.ndarray, count: int) -> np.ndarray:
     """(count,) a third of the area of the triangles around each vertex."""
     area = 0.5 * np.linalg.norm(np.cross(positions[triangles[:, 1]] - positions[triangles[:, 0]],
@@ -112,11 +102,6 @@ def smooth_field(values: np.ndarray, adj: sp.csr_matrix, iterations: int) -> np.
     for _ in range(iterations):
         values = (adj @ values + values) / (degree if values.ndim == 1 else degree[:, None])
     return values
-
-
-def smoothstep(edge0, edge1, x):
-    t = np.clip((np.asarray(x, float) - edge0) / (edge1 - edge0), 0.0, 1.0)
-    return t * t * (3.0 - 2.0 * t)
 
 
 def mask_per_vertex(head, name: str) -> np.ndarray:
@@ -201,7 +186,7 @@ def anatomy(head) -> Anatomy:
     tri = skin_triangles(head)
     edges = unique_edges(tri)
     adj = adjacency(edges, n)
-    normal = vertex_normals(base, tri, n)
+    normal = vertex_normals(base[:n], tri, dtype=np.float64)
     # MakeHuman's UV masks are not quite symmetric; the anatomy must be (hm08 is).
     mirror = np.asarray(head.mirror)[:n]
     lids_mask = mask_per_vertex(head, "eyelids")[:n]
@@ -557,7 +542,7 @@ def build_net(head, base_positions, *, anat: Anatomy | None = None, spec: dict |
     rest = head.positions(np.asarray(base_positions, np.float64))[:n].astype(np.float64)
     scale = character_scale(head, base_positions)
     tri = anat.triangles
-    normal = vertex_normals(rest, tri, n)
+    normal = vertex_normals(rest[:n], tri, dtype=np.float64)
     area = vertex_areas(rest, tri, n)
     tissue = anat.tissue
     depth = tissue["depth"] * scale
