@@ -66,6 +66,7 @@ _WHERE = {
     "ETHNICITIES": ("facsim.head.character", "facsim.character"),
     "load_face_data": ("facsim.head.assets", "facsim.assets"),
     "cache_dir": ("facsim.head.assets", "facsim.assets"),
+    "EASINGS": ("facsim.timeline.easing", "facsim.easing"),
     "VIEWS": ("facsim.render.camera", "facsim.camera"),
     "hex_to_rgb": ("facsim.head.appearance", "facsim.appearance"),
     "register_table": ("facsim.engines.registers", "facsim.registers"),

@@ -241,7 +241,7 @@ def create_app(*, workdir, token: str | None = None, allowed_hosts: set[str] | N
                 "intensity_tables": {k: dict(v) for k, v in compat.INTENSITY_TABLES.items()},
                 "views": {k: {"yaw": v[0], "pitch": v[1]} for k, v in compat.VIEWS.items()},
                 "engines": list(checks.ENGINES), "antialias": list(checks.ANTIALIAS), "rigid": rigid,
-                "max_size": checks.MAX_SIZE}
+                "max_size": checks.MAX_SIZE, "easings": list(compat.EASINGS)}
 
     @app.get("/api/emotions")
     async def emotions():
