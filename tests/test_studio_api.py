@@ -189,7 +189,14 @@ def test_render_rejects_bad_input_naming_the_field(client, body, field):
     assert problem(client.post("/api/render", json=body), 422)["field"] == field
 
 
+def test_render_with_the_muscle_engine(client):
+    r = client.post("/api/render", json={"expression": "4+6", "engine": "muscle", "options": {"size": 32}})
+    assert r.status_code == 200 and r.content.startswith(b"\x89PNG")
+
+
 def test_render_bad_body_shapes(client):
+    assert "Content-Type" in problem(client.post("/api/render", content=b'{"expression": "12"}',
+                                                 headers={"content-type": "text/plain"}), 415)["error"]
     problem(client.post("/api/render", json=[1, 2]), 400)
     problem(client.post("/api/render", content=b"x" * (2 << 20), headers={"content-type": "application/json"}), 413)
 

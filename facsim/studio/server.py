@@ -110,6 +110,11 @@ def _query(query: str, name: str) -> str | None:
 
 
 async def json_body(request: Request):
+    """The request's JSON. Only ``application/json`` is read: other pages cannot send that
+    cross-origin without a CORS preflight, which this server never grants (no CSRF)."""
+    kind = request.headers.get("content-type", "").split(";")[0].strip().lower()
+    if kind != "application/json":
+        raise RequestError(f"send JSON with Content-Type: application/json, not {kind or 'no type'!r}", status=415)
     try:
         return json.loads(await request.body() or b"null")
     except (json.JSONDecodeError, UnicodeDecodeError) as exc:
