@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 
 
 def _port(text: str) -> int:
@@ -33,12 +34,28 @@ def cmd_studio(args) -> None:
         raise ValueError("the studio needs its extra: pip install 'facsim[studio]' (or run install.sh)")
     if args.queue < 1:
         raise ValueError(f"--queue must be at least 1, got {args.queue}")
+    _check_free(args.host, args.port)
     from .server import serve
 
+    serve(host=args.host, port=args.port, open_browser=args.open, token=args.token, max_pending=args.queue)
+
+
+def _check_free(host: str, port: int) -> None:
+    """Fail in one line, before starting anything, when the address cannot be used."""
+    import socket
+
     try:
-        serve(host=args.host, port=args.port, open_browser=args.open, token=args.token, max_pending=args.queue)
-    except OSError as exc:
-        raise ValueError(f"cannot listen on {args.host}:{args.port}: {exc.strerror or exc}") from None
+        infos = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)
+    except socket.gaierror as exc:
+        raise ValueError(f"--host {host!r} is not an address of this machine: {exc.strerror}") from None
+    family, _, _, _, address = infos[0]
+    with socket.socket(family, socket.SOCK_STREAM) as probe:
+        probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            probe.bind(address)
+        except OSError as exc:
+            raise ValueError(f"cannot listen on {host}:{port}: {exc.strerror or exc} "
+                             f"(another program uses it? try --port {port + 1})") from None
 
 
 def main(argv=None) -> int:
@@ -52,6 +69,6 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         return 130
     except ValueError as exc:
-        print(f"facsim: error: {exc}")
+        print(f"facsim: error: {exc}", file=sys.stderr)
         return 2
     return 0
