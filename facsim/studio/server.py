@@ -2,7 +2,7 @@
 
 Handlers validate input (:mod:`facsim.studio.requests`), answer small
 questions themselves (parse, catalogue, timeline curves) and send anything
-that renders to the worker process through :class:`~facsim.studio.queue.RenderQueue`.
+that renders to the worker process through :class:`~facsim.studio.jobs.RenderQueue`.
 
 Safety, by default: the server listens on loopback and accepts only loopback
 ``Host`` headers (no DNS rebinding); on any other address a token is required
@@ -25,7 +25,7 @@ from fastapi import FastAPI, Request
 from fastapi.responses import FileResponse, JSONResponse, Response, StreamingResponse
 
 from . import compat, requests as checks, worker
-from .queue import Busy, RenderQueue
+from .jobs import Busy, RenderQueue
 from .requests import RequestError
 from .vendor import VENDOR_ROOTS, VendorError, ensure_three, safe_vendor_path
 
@@ -501,7 +501,7 @@ def serve(*, host: str = "127.0.0.1", port: int = 8000, open_browser: bool = Fal
 
     import uvicorn
 
-    from .queue import default_workdir
+    from .jobs import default_workdir
 
     ensure_three()    # fetch three.js now, with a clear error, not when the page asks
     loopback = is_loopback(host)

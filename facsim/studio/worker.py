@@ -1,7 +1,7 @@
 """The studio's render worker: the one process that owns the OpenGL context.
 
 Everything here runs inside a process started with ``spawn`` by
-:class:`facsim.studio.queue.RenderQueue`; HTTP handlers never call it directly.
+:class:`facsim.studio.jobs.RenderQueue`; HTTP handlers never call it directly.
 The first render creates the GL context in this process (never before a fork:
 a forked EGL context hangs). Faces are cached per (character, engine), so
 moving a slider and pressing Render again costs one frame.
