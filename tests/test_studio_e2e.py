@@ -188,7 +188,7 @@ def test_timeline_clip_exports_mp4_with_progress_and_glb(page, server, tmp_path)
         from PIL import Image
 
         image = Image.open(io.BytesIO(screenshot)).convert("RGB")
-        image.thumbnail((1100, 1100))
+        image.thumbnail((1000, 1000))
         image.save(ROOT / "docs" / "studio.png", optimize=True)
 
 

@@ -203,7 +203,8 @@ function setLevel(code, side, value) {
   S.emotion = null;
   showExpression(); syncSliders(); updateFacsFromSliders();
 }
-function showExpression() { S.mode = 'expression'; stop(); viewer.apply(S.levels); }
+function showMode(text, timeline) { const m = $('#mode'); m.textContent = text; m.classList.toggle('timeline', timeline); }
+function showExpression() { S.mode = 'expression'; stop(); viewer.apply(S.levels); showMode('showing the sliders', false); }
 const updateFacsFromSliders = debounce(async () => {
   const levels = Object.fromEntries(Object.entries(S.levels));
   try {
@@ -325,7 +326,7 @@ function timelineLevels(t) {
 }
 function showTime(t) {
   $('#clock').textContent = `${t.toFixed(2)} s`;
-  if (S.curves) { S.mode = 'timeline'; viewer.apply(timelineLevels(t)); }
+  if (S.curves) { S.mode = 'timeline'; viewer.apply(timelineLevels(t)); showMode(`showing the timeline at ${t.toFixed(2)} s`, true); }
 }
 const refreshPreview = debounce(async doc => {
   $('#duration').value = doc.duration; $('#fps').value = doc.fps;
