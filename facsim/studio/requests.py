@@ -33,6 +33,8 @@ ENGINES = ("registers", "muscle")
 PROJECTIONS = ("perspective", "orthographic")
 NAMED_COLORS = {"white": "#ffffff", "black": "#000000", "grey": "#808080", "gray": "#808080"}
 VIDEO_FORMATS = ("mp4", "webm", "gif")
+#: Points per track in the editor's drawing of its shape.
+DRAW_SAMPLES = 241
 
 
 class RequestError(ValueError):
@@ -308,4 +310,10 @@ def timeline_preview(document: Any) -> dict:
     out: dict[str, dict[str, list[float]]] = {}
     for (code, side), values in curves.items():
         out.setdefault(str(code), {})[side] = [round(float(v), 4) for v in values]
-    return {"fps": timeline.fps, "length": timeline.length, "frames": len(times), "curves": out}
+    # Each track's own level on a finer grid, for drawing its shape (easing included) in the editor.
+    import numpy as np
+
+    grid = np.linspace(0.0, timeline.length, DRAW_SAMPLES)
+    shapes = [[round(float(v), 4) for v in track.levels(grid)] for track in timeline.tracks]
+    return {"fps": timeline.fps, "length": timeline.length, "frames": len(times), "curves": out,
+            "shapes": {"step": timeline.length / (DRAW_SAMPLES - 1), "levels": shapes}}

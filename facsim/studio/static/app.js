@@ -328,10 +328,14 @@ function showTime(t) {
   $('#clock').textContent = `${t.toFixed(2)} s`;
   if (S.curves) { S.mode = 'timeline'; viewer.apply(timelineLevels(t)); showMode(`showing the timeline at ${t.toFixed(2)} s`, true); }
 }
-const refreshPreview = debounce(async doc => {
+let previewSerial = 0;
+function timelineChanged(doc) { refreshPreview(doc, ++previewSerial); }
+const refreshPreview = debounce(async (doc, serial) => {
   $('#duration').value = doc.duration; $('#fps').value = doc.fps;
   try {
-    S.curves = await api('/api/timeline/preview', {timeline: doc});
+    const preview = await api('/api/timeline/preview', {timeline: doc});
+    if (serial !== previewSerial) return;          // the document changed meanwhile
+    S.curves = preview; editor.setShapes(preview.shapes);
     showError($('#timeline-error'), null);
     if (S.mode === 'timeline') showTime(editor.time);
   } catch (err) { showError($('#timeline-error'), err); }
@@ -501,7 +505,7 @@ async function main() {
     e.target.value = '';
   });
   // timeline
-  editor = new TimelineEditor($('#timeline-canvas'), {units: S.units, onChange: refreshPreview, onSeek: showTime, onSelect: inspector});
+  editor = new TimelineEditor($('#timeline-canvas'), {units: S.units, onChange: timelineChanged, onSeek: showTime, onSelect: inspector});
   S.editor = editor;
   for (const u of catalogue.units.filter(u => u.simulated)) $('#add-au').append(el('option', {value: u.code}, `AU${u.code} ${u.name}`));
   $('#add-au').value = 12;

@@ -56,6 +56,7 @@ export class TimelineEditor {
     this.onChange = onChange; this.onSeek = onSeek; this.onSelect = onSelect;
     this.doc = {duration: 3, fps: 30, intensities: 'hapfacs', tracks: []};
     this.time = 0; this.selected = -1; this.drag = null;
+    this.shapes = null;   // each track's sampled level from the server (easings drawn exactly)
     canvas.addEventListener('pointerdown', e => this.down(e));
     canvas.addEventListener('pointermove', e => this.move(e));
     canvas.addEventListener('pointerup', e => this.up(e));
@@ -64,7 +65,9 @@ export class TimelineEditor {
 
   get duration() { return this.doc.duration || Math.max(1, ...this.doc.tracks.map(trackEnd)); }
   setDocument(doc) { this.doc = doc; this.selected = -1; this.onSelect(-1); this.changed(); }
-  changed() { this.draw(); this.onChange(this.doc); }
+  changed() { this.shapes = null; this.draw(); this.onChange(this.doc); }
+  /** The server's sampled shapes for the document as it is now. */
+  setShapes(shapes) { this.shapes = shapes; this.draw(); }
 
   lanes() {
     const lanes = new Map();
@@ -147,16 +150,25 @@ export class TimelineEditor {
       if (pts.length) pts = [[pts[0][0], 0], ...pts, [pts[pts.length - 1][0], 0]];
     }
     if (!pts.length) return;
+    const handles = pts;
+    if (this.shapes && !this.drag && this.shapes.levels[i]) {   // the exact shape, easing included
+      const step = this.shapes.step;
+      const levels = this.shapes.levels[i];
+      const first = Math.max(0, levels.findIndex(v => v > 0) - 1);
+      const last = Math.min(levels.length - 1, levels.length - [...levels].reverse().findIndex(v => v > 0));
+      if (first <= last) pts = levels.slice(first, last + 1).map((v, k) => [(first + k) * step, v]);
+    }
     g.beginPath();
     pts.forEach(([t, v], k) => k ? g.lineTo(this.x(t), y(v)) : g.moveTo(this.x(t), y(v)));
+    g.lineTo(this.x(pts[pts.length - 1][0]), y(0)); g.lineTo(this.x(pts[0][0]), y(0));
     g.closePath(); g.fill(); g.stroke();
     if (track.side && track.side !== 'both') {
       g.fillStyle = '#2f6f8f'; g.fillText(track.side === 'left' ? 'L' : track.side === 'right' ? 'R' : 'U',
-                                         this.x(pts[0][0]) + 3, top + 12);
+                                         this.x(handles[0][0]) + 3, top + 12);
     }
     if (selected && clip && !clip.hold) {
       g.fillStyle = '#2f6f8f';
-      for (const [t, v] of pts) { g.beginPath(); g.arc(this.x(t), y(v), 4.5, 0, 7); g.fill(); }
+      for (const [t, v] of handles) { g.beginPath(); g.arc(this.x(t), y(v), 4.5, 0, 7); g.fill(); }
     }
   }
 
