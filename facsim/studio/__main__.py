@@ -1,6 +1,6 @@
-"""``python -m facsim.studio [--port 8000] [--host 127.0.0.1] [--open]``."""
+"""``python -m facsim.studio [--port 8000] [--host 127.0.0.1] [--open]``: the same as ``facsim studio``."""
 import sys
 
-from .cli import main
+from facsim.cli import main
 
-sys.exit(main(sys.argv[1:]))
+sys.exit(main(["studio", *sys.argv[1:]]))

@@ -47,6 +47,8 @@ class Job:
     filename: str | None = None
     created: float = field(default_factory=time.time)
     future: Future | None = None
+    #: Every (done, total) the worker reported, in order: what the job's event stream replays.
+    history: list = field(default_factory=list)
 
     def to_json(self) -> dict:
         return {"id": self.id, "kind": self.kind, "state": self.state, "done": self.done, "total": self.total,
@@ -195,8 +197,10 @@ class RenderQueue:
                 return
             job_id, done, total = message
             job = self.jobs.get(job_id)
-            if job is not None and not job.finished:
-                job.state, job.done, job.total = "running", done, total
+            if job is not None:
+                job.history.append((done, total))
+                if not job.finished:
+                    job.state, job.done, job.total = "running", done, total
 
     # --------------------------------------------------------- lifetime ---
     def worker_pid(self) -> int:

@@ -29,7 +29,6 @@ MAX_SIZE = 2048
 #: Longest timeline the studio samples or renders, in frames.
 MAX_FRAMES = 30 * 600
 ANTIALIAS = (1, 2, 4, 8, "fxaa")
-ENGINES = ("registers", "muscle")
 PROJECTIONS = ("perspective", "orthographic")
 NAMED_COLORS = {"white": "#ffffff", "black": "#000000", "grey": "#808080", "gray": "#808080"}
 VIDEO_FORMATS = ("mp4", "webm", "gif")
@@ -66,6 +65,11 @@ def number(value: Any, field: str, low: float, high: float) -> float:
     if not low <= value <= high:
         raise RequestError(f"{field} must be between {low:g} and {high:g}, got {value!r}", field=field)
     return float(value)
+
+
+def engine(value: Any) -> str:
+    """An engine name from :data:`facsim.engines.ENGINES` (default: facsim's default engine)."""
+    return choice(value or compat.DEFAULT_ENGINE, tuple(compat.ENGINES), "engine")
 
 
 def intensities_table(value: Any = "hapfacs") -> str:

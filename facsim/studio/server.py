@@ -17,6 +17,7 @@ import asyncio
 import hashlib
 import hmac
 import json
+import time
 from collections import OrderedDict
 from importlib import resources
 from pathlib import Path
@@ -245,7 +246,7 @@ def create_app(*, workdir, token: str | None = None, allowed_hosts: set[str] | N
         return {"units": units, "regions": ["upper face", "lower face", "head", "eyes"],
                 "intensity_tables": {k: dict(v) for k, v in compat.INTENSITY_TABLES.items()},
                 "views": {k: {"yaw": v[0], "pitch": v[1]} for k, v in compat.VIEWS.items()},
-                "engines": list(checks.ENGINES), "antialias": list(checks.ANTIALIAS), "rigid": rigid,
+                "engines": list(compat.ENGINES), "antialias": list(checks.ANTIALIAS), "rigid": rigid,
                 "max_size": checks.MAX_SIZE, "easings": list(compat.EASINGS)}
 
     @app.get("/api/emotions")
@@ -350,7 +351,7 @@ def create_app(*, workdir, token: str | None = None, allowed_hosts: set[str] | N
             raise RequestError("send {\"expression\": ..., \"character\": ..., \"options\": {...}}", status=400)
         table = checks.intensities_table(body.get("intensities"))
         return {"character": checks.character_params(body.get("character")),
-                "engine": checks.choice(body.get("engine", "registers"), checks.ENGINES, "engine"),
+                "engine": checks.engine(body.get("engine")),
                 "expression": checks.expression_text(body.get("expression", "neutral"), table),
                 "intensities": table,
                 "options": checks.render_options(body.get("options"))}
@@ -418,7 +419,7 @@ def create_app(*, workdir, token: str | None = None, allowed_hosts: set[str] | N
             spec = {"timeline": body["timeline"], "character": checks.character_params(body.get("character"))}
             if kind == "video":
                 spec.update(format=checks.choice(body.get("format", "mp4"), checks.VIDEO_FORMATS, "format"),
-                            engine=checks.choice(body.get("engine", "registers"), checks.ENGINES, "engine"),
+                            engine=checks.engine(body.get("engine")),
                             options=checks.render_options(body.get("options"), video=True))
         job = queue().start_job(kind, spec)
         return job.to_json()
@@ -445,24 +446,28 @@ def create_app(*, workdir, token: str | None = None, allowed_hosts: set[str] | N
         job = find_job(job_id)
 
         async def events():
-            last = None
-            idle = 0
+            sent, idle, finished_at = 0, 0, None
+            yield f"event: progress\ndata: {json.dumps(job.to_json())}\n\n"
             while True:
-                snapshot = job.to_json()
-                key = (snapshot["state"], snapshot["done"], snapshot["total"])
-                if job.finished:
-                    yield f"event: {job.state}\ndata: {json.dumps(snapshot)}\n\n"
-                    return
-                if key != last:
-                    last, idle = key, 0
+                while sent < len(job.history):        # every step the worker reported, in order
+                    done, total = job.history[sent]
+                    sent += 1
+                    snapshot = dict(job.to_json(), state="running", done=done, total=total)
                     yield f"event: progress\ndata: {json.dumps(snapshot)}\n\n"
-                else:
-                    idle += 1
-                    if idle % 40 == 0:
-                        yield ": still working\n\n"
+                    idle = 0
+                if job.finished:
+                    # the last reports may still be on their way from the worker: wait for them briefly
+                    finished_at = finished_at or time.monotonic()
+                    caught_up = job.history and job.history[-1][0] >= job.history[-1][1]
+                    if caught_up or job.state != "done" or time.monotonic() - finished_at > 1.0:
+                        yield f"event: {job.state}\ndata: {json.dumps(job.to_json())}\n\n"
+                        return
+                idle += 1
+                if idle % 40 == 0:
+                    yield ": still working\n\n"
                 if await request.is_disconnected():
                     return
-                await asyncio.sleep(0.25)
+                await asyncio.sleep(0.1)
 
         return StreamingResponse(events(), media_type="text/event-stream",
                                  headers={"Cache-Control": "no-store", "X-Accel-Buffering": "no"})

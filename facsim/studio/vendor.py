@@ -41,10 +41,8 @@ class VendorError(RuntimeError):
 
 
 def _cache_dir() -> Path:
-    try:
-        from facsim.head.assets import cache_dir
-    except ImportError:  # before the layout refactor
-        from facsim.assets import cache_dir
+    from facsim.head.assets import cache_dir
+
     return cache_dir()
 
 

@@ -163,20 +163,16 @@ def _write(folder: Path, name: str, data: bytes, job_id: str) -> str:
 
 
 def _video(job_id: str, folder: Path, timeline, spec: dict) -> str:
-    """The frame loop of ``facsim animate``, reporting each frame and stopping when cancelled."""
-    from facsim.studio.compat import VideoWriter, sample_frames
+    """``facsim animate`` into the job folder, reporting each frame; stops at the next frame when cancelled."""
+    from facsim.pipeline import animate
 
     name = f"clip.{spec['format']}"
-    fps = timeline.fps
-    frames = sample_frames(timeline, fps)
-    face = face_for(spec["character"], spec["engine"])
-    options = _options(spec["options"])
-    total = len(frames)
-    _report(job_id, 0, total)
-    with VideoWriter(folder / name, fps) as writer:
-        state = face.start_animation()
-        for i, act in enumerate(frames):
-            _check_cancel(folder)
-            writer.append(face.render(**state.step(act)._asdict(), **options))
-            _report(job_id, i + 1, total)
+    _report(job_id, 0, 0)
+
+    def on_frame(done: int, total: int) -> None:
+        _report(job_id, done, total)
+        _check_cancel(folder)
+
+    animate(timeline, folder / name, face=face_for(spec["character"], spec["engine"]), on_frame=on_frame,
+            **_options(spec["options"]))
     return name

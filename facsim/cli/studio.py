@@ -1,8 +1,7 @@
-"""``facsim studio``: the browser workbench (registered by facsim's CLI as a command group)."""
+"""The CLI's ``facsim studio``: the browser workbench (:mod:`facsim.studio`)."""
 from __future__ import annotations
 
 import argparse
-import sys
 
 
 def _port(text: str) -> int:
@@ -15,7 +14,7 @@ def _port(text: str) -> int:
     return port
 
 
-def add_commands(sub, *_) -> None:
+def add_commands(sub) -> None:
     p = sub.add_parser("studio", help="open the browser workbench: sliders, 3-D preview, timeline, exports")
     p.add_argument("--port", type=_port, default=8000, help="port to listen on (default 8000)")
     p.add_argument("--host", default="127.0.0.1",
@@ -35,7 +34,7 @@ def cmd_studio(args) -> None:
     if args.queue < 1:
         raise ValueError(f"--queue must be at least 1, got {args.queue}")
     _check_free(args.host, args.port)
-    from .server import serve
+    from facsim.studio.server import serve
 
     serve(host=args.host, port=args.port, open_browser=args.open, token=args.token, max_pending=args.queue)
 
@@ -57,18 +56,3 @@ def _check_free(host: str, port: int) -> None:
             raise ValueError(f"cannot listen on {host}:{port}: {exc.strerror or exc} "
                              f"(another program uses it? try --port {port + 1})") from None
 
-
-def main(argv=None) -> int:
-    """``python -m facsim.studio``: the same command without the rest of the CLI."""
-    parser = argparse.ArgumentParser(prog="facsim studio")
-    sub = parser.add_subparsers(dest="command")
-    add_commands(sub)
-    args = parser.parse_args(["studio", *(argv or [])])
-    try:
-        args.handler(args)
-    except KeyboardInterrupt:
-        return 130
-    except ValueError as exc:
-        print(f"facsim: error: {exc}", file=sys.stderr)
-        return 2
-    return 0
