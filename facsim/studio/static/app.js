@@ -443,7 +443,8 @@ async function startExport(kind, format) {
   const finish = (text, link) => { events.close(); cancel.remove(); state.replaceChildren(text, link || ''); item.dataset.state = text; };
   events.addEventListener('progress', e => {
     const j = JSON.parse(e.data); bar.max = j.total || 1; bar.value = j.done;
-    state.textContent = j.state === 'queued' ? 'waiting…' : `${j.done} / ${j.total}`;
+    state.textContent = j.state === 'queued' ? 'waiting…' : !j.total ? 'starting…'
+      : kind === 'video' ? `frame ${j.done} of ${j.total}` : 'working…';
     item.dataset.progress = (+item.dataset.progress || 0) + 1;
   });
   events.addEventListener('done', e => {
