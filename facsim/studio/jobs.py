@@ -203,9 +203,6 @@ class RenderQueue:
                     job.state, job.done, job.total = "running", done, total
 
     # --------------------------------------------------------- lifetime ---
-    def worker_pid(self) -> int:
-        return self.submit(worker.ping).result(timeout=120)
-
     def close(self) -> None:
         """Cancel what waits, stop the worker and the progress reader."""
         with self._lock:

@@ -7,14 +7,13 @@ a forked EGL context hangs). Faces are cached per (character, engine), so
 moving a slider and pressing Render again costs one frame.
 
 Each public function takes plain data (already validated by
-:mod:`facsim.studio.requests`) and returns bytes or a file name inside the
-job folder it was given; it never writes anywhere else.
+:mod:`facsim.studio.requests`) and returns bytes or a file name. Jobs write
+only inside the job folder they are given; thumbnails go to facsim's cache.
 """
 from __future__ import annotations
 
 import io
 import json
-import os
 from collections import OrderedDict
 from pathlib import Path
 
@@ -35,11 +34,6 @@ def init(progress_queue) -> None:
     """Process initializer: remember where progress goes."""
     global _progress
     _progress = progress_queue
-
-
-def ping() -> int:
-    """The worker's process id (health checks)."""
-    return os.getpid()
 
 
 def face_for(character: dict | str, engine: str = "registers"):
