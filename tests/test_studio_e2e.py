@@ -192,6 +192,30 @@ def test_timeline_clip_exports_mp4_with_progress_and_glb(page, server, tmp_path)
         image.save(ROOT / "docs" / "studio.png", optimize=True)
 
 
+def test_character_and_timeline_files_round_trip(page, tmp_path):
+    page.click("button[data-tab=character]")
+    page.fill("#seed", "5")
+    page.click("#random")
+    page.wait_for_function("document.querySelector('#status').textContent.startsWith('random:5')", timeout=120_000)
+    with page.expect_download() as download:
+        page.click("#character-save")
+    saved = tmp_path / "person.yaml"
+    download.value.save_as(saved)
+    assert "name: random:5" in saved.read_text()
+    page.click("button[data-character=ava]")
+    page.wait_for_function("document.querySelector('#status').textContent.startsWith('ava')", timeout=120_000)
+    page.set_input_files("#character-load", str(saved))
+    page.wait_for_function("document.querySelector('#status').textContent.startsWith('random:5')", timeout=120_000)
+    page.click("button[data-tab=expression]")
+    page.set_input_files("#timeline-load", str(ROOT / "examples" / "overlapping_aus.yaml"))
+    page.wait_for_function("studio.editor.doc.tracks.length === 5 && studio.editor.shapes !== null")
+    assert [lane["label"][:4] for lane in page.evaluate("() => studio.editor.lanes()")] == ["AU6 ", "AU12", "AU51"]
+    with page.expect_download() as download:
+        page.click("#timeline-save-json")
+    download.value.save_as(tmp_path / "t.json")
+    assert json.loads((tmp_path / "t.json").read_text())["tracks"][0]["segments"][0]["easing"] == "smoothstep"
+
+
 def test_fifty_concurrent_renders_are_answered_or_refused(server):
     from facsim.studio.loadtest import describe, run
 
