@@ -68,7 +68,7 @@ def page(server):
     url, _ = server
     with playwright.sync_playwright() as p:
         browser = p.chromium.launch(executable_path=CHROMIUM, args=QUIET)
-        page = browser.new_page(viewport={"width": 1360, "height": 940})
+        page = browser.new_page(viewport={"width": 1440, "height": 940})
         errors = []
         page.on("pageerror", lambda exc: errors.append(str(exc)))
         page.goto(url + "/")
