@@ -4,18 +4,15 @@ Handlers validate input (:mod:`facsim.studio.requests`), answer small
 questions themselves (parse, catalogue, timeline curves) and send anything
 that renders to the worker process through :class:`~facsim.studio.jobs.RenderQueue`.
 
-Safety, by default: the server listens on loopback and accepts only loopback
-``Host`` headers (no DNS rebinding); on any other address a token is required
-(``?token=`` once, then a cookie, or the ``X-Facsim-Token`` header). Request
-bodies are size-limited, the queue is bounded (a full queue answers 503 at
-once), every error is JSON naming the problem, and files are served only by
-job id from the job's own folder.
+Safety, by default: loopback only, a token elsewhere, size-limited bodies
+(:mod:`facsim.studio.guard`); a bounded queue (a full queue answers 503 at
+once); every error is JSON naming the problem; files are served only by job
+id from the job's own folder.
 """
 from __future__ import annotations
 
 import asyncio
 import hashlib
-import hmac
 import json
 import time
 from collections import OrderedDict
@@ -26,6 +23,7 @@ from fastapi import FastAPI, Request
 from fastapi.responses import FileResponse, JSONResponse, Response, StreamingResponse
 
 from . import compat, requests as checks, worker
+from .guard import LOOPBACK, TOKEN_COOKIE, Guard, error, is_loopback, query
 from .jobs import Busy, RenderQueue
 from .requests import RequestError
 from .vendor import VENDOR_ROOTS, VendorError, ensure_three, safe_vendor_path
@@ -34,80 +32,9 @@ from .vendor import VENDOR_ROOTS, VendorError, ensure_three, safe_vendor_path
 MAX_BODY = 1 << 20
 STATIC_FILES = {"app.js": "text/javascript", "timeline.js": "text/javascript", "style.css": "text/css",
                 "index.html": "text/html"}
-TOKEN_COOKIE = "facsim_token"
 THUMBNAIL_VERSION = 1
 MEDIA_TYPES = {".png": "image/png", ".mp4": "video/mp4", ".webm": "video/webm", ".gif": "image/gif",
                ".glb": "model/gltf-binary", ".csv": "text/csv", ".facs": "text/plain"}
-
-
-def error(status: int, message: str, **extra) -> JSONResponse:
-    return JSONResponse({"error": message, **extra}, status_code=status)
-
-
-class Guard:
-    """ASGI middleware: token check, ``Host`` check and the body size limit, before any handler runs."""
-
-    def __init__(self, app, *, token: str | None, allowed_hosts: set[str] | None, max_body: int):
-        self.app, self.token, self.allowed_hosts, self.max_body = app, token, allowed_hosts, max_body
-
-    async def __call__(self, scope, receive, send):
-        if scope["type"] != "http":
-            return await self.app(scope, receive, send)
-        headers = {k.decode("latin-1").lower(): v.decode("latin-1") for k, v in scope["headers"]}
-        problem = self._refuse(scope, headers)
-        if problem is not None:
-            return await problem(scope, receive, send)
-        length = headers.get("content-length")
-        if length is not None and (not length.isdigit() or int(length) > self.max_body):
-            return await error(413, f"request body is larger than {self.max_body} bytes")(scope, receive, send)
-        seen = 0
-
-        async def limited_receive():
-            nonlocal seen
-            message = await receive()
-            seen += len(message.get("body", b""))
-            if seen > self.max_body:
-                raise _TooLarge()
-            return message
-
-        try:
-            await self.app(scope, limited_receive, send)
-        except _TooLarge:
-            await error(413, f"request body is larger than {self.max_body} bytes")(scope, receive, send)
-
-    def _refuse(self, scope, headers):
-        if self.allowed_hosts is not None:
-            host = headers.get("host", "").rsplit(":", 1)[0] if not headers.get("host", "").startswith("[") \
-                else headers["host"].split("]")[0] + "]"
-            if host not in self.allowed_hosts:
-                return error(403, f"host {host!r} is not allowed; open the studio at http://127.0.0.1")
-        if self.token is None:
-            return None
-        given = headers.get("x-facsim-token") or _cookie(headers.get("cookie", ""), TOKEN_COOKIE) \
-            or _query(scope.get("query_string", b"").decode("latin-1"), "token")
-        if given and hmac.compare_digest(given.encode(), self.token.encode()):
-            return None
-        return error(401, "this studio needs its token: open the address printed when `facsim studio` started "
-                          "(…/?token=…)")
-
-
-class _TooLarge(Exception):
-    pass
-
-
-def _cookie(header: str, name: str) -> str | None:
-    for part in header.split(";"):
-        key, _, value = part.strip().partition("=")
-        if key == name:
-            return value
-    return None
-
-
-def _query(query: str, name: str) -> str | None:
-    from urllib.parse import parse_qs
-
-    values = parse_qs(query).get(name)
-    return values[0] if values else None
 
 
 async def json_body(request: Request):
@@ -200,7 +127,7 @@ def create_app(*, workdir, token: str | None = None, allowed_hosts: set[str] | N
     async def page(request: Request):
         html = (static / "index.html").read_text(encoding="utf-8")
         response = Response(html, media_type="text/html", headers={"Cache-Control": "no-store"})
-        if token and _query(request.url.query, "token") == token:
+        if token and query(request.url.query, "token") == token:
             response.set_cookie(TOKEN_COOKIE, token, httponly=True, samesite="strict")
         return response
 
@@ -482,20 +409,6 @@ def create_app(*, workdir, token: str | None = None, allowed_hosts: set[str] | N
                             filename=path.name)
 
     return Guard(app, token=token, allowed_hosts=allowed_hosts, max_body=max_body)
-
-
-LOOPBACK = {"127.0.0.1", "localhost", "::1", "[::1]"}
-
-
-def is_loopback(host: str) -> bool:
-    import ipaddress
-
-    if host == "localhost":
-        return True
-    try:
-        return ipaddress.ip_address(host).is_loopback
-    except ValueError:
-        return False
 
 
 def serve(*, host: str = "127.0.0.1", port: int = 8000, open_browser: bool = False, token: str | None = None,
