@@ -1,0 +1,6 @@
+"""``python -m facsim.studio [--port 8000] [--host 127.0.0.1] [--open]``: the same as ``facsim studio``."""
+import sys
+
+from facsim.cli import main
+
+sys.exit(main(["studio", *sys.argv[1:]]))
