@@ -12,6 +12,7 @@ for pkg in libegl1 libgl1 libgl1-mesa-dri; do
   dpkg -s "$pkg" >/dev/null 2>&1 || need+=("$pkg")
 done
 command -v node >/dev/null 2>&1 || need+=(nodejs npm)   # runs the glTF validator in the tests
+command -v flite >/dev/null 2>&1 || need+=(flite)        # speech synthesis with phone timings (facsim speak)
 if [ ${#need[@]} -gt 0 ]; then
   SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO="sudo"
   $SUDO apt-get update -qq
@@ -19,5 +20,6 @@ if [ ${#need[@]} -gt 0 ]; then
 fi
 
 python3 -m pip install -q -e ".[test]"
+python3 -m pip install -q -e ".[speech]"   # pocketsphinx: forced alignment of recorded speech
 bash tests/gltf_validator/install.sh   # the Khronos glTF validator the tests run (npm, pinned by its lock file)
 python3 -m facsim.cli data

@@ -125,6 +125,8 @@ def _timing_text(timing) -> str:
 
 def dumps_notation(timeline) -> str:
     """The timeline as ``.facs`` text (see the module docstring); :func:`loads_notation` reads it back equal."""
+    if any(hasattr(track, "say") for track in timeline.tracks):
+        raise ValueError(".facs notation has no speech tracks; save a timeline with speech as YAML or JSON")
     lines = [f"{HEADER} {VERSION}", f"fps: {_num(timeline.fps)}"]
     if timeline.duration is not None:
         lines.append(f"duration: {_num(timeline.duration)}")

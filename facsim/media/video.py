@@ -97,7 +97,7 @@ class VideoWriter:
         encoder = imageio_ffmpeg.write_frames(
             str(self._tmp), (width, height), fps=self.fps, codec=codec, pix_fmt_in="rgba", pix_fmt_out="yuv420p",
             quality=self.quality, macro_block_size=1, output_params=extra + (["-shortest"] if self.audio else []),
-            audio_path=self.audio, audio_codec=audio_codec,
+            audio_path=self.audio, audio_codec=audio_codec, ffmpeg_log_level="error",
         )
         encoder.send(None)  # start the generator
         return encoder
