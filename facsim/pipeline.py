@@ -68,7 +68,7 @@ def animate(timeline, path, *, face=None, character=None, engine=None, fps: floa
     try:
         if speech is not None and video_format(path) in ("mp4", "webm"):
             audio = speech.name
-        with VideoWriter(path, fps, audio=audio) as writer:
+        with VideoWriter(path, fps, audio=audio, cut_audio=speech is None) as writer:
             state = face.start_animation()
             for i, act in enumerate(frames):
                 writer.append(face.render(**state.step(act)._asdict(), **render_options))
@@ -92,15 +92,16 @@ def _speech_audio(timeline, fps):
     """A temporary WAV of the timeline's speech, as long as the video (``None`` without speech tracks)."""
     import tempfile
 
-    from facsim.speech.track import AUDIO_RATE, timeline_audio
+    from facsim.speech.track import timeline_audio
 
-    samples = timeline_audio(timeline, fps)
-    if samples is None:
+    speech = timeline_audio(timeline, fps)
+    if speech is None:
         return None
     from scipy.io import wavfile
 
     from facsim.speech.audio import to_pcm16
 
+    samples, rate = speech
     tmp = tempfile.NamedTemporaryFile(prefix="facsim-speech-", suffix=".wav")
-    wavfile.write(tmp.name, AUDIO_RATE, to_pcm16(samples))
+    wavfile.write(tmp.name, rate, to_pcm16(samples))
     return tmp

@@ -22,10 +22,6 @@ import numpy as np
 from .coarticulation import SpeechCurves, speech_curves
 from .utterance import Utterance
 
-#: Audio written beside PNG sequences and muxed into videos.
-AUDIO_RATE = 48000
-
-
 def _error(problem: str, where: str):
     from facsim.timeline.model import TimelineError
 
@@ -129,10 +125,12 @@ def speech_tracks(timeline) -> tuple[SpeechTrack, ...]:
     return tuple(t for t in timeline.tracks if isinstance(t, SpeechTrack))
 
 
-def timeline_audio(timeline, fps: float | None = None, rate: int = AUDIO_RATE) -> np.ndarray | None:
-    """The timeline's speech mixed into one mono track as long as its video (``None`` without speech).
+def timeline_audio(timeline, fps: float | None = None, rate: int | None = None) -> tuple[np.ndarray, int] | None:
+    """The timeline's speech mixed into one mono track as long as its video, and its sample rate
+    (``None`` without speech).
 
     The track lasts exactly ``frame_count / fps`` seconds, so audio and video end together.
+    ``rate`` defaults to the highest rate among the clips (flite's 16 kHz needs no resampling).
     """
     from facsim.timeline.sampling import frame_count
 
@@ -144,9 +142,10 @@ def timeline_audio(timeline, fps: float | None = None, rate: int = AUDIO_RATE) -
     fps = fps or timeline.fps
     duration = frame_count(timeline, fps) / fps
     clips = [(t.start, t.utterance.samples, t.utterance.rate) for t in tracks]
+    rate = rate or max(clip[2] for clip in clips)
     out = mix(clips, duration, rate)
     assert math.isclose(len(out) / rate, duration, abs_tol=1 / rate)
-    return out
+    return out, rate
 
 
 def with_speech(curves, tracks, times) -> dict:
