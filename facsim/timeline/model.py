@@ -38,6 +38,16 @@ Times are seconds from the start of the video; intensities are fractions
         start: 0.5           # constant hold from start (default 0) to end
         end: 1.5
         intensity: 50%
+      - say: "Pack my box."  # speech (facsim.speech.track): synthesised text ...
+        voice: slt           # slt (default), awb, rms, kal16, kal, piper:MODEL
+        start: 0.5
+      - audio: me.wav        # ... or a recording (relative to this file) and its words
+        transcript: "Pack my box."
+        start: 2.0
+
+A speech track's phones become AU curves when the timeline is sampled, so it
+mixes with the other tracks (while it speaks it owns the lips and jaw; see
+:mod:`facsim.speech.combine`) and lasts as long as its audio; videos carry the audio.
 
 Each track has exactly one source (``au``, ``facs`` or ``emotion``) and one
 timing:
