@@ -38,16 +38,6 @@ Times are seconds from the start of the video; intensities are fractions
         start: 0.5           # constant hold from start (default 0) to end
         end: 1.5
         intensity: 50%
-      - say: "Pack my box."  # speech (facsim.speech.track): synthesised text ...
-        voice: slt           # slt (default), awb, rms, kal16, kal, piper:MODEL
-        start: 0.5
-      - audio: me.wav        # ... or a recording (relative to this file) and its words
-        transcript: "Pack my box."
-        start: 2.0
-
-A speech track's phones become AU curves when the timeline is sampled, so it
-mixes with the other tracks (while it speaks it owns the lips and jaw; see
-:mod:`facsim.speech.combine`) and lasts as long as its audio; videos carry the audio.
 
 Each track has exactly one source (``au``, ``facs`` or ``emotion``) and one
 timing:
@@ -61,6 +51,19 @@ timing:
   ``onset``, held for ``apex``, falling to 0 over ``offset``.
 * a hold (``start``, ``end``): the level is ``intensity`` from ``start`` to
   ``end``, with no ramps (a step on and off; use an envelope for ramps).
+
+Speech tracks (:mod:`facsim.speech.track`) say synthesised text or play a recording::
+
+      - say: "Pack my box."  # synthesised text ...
+        voice: slt           # slt (default), awb, rms, kal16, kal, piper:MODEL
+        start: 0.5
+      - audio: me.wav        # ... or a recording (relative to the file) and its words
+        transcript: "Pack my box."
+        start: 2.0
+
+Their phones become AU curves when the timeline is sampled, so they mix with the
+other tracks (while speaking they own the lips and jaw, see
+:mod:`facsim.speech.combine`); each lasts as long as its audio; videos carry the audio.
 
 Every track is active on the half-open interval ``[start, end)``: a track
 contributes 0 at its end time, so a track that ends at 1 s and one that starts
