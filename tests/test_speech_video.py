@@ -210,3 +210,18 @@ def test_speech_example_validates_against_the_schema():
     jsonschema.Draft202012Validator(timeline_schema()).validate(yaml.safe_load(path.read_text()))
     timeline = load_timeline(path)
     assert timeline.tracks[2].end == pytest.approx(0.9 + synthesize("Pack my box with five dozen liquor jugs.").duration)
+
+
+def test_facs_notation_carries_speech_tracks(speech_yaml, tmp_path):
+    from facsim.exchange.notation_file import dumps_notation, loads_notation, read_notation
+    from facsim.speech.audio import write_wav
+
+    timeline = load_timeline(speech_yaml)
+    text = dumps_notation(timeline)
+    assert f'say "{TEXT}" voice=slt @0.25' in text
+    assert loads_notation(text) == timeline
+    u = synthesize(TEXT)
+    write_wav(tmp_path / "me.wav", u.samples, u.rate)
+    (tmp_path / "me.facs").write_text(f'facsim-notation 1\naudio me.wav "{TEXT}" @0.5\n')
+    recording = read_notation(tmp_path / "me.facs")
+    assert recording.tracks[0].audio == str(tmp_path / "me.wav") and recording.length > 1.0
