@@ -82,7 +82,7 @@ def _flite(text: str, voice: str) -> Utterance:
         raise RuntimeError("flite is not installed; run install.sh (or apt-get install flite)")
     with tempfile.TemporaryDirectory(prefix="facsim-flite-") as tmp:
         wav = Path(tmp) / "speech.wav"
-        # "--" guards text that starts with a dash; -psdur prints "phone:end" pairs.
+        # -psdur prints "phone:end" pairs; -t takes the next argument as text even if it starts with "-".
         run = subprocess.run([exe, "-voice", voice, "-psdur", "-t", text, "-o", str(wav)],
                              capture_output=True, text=True, timeout=300)
         if run.returncode != 0 or not wav.is_file():
