@@ -13,13 +13,14 @@ for pkg in libegl1 libgl1 libgl1-mesa-dri; do
 done
 command -v node >/dev/null 2>&1 || need+=(nodejs npm)   # runs the glTF validator in the tests
 command -v chromium >/dev/null 2>&1 || need+=(chromium)  # the studio's end-to-end tests drive it (Playwright)
+command -v flite >/dev/null 2>&1 || need+=(flite)        # speech synthesis with phone timings (facsim speak)
 if [ ${#need[@]} -gt 0 ]; then
   SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO="sudo"
   $SUDO apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${need[@]}"
 fi
 
-python3 -m pip install -q -e ".[test,studio,studio-test]"
+python3 -m pip install -q -e ".[test,studio,studio-test,speech]"
 bash tests/gltf_validator/install.sh   # the Khronos glTF validator the tests run (npm, pinned by its lock file)
 python3 -m facsim.cli data
 python3 -m facsim.studio.vendor   # three.js for the studio page (npm registry tarball, sha512 checked)

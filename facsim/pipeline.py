@@ -47,9 +47,13 @@ def animate(timeline, path, *, face=None, character=None, engine=None, fps: floa
     Returns
     -------
     Path of the finished file.
+
+    A timeline with speech tracks gets their sound (unless ``audio`` is given):
+    AAC in MP4, Opus in WebM, a WAV beside PNG frames (``frames/`` → ``frames.wav``);
+    GIFs have no sound.
     """
     from facsim.face import Face
-    from facsim.media.video import VideoWriter
+    from facsim.media.video import VideoWriter, video_format
     from facsim.timeline.sampling import sample_frames
 
     if face is not None and (character is not None or engine is not None):
@@ -60,14 +64,44 @@ def animate(timeline, path, *, face=None, character=None, engine=None, fps: floa
         face = Face(character or timeline.character or "ava", engine=engine or timeline.engine or "registers")
     fps = fps or timeline.fps
     frames = sample_frames(timeline, fps)
+    speech = None if audio is not None else _speech_audio(timeline, fps)
     try:
-        with VideoWriter(path, fps, audio=audio) as writer:
+        if speech is not None and video_format(path) in ("mp4", "webm"):
+            audio = speech.name
+        with VideoWriter(path, fps, audio=audio, cut_audio=speech is None) as writer:
             engine = face.start_animation()
             for i, act in enumerate(frames):
                 writer.append(face.render(deformation=engine.step(act), **render_options))
                 if on_frame is not None:
                     on_frame(i + 1, len(frames))
+        if speech is not None and writer.format == "png":     # PNG frames: the sound goes beside them
+            import shutil
+
+            from facsim.atomic import atomic_write
+
+            atomic_write(writer.path.with_suffix(".wav"), lambda tmp: shutil.copyfile(speech.name, tmp))
         return writer.path
     finally:
         if own_face:
             face.close()
+        if speech is not None:
+            speech.close()
+
+
+def _speech_audio(timeline, fps):
+    """A temporary WAV of the timeline's speech, as long as the video (``None`` without speech tracks)."""
+    import tempfile
+
+    from facsim.speech.track import timeline_audio
+
+    speech = timeline_audio(timeline, fps)
+    if speech is None:
+        return None
+    from scipy.io import wavfile
+
+    from facsim.speech.audio import to_pcm16
+
+    samples, rate = speech
+    tmp = tempfile.NamedTemporaryFile(prefix="facsim-speech-", suffix=".wav")
+    wavfile.write(tmp.name, rate, to_pcm16(samples))
+    return tmp

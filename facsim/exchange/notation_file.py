@@ -21,6 +21,7 @@ Example
     happiness    0.5-1.5@0.5                      <- emotion preset, hold at 50 %
     sadness/emfacs 1+0.5/0/0.5                    <- preset from a named table
     AU12L        0:0>0.8:C~smoothstep>1.6:0;2:0.3>2.5:0   <- AU track, segments
+    say "Pack my box." voice=slt @0.5             <- speech (facsim.speech.track)
 
 Grammar
 -------
@@ -35,7 +36,9 @@ come before the first track::
         description: STRING
         blinks: {name "=" NUMBER}        rate, duration, seed, min_interval (defaults as Blinks)
     STRING    = bare word without spaces, '"' or '#'  |  a JSON string "..."
-    track     = source SP timing
+    track     = source SP timing  |  speech
+    speech    = "say" SP JSON-STRING [ SP "voice=" STRING ] SP "@" TIME     synthesised text from TIME
+              | "audio" SP STRING SP JSON-STRING SP "@" TIME           a recording and its transcript
     source    = "AU" CODE [ "L" | "R" | "U" ]    one AU: both sides, left, right, unilateral
               | "[" FACS "]"  |  JSON string     a FACS string (its intensities times the level)
               | NAME [ "/" TABLE ]               an emotion preset (and its table)
@@ -74,6 +77,7 @@ _WORD = re.compile(r"[A-Za-z][A-Za-z0-9_-]*")
 _BARE = re.compile(r"[^\s\"#]+")
 _AU = re.compile(r"AU(\d+)([LRU]?)(?=\s|$)")
 _KEY = re.compile(r"([a-z_]+):(?=\s|$)")
+_SPEECH = re.compile(r"(say|audio)[ \t]+")
 
 
 class NotationFileError(ExchangeError):
@@ -98,6 +102,17 @@ def _source_text(track) -> str:
         text = track.facs
         return f"[{text}]" if not set(text) & set("]\n\r\"") else json.dumps(text, ensure_ascii=False)
     return track.emotion + (f"/{track.table}" if track.table is not None else "")
+
+
+def _is_speech(track) -> bool:
+    return hasattr(track, "say")
+
+
+def _speech_text(track) -> str:
+    if track.say is not None:
+        voice = "" if track.voice is None else f" voice={_string(track.voice)}"
+        return f"say {json.dumps(track.say, ensure_ascii=False)}{voice} @{_num(track.start)}"
+    return f"audio {_string(track.audio)} {json.dumps(track.transcript, ensure_ascii=False)} @{_num(track.start)}"
 
 
 def _ends(level: float, easing: str = "linear") -> str:
@@ -138,10 +153,14 @@ def dumps_notation(timeline) -> str:
                      f"min_interval={_num(b.min_interval)}")
     if timeline.tracks:
         lines.append("")
-    sources = [_source_text(track) for track in timeline.tracks]
-    width = max(map(len, sources), default=0)
-    for source, track in zip(sources, timeline.tracks):
-        lines.append(f"{source.ljust(width)}  {_timing_text(track.timing)}")
+    timed = [track for track in timeline.tracks if not _is_speech(track)]
+    sources = {id(track): _source_text(track) for track in timed}
+    width = max(map(len, sources.values()), default=0)
+    for track in timeline.tracks:
+        if _is_speech(track):
+            lines.append(_speech_text(track))
+        else:
+            lines.append(f"{sources[id(track)].ljust(width)}  {_timing_text(track.timing)}")
     return "\n".join(lines) + "\n"
 
 
@@ -315,11 +334,13 @@ def _timing(line: _Line, table: str):
         raise line.error(exc.problem, start) from None
 
 
-def _track(line: _Line, table: str):
+def _track(line: _Line, table: str, folder=None):
     from facsim.timeline.model import Track, TimelineError
 
     start = line.pos
     source: dict = {}
+    if _SPEECH.match(line.text, start):
+        return _speech_track(line, folder)
     if line.text.startswith("AU", start) and _AU.match(line.text, start):
         found = line.match(_AU, "an AU")
         source = {"au": int(found.group(1)), "side": _SUFFIX_SIDE[found.group(2)]}
@@ -351,6 +372,41 @@ def _track(line: _Line, table: str):
             index = exc.location[1] if len(exc.location) > 1 else 0
             where = line.segment_starts[index] if index < len(line.segment_starts) else timing_at
         raise line.error(exc.problem, where) from None
+
+
+def _speech_track(line: _Line, folder=None):
+    from facsim.speech.track import SpeechTrack
+    from facsim.timeline.model import TimelineError
+
+    start = line.pos
+    kind = line.match(_SPEECH, "say or audio").group(1)
+    fields: dict = {}
+    if kind == "say":
+        if line.peek() != '"':
+            raise line.error('expected the text to say in double quotes, e.g. say "Hello." @0')
+        fields["say"] = line.json_string()
+        line.skip_space()
+        if line.text.startswith("voice=", line.pos):
+            line.pos += len("voice=")
+            fields["voice"] = line.json_string() if line.peek() == '"' else line.match(_BARE, "a voice name").group()
+            line.skip_space()
+    else:
+        audio = line.json_string() if line.peek() == '"' else line.match(_BARE, "an audio file").group()
+        fields["audio"] = audio if folder is None or Path(audio).is_absolute() else str(Path(folder) / audio)
+        line.skip_space()
+        if line.peek() != '"':
+            raise line.error('expected the transcript in double quotes after the audio file')
+        fields["transcript"] = line.json_string()
+        line.skip_space()
+    if not line.accept("@"):
+        raise line.error("expected '@' and the start time, e.g. @0.5")
+    fields["start"] = line.number("a start time in seconds")
+    if not line.at_end():
+        raise line.error("unexpected text after the speech track's start time")
+    try:
+        return SpeechTrack(**fields)
+    except TimelineError as exc:
+        raise line.error(exc.problem, start) from None
 
 
 def _setting_value(line: _Line, key: str, settings: dict):
@@ -389,8 +445,10 @@ def _setting_value(line: _Line, key: str, settings: dict):
     return value
 
 
-def loads_notation(text: str):
+def loads_notation(text: str, *, folder=None):
     """Read ``.facs`` text into a :class:`~facsim.timeline.Timeline` (grammar in the module docstring).
+
+    Relative audio files of speech tracks are read from ``folder`` (default: the working folder).
 
     Raises
     ------
@@ -433,7 +491,7 @@ def loads_notation(text: str):
             settings[name] = _setting_value(line, name, settings)
             setting_lines[name] = line.lineno
             continue
-        tracks.append(_track(line, settings.get("intensities", DEFAULT_INTENSITIES)))
+        tracks.append(_track(line, settings.get("intensities", DEFAULT_INTENSITIES), folder))
         track_lines.append(line.lineno)
     try:
         return Timeline(tuple(tracks), duration=settings.get("duration"), fps=settings.get("fps", DEFAULT_FPS),
@@ -454,7 +512,7 @@ def read_notation(path):
     """Read a ``.facs`` file (see :func:`loads_notation`); errors name the file."""
     path = Path(path)
     try:
-        return loads_notation(path.read_text(encoding="utf-8"))
+        return loads_notation(path.read_text(encoding="utf-8"), folder=path.parent)
     except NotationFileError as exc:
         raise exc.in_file(path) from None
     except UnicodeDecodeError as exc:

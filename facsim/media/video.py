@@ -46,9 +46,13 @@ class VideoWriter:
         An audio file muxed into MP4 (AAC) or WebM (Opus).
     quality : int
         ffmpeg quality 0–10 (imageio-ffmpeg's scale; 8 is visually lossless for faces).
+    cut_audio : bool
+        End the file with the shorter stream (ffmpeg ``-shortest``, for audio longer than
+        the video). False for audio made to the video's length: ``-shortest`` ends on whole
+        audio codec frames and can drop the last video frame.
     """
 
-    def __init__(self, path, fps: float = 30.0, *, audio=None, quality: int = 8):
+    def __init__(self, path, fps: float = 30.0, *, audio=None, quality: int = 8, cut_audio: bool = True):
         self.path = Path(path)
         self.format = video_format(self.path)
         self.fps = float(fps)
@@ -59,6 +63,7 @@ class VideoWriter:
         if audio is not None and self.format not in ("mp4", "webm"):
             raise ValueError(f"an audio track can only be muxed into .mp4 or .webm, not {self.format}")
         self.audio = None if audio is None else str(audio)
+        self.cut_audio = cut_audio
         self.quality = quality
         self.frames_written = 0
         self._encoder = None
@@ -96,8 +101,8 @@ class VideoWriter:
         audio_codec = None if self.audio is None else ("aac" if self.format == "mp4" else "libopus")
         encoder = imageio_ffmpeg.write_frames(
             str(self._tmp), (width, height), fps=self.fps, codec=codec, pix_fmt_in="rgba", pix_fmt_out="yuv420p",
-            quality=self.quality, macro_block_size=1, output_params=extra + (["-shortest"] if self.audio else []),
-            audio_path=self.audio, audio_codec=audio_codec,
+            quality=self.quality, macro_block_size=1, output_params=extra + (["-shortest"] if self.audio and self.cut_audio else []),
+            audio_path=self.audio, audio_codec=audio_codec, ffmpeg_log_level="error",
         )
         encoder.send(None)  # start the generator
         return encoder

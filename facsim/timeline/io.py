@@ -117,6 +117,9 @@ def _schema_problem(error) -> tuple[tuple, str]:
         return location, _intensity_problem(instance)
     if marker == "track-timing":
         return location, _timing_problem(instance)
+    if marker == "speech-source":
+        return location, ("a speech track takes 'say' (text, with an optional 'voice') or 'audio' "
+                          "(a WAV file) with 'transcript'")
     if marker == "track-source" or "dependentSchemas" in error.schema_path:
         return location, _source_problem_in(instance)
     if kind == "additionalProperties":
@@ -174,7 +177,15 @@ def _segments_from(items: Sequence[Mapping], table: str) -> tuple[Segment, ...]:
     return tuple(segments)
 
 
-def _track_from_dict(data: Mapping, table: str) -> Track:
+def _track_from_dict(data: Mapping, table: str, folder: Path | None = None) -> Track:
+    if "say" in data or "audio" in data:
+        from facsim.speech.track import SpeechTrack
+
+        audio = data.get("audio")
+        if audio is not None and folder is not None and not Path(audio).is_absolute():
+            audio = str(folder / audio)
+        return SpeechTrack(say=data.get("say"), voice=data.get("voice"), audio=audio,
+                           transcript=data.get("transcript"), start=data.get("start", 0.0))
     if "segments" in data:
         timing = _segments_from(data["segments"], table)
     else:
@@ -190,7 +201,7 @@ def _track_from_dict(data: Mapping, table: str) -> Track:
                  emotion=data.get("emotion"), table=data.get("table"), timing=timing)
 
 
-def timeline_from_dict(data: Mapping) -> Timeline:
+def timeline_from_dict(data: Mapping, *, folder=None) -> Timeline:
     """Build a :class:`Timeline` from parsed YAML/JSON (see the module docstring).
 
     Raises
@@ -224,7 +235,7 @@ def timeline_from_dict(data: Mapping) -> Timeline:
     tracks = []
     for i, item in enumerate(data.get("tracks", [])):
         try:
-            tracks.append(_track_from_dict(item, table))
+            tracks.append(_track_from_dict(item, table, None if folder is None else Path(folder)))
         except TimelineError as exc:
             raise exc.within("tracks", i) from None
     return Timeline(tuple(tracks), duration=data.get("duration"), fps=data.get("fps", DEFAULT_FPS),
@@ -280,6 +291,9 @@ def timeline_to_dict(timeline: Timeline) -> dict:
     tracks = []
     for track in timeline.tracks:
         item: dict[str, Any] = {}
+        if not isinstance(track, Track):          # a speech track
+            tracks.append(_speech_to_dict(track))
+            continue
         if track.au is not None:
             item["au"] = track.au
             item["side"] = track.side
@@ -293,6 +307,15 @@ def timeline_to_dict(timeline: Timeline) -> dict:
         tracks.append(item)
     out["tracks"] = tracks
     return out
+
+
+def _speech_to_dict(track) -> dict:
+    item: dict[str, Any] = {"say": track.say} if track.say is not None else {"audio": track.audio,
+                                                                            "transcript": track.transcript}
+    if track.voice is not None:
+        item["voice"] = track.voice
+    item["start"] = _number(track.start)
+    return item
 
 
 # ------------------------------------------------------------------ files ---
@@ -360,7 +383,7 @@ def load_timeline(path: str | os.PathLike) -> Timeline:
             raise TimelineError(f"malformed JSON: {exc.msg} (column {exc.colno})", file=path,
                                 line=exc.lineno) from None
     try:
-        return timeline_from_dict(data)
+        return timeline_from_dict(data, folder=path.parent)
     except TimelineError as exc:
         line = _yaml_line(text, exc.location) if kind == "yaml" and exc.location else None
         raise exc.in_file(path, line) from None

@@ -52,6 +52,19 @@ timing:
 * a hold (``start``, ``end``): the level is ``intensity`` from ``start`` to
   ``end``, with no ramps (a step on and off; use an envelope for ramps).
 
+Speech tracks (:mod:`facsim.speech.track`) say synthesised text or play a recording::
+
+      - say: "Pack my box."  # synthesised text ...
+        voice: slt           # slt (default), awb, rms, kal16, kal, piper:MODEL
+        start: 0.5
+      - audio: me.wav        # ... or a recording (relative to the file) and its words
+        transcript: "Pack my box."
+        start: 2.0
+
+Their phones become AU curves when the timeline is sampled, so they mix with the
+other tracks (while speaking they own the lips and jaw, see
+:mod:`facsim.speech.combine`); each lasts as long as its audio; videos carry the audio.
+
 Every track is active on the half-open interval ``[start, end)``: a track
 contributes 0 at its end time, so a track that ends at 1 s and one that starts
 at 1 s on the same AU never add up. An ``au`` track's level is the AU's
@@ -589,9 +602,11 @@ class Timeline:
     description: str | None = None
 
     def __post_init__(self):
+        from facsim.speech.track import SpeechTrack
+
         tracks = tuple(self.tracks)
         for i, track in enumerate(tracks):
-            if not isinstance(track, Track):
+            if not isinstance(track, (Track, SpeechTrack)):
                 raise TimelineError(f"expected a Track, got {type(track).__name__}", location=("tracks", i))
         object.__setattr__(self, "tracks", tracks)
         object.__setattr__(self, "fps", positive(self.fps, "fps"))
@@ -613,6 +628,8 @@ class Timeline:
             raise TimelineError(f"expected Blinks, got {self.blinks!r}", location=("blinks",))
         intensities_table(self.intensities)
         for i, track in enumerate(tracks):     # letters must read in this table too
+            if isinstance(track, SpeechTrack):
+                continue
             try:
                 track_activations(track, self.intensities)
             except TimelineError as exc:

@@ -133,14 +133,23 @@ def activation_curves(timeline: Timeline, times) -> dict[tuple[int, str], np.nda
     if times.ndim != 1:
         raise ValueError(f"times must be a 1-D array of seconds, got shape {times.shape}")
     totals: dict[tuple[int, str], np.ndarray] = {}
+    speech = []
     for track in _all_tracks(timeline):
+        if not isinstance(track, Track):   # speech: AU curves from its phones, combined below
+            speech.append(track)
+            continue
         base = track_activations(track, timeline.intensities)
         if not base:
             continue
         level = track.levels(times)
         for key, value in base:
             totals[key] = totals.get(key, np.zeros(times.shape)) + value * level
-    return {key: np.clip(np.round(totals[key], DECIMALS), 0.0, 1.0) for key in sorted(totals)}
+    curves = {key: np.clip(np.round(totals[key], DECIMALS), 0.0, 1.0) for key in sorted(totals)}
+    if speech:
+        from facsim.speech.track import with_speech
+
+        curves = with_speech(curves, speech, times)
+    return curves
 
 
 def intensity_curves(timeline: Timeline, times) -> dict[str, np.ndarray]:
