@@ -17,6 +17,8 @@ Counterbalancing decides which characters show which conditions:
   the block's C conditions; list *k* (of ``lists``) shifts the rotation by
   *k*, so over the lists every condition is shown by ``lists`` different
   characters, and with ``lists`` = n each condition by every character once.
+  The rotation runs on from one block to the next, so over the whole set
+  too the characters' counts differ by at most one.
 
 Every condition then becomes its outputs: one PNG per still level (level ×
 the condition's intensity), a video, a glb. Names are *readable*
@@ -109,11 +111,13 @@ def conditions(block: Block) -> tuple[Condition, ...]:
                  for engine in block.engines for view in block.views for size in block.sizes)
 
 
-def assignments(block: Block, index: int, *, method: str, lists: int, seed: int
+def assignments(block: Block, index: int, *, method: str, lists: int, seed: int, start: int = 0
                 ) -> Iterator[tuple[int, str, Condition]]:
     """(list number, character, condition) triples of one block; lists count from 1 (0: no lists).
 
-    ``index`` is the block's position, so blocks draw independent orders from one seed.
+    ``index`` is the block's position, so blocks draw independent orders from one seed; ``start``
+    is where the rotation over the characters begins (the conditions dealt before this block), so
+    the remainders of several blocks fall on different characters and the whole set stays balanced.
 
     Examples
     --------
@@ -134,7 +138,7 @@ def assignments(block: Block, index: int, *, method: str, lists: int, seed: int
     order = np.random.default_rng([seed, index]).permutation(len(conds))
     for k in range(lists):
         for position, c in enumerate(order):
-            yield k + 1, chars[(position + k) % len(chars)], conds[int(c)]
+            yield k + 1, chars[(start + position + k) % len(chars)], conds[int(c)]
 
 
 def _intensity_tag(level: float) -> str:
@@ -251,15 +255,17 @@ def expand(spec: StimulusSet) -> tuple[Item, ...]:
         at the same intensity), naming the block.
     """
     items: dict[str, Item] = {}
+    dealt = 0
     for index, block in enumerate(spec.blocks):
         for list_no, character, cond in assignments(block, index, method=spec.counterbalance,
-                                                    lists=spec.lists, seed=spec.seed):
+                                                    lists=spec.lists, seed=spec.seed, start=dealt):
             for item in _items_of(spec, block, list_no, character, cond):
                 if item.key in items:
                     raise SpecError(f"two outputs would both be {item.key!r}; give distinct intensities "
                                     "and still levels (a still's level times the intensity names it)",
                                     location=("blocks", index))
                 items[item.key] = item
+        dealt += len(conditions(block))
     ordered = [items[k] for k in sorted(items)]
     if spec.naming == "blind":
         tokens = blind_names(list(items), spec.seed)
