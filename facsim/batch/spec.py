@@ -197,11 +197,17 @@ def _schema_problem(error) -> tuple[tuple, str]:
     schema = error.schema if isinstance(error.schema, dict) else {}
     marker = schema.get("x-facsim")
     location = tuple(error.absolute_path)
-    if marker == "block-source" or "dependentSchemas" in error.schema_path:
+    if (marker == "block-source" and error.validator == "oneOf") or "dependentSchemas" in error.schema_path:
         return location, _block_source_problem(error.instance)
+    if error.validator == "minProperties" and location and location[-1] == "outputs":
+        return location, "no outputs: give 'stills', 'video' or 'glb: true'"
     if marker in _EXPECTED and error.validator in ("anyOf", "oneOf"):
         return location, f"{_EXPECTED[marker]}, got {error.instance!r}"
-    return timeline_io._schema_problem(error)  # the timeline's wording: unknown fields, types, ranges
+    location, problem = timeline_io._schema_problem(error)  # the timeline's wording: fields, types, ranges
+    if error.validator == "additionalProperties":  # point at the unknown key itself (its line)
+        allowed = schema.get("properties", {})
+        location = (*location, sorted(k for k in error.instance if k not in allowed)[0])
+    return location, problem
 
 
 def _check_schema(data: Any) -> None:
