@@ -182,6 +182,9 @@ _EXPECTED = {
     "antialias": "expected MSAA samples 1..16 or 'fxaa'",
 }
 
+_PATTERNS = {"key": "expected a file name ending in .csv (no folders)",
+             "name": "expected a folder name: letters, digits, '_', '.' or '-', starting with a letter or digit"}
+
 
 def _block_source_problem(block: Mapping) -> str:
     given = [k for k in _SOURCES if k in block]
@@ -201,6 +204,13 @@ def _schema_problem(error) -> tuple[tuple, str]:
         return location, _block_source_problem(error.instance)
     if error.validator == "minProperties" and location and location[-1] == "outputs":
         return location, "no outputs: give 'stills', 'video' or 'glb: true'"
+    if error.validator in ("anyOf", "oneOf"):
+        # The branch of the right type that failed inside says more ('onset: must be >= 0').
+        inner = [e for e in error.context if e.validator not in ("type", "enum", "const")]
+        if inner and isinstance(error.instance, (Mapping, list)):
+            return _schema_problem(min(inner, key=lambda e: (-len(e.absolute_path), str(e.schema_path))))
+    if error.validator == "pattern" and location and location[-1] in _PATTERNS:
+        return location, f"{_PATTERNS[location[-1]]}, got {error.instance!r}"
     if marker in _EXPECTED and error.validator in ("anyOf", "oneOf"):
         return location, f"{_EXPECTED[marker]}, got {error.instance!r}"
     location, problem = timeline_io._schema_problem(error)  # the timeline's wording: fields, types, ranges
