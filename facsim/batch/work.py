@@ -105,8 +105,12 @@ def render_item(item: Item, threads: int | None = None) -> bytes:
         return _png_bytes(image)
     if item.kind == "glb":
         from facsim.exchange.gltf import glb_bytes
+        from facsim.registers import register_table
 
-        return glb_bytes(face, item_timeline(item), fps=item.fps)
+        # Morph targets for the item's own AUs keep the file small (2.8 MB with all 68); head and eye
+        # positions (51-58, 61-66) are joint rotations, animated whatever the targets.
+        morphs = sorted(set(item.aus) & set(register_table()["action_units"]))
+        return glb_bytes(face, item_timeline(item), aus=morphs or "all", fps=item.fps)
     from facsim.video import animate
 
     path = _scratch_dir() / f"{os.getpid()}-item.{item.format}"
