@@ -19,5 +19,6 @@ if [ ${#need[@]} -gt 0 ]; then
 fi
 
 python3 -m pip install -q -e ".[test]"
+python3 -m pip install -q -e ".[dask]"   # facsim batch on Dask (LocalCluster or a cluster's scheduler)
 bash tests/gltf_validator/install.sh   # the Khronos glTF validator the tests run (npm, pinned by its lock file)
 python3 -m facsim.cli data
