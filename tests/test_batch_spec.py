@@ -309,3 +309,17 @@ def test_items_pickle_for_workers():
     items = expand(spec(block(aus=[1], outputs={"stills": [1], "video": True})))
     assert pickle.loads(pickle.dumps(items)) == items
     assert all(hash(it) == hash(pickle.loads(pickle.dumps(it))) for it in itertools.islice(items, 2))
+
+
+def test_progress_line_gives_counts_rate_and_eta():
+    import io as _io
+
+    from facsim.batch.run import Progress
+
+    stream = _io.StringIO()
+    bar = Progress(100, 40, stream=stream)
+    bar.start -= 10.0  # 10 s ago
+    bar.update(60)     # 20 new items in 10 s: 2 items/s, 40 left → 20 s
+    line = bar.text(now=bar.start + 10.0)
+    assert "60/100 items, 40 resumed, 2.00 items/s, ETA 0:20" in line
+    assert stream.getvalue().endswith("\n")  # not a terminal: whole lines, for logs

@@ -15,6 +15,8 @@ unless ``force``.
 from __future__ import annotations
 
 import contextlib
+import hashlib
+import json
 import os
 import signal
 import sys
@@ -187,26 +189,18 @@ def _local_results(todo: list[Item], workers: int, threads: int) -> Iterator[tup
 
 
 def _threads_by_host(client) -> dict[str, int]:
-    """llvmpipe threads per worker on each host of a running cluster (cores / workers there)."""
+    """llvmpipe threads per worker on each host of a running cluster: its cores / its workers' threads."""
     from urllib.parse import urlparse
 
-    workers = client.scheduler_info(n_workers=-1)["workers"] if _takes_n_workers(client) \
-        else client.scheduler_info()["workers"]
+    cores = client.run(os.cpu_count)  # {worker address: cores of its machine}
+    nthreads = client.nthreads()      # {worker address: threads of that worker}
     per_host: dict[str, list[int]] = {}
-    for address, info in workers.items():
+    host_cores: dict[str, int] = {}
+    for address, n in nthreads.items():
         host = urlparse(address).hostname or address
-        per_host.setdefault(host, []).append(int(info.get("nthreads", 1)))
-    cores = {}
-    for address, info in workers.items():
-        host = urlparse(address).hostname or address
-        cores[host] = int((info.get("metrics") or {}).get("cpu_count", 0) or os.cpu_count() or 1)
-    return {host: max(1, cores[host] // max(1, sum(n))) for host, n in per_host.items()}
-
-
-def _takes_n_workers(client) -> bool:
-    import inspect
-
-    return "n_workers" in inspect.signature(client.scheduler_info).parameters
+        per_host.setdefault(host, []).append(int(n))
+        host_cores[host] = int(cores.get(address) or 1)
+    return {host: max(1, host_cores[host] // max(1, sum(n))) for host, n in per_host.items()}
 
 
 def render_on_dask(item: Item, threads_by_host: dict) -> bytes:
@@ -224,16 +218,14 @@ def render_on_dask(item: Item, threads_by_host: dict) -> bytes:
 def _dask_results(todo: list[Item], *, workers: int, scheduler: str | None
                   ) -> Iterator[tuple[Item, bytes | BaseException]]:
     """Render on Dask: a LocalCluster of ``workers`` processes (1 thread each), or the cluster at ``scheduler``."""
-    import hashlib
-
     from distributed import Client, LocalCluster, as_completed
 
     cluster = None
     if scheduler is None:
-        # Workers are spawned processes; they inherit LP_NUM_THREADS from here.
-        os.environ["LP_NUM_THREADS"] = str(render_threads(workers))
-        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
-                               host="127.0.0.1")
+        # Workers are spawned processes and inherit LP_NUM_THREADS from here, at start-up.
+        with _environment(LP_NUM_THREADS=str(render_threads(workers))):
+            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                   dashboard_address=None, host="127.0.0.1")
         client = Client(cluster)
     else:
         client = Client(scheduler, timeout=30)
@@ -261,7 +253,30 @@ def _dask_results(todo: list[Item], *, workers: int, scheduler: str | None
                 cluster.close()
 
 
+@contextlib.contextmanager
+def _environment(**values: str):
+    saved = {k: os.environ.get(k) for k in values}
+    os.environ.update(values)
+    try:
+        yield
+    finally:
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+
+
 # ------------------------------------------------------------------ run ---
+
+def _store(folder: Path, journal: Journal, item: Item, data: bytes) -> dict:
+    """Write one finished file atomically, then journal it (in that order: a line means a whole file)."""
+    path = folder / item.file
+    path.parent.mkdir(parents=True, exist_ok=True)
+    atomic_write(path, lambda tmp: tmp.write_bytes(data))
+    journal.append(item.key, item.file, hashlib.sha256(data).hexdigest(), len(data))
+    return journal.entries[item.key]
+
 
 @contextlib.contextmanager
 def _sigterm_as_interrupt():
@@ -324,7 +339,8 @@ def run_batch(spec: StimulusSet, folder: str | os.PathLike, *, workers: int = 1,
             if dask or scheduler:
                 results = _dask_results(todo, workers=workers, scheduler=scheduler)
             else:
-                results = _local_results(todo, min(workers, len(todo)), render_threads(workers))
+                n = min(workers, len(todo))
+                results = _local_results(todo, n, render_threads(n))
             count = len(done)
             try:
                 with _sigterm_as_interrupt():
@@ -333,13 +349,7 @@ def run_batch(spec: StimulusSet, folder: str | os.PathLike, *, workers: int = 1,
                             failed.append(item.key)
                             first_error = first_error or f"{item.key}: {result}"
                             continue
-                        path = folder / item.file
-                        path.parent.mkdir(parents=True, exist_ok=True)
-                        atomic_write(path, lambda tmp, data=result: tmp.write_bytes(data))
-                        import hashlib
-
-                        journal.append(item.key, item.file, hashlib.sha256(result).hexdigest(), len(result))
-                        done[item.key] = journal.entries[item.key]
+                        done[item.key] = _store(folder, journal, item, result)
                         count += 1
                         bar.update(count)
                         if on_item is not None:
@@ -354,8 +364,6 @@ def run_batch(spec: StimulusSet, folder: str | os.PathLike, *, workers: int = 1,
         if failed:
             raise BatchError(f"{len(failed)} of {len(items)} items failed (the others are kept; rerun to retry "
                              f"them); first: {first_error}")
-        import json
-
         journal.entries = {k: done[k] for k in sorted(done)}
         journal.rewrite_sorted()
         paths = write_manifest(folder, items, done, spec=json.loads(spec.spec_json), spec_hash=spec.spec_hash,
