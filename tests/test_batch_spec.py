@@ -319,7 +319,9 @@ def test_progress_line_gives_counts_rate_and_eta():
     stream = _io.StringIO()
     bar = Progress(100, 40, stream=stream)
     bar.start -= 10.0  # 10 s ago
-    bar.update(60)     # 20 new items in 10 s: 2 items/s, 40 left → 20 s
+    bar.update(63)     # not a tenth of the 60 to make: a log gets no line
+    assert stream.getvalue() == ""
+    bar.update(64)     # 24 new items in 10 s: 2.4 items/s, 36 left → 15 s
     line = bar.text(now=bar.start + 10.0)
-    assert "60/100 items, 40 resumed, 2.00 items/s, ETA 0:20" in line
-    assert stream.getvalue().endswith("\n")  # not a terminal: whole lines, for logs
+    assert "64/100 items, 40 resumed, 2.40 items/s, ETA 0:15" in line
+    assert stream.getvalue().count("\n") == 1  # not a terminal: whole lines, for logs
