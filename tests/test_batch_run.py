@@ -210,6 +210,19 @@ def test_real_cluster_loses_a_worker_and_still_completes_the_set(spec_file, refe
             _stop(process)
 
 
+def _children(pid: int) -> list[int]:
+    tasks = Path(f"/proc/{pid}/task")
+    return sorted({int(c) for t in tasks.iterdir() for c in (t / "children").read_text().split()})
+
+
+def _alive(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state not in ("Z", "X")  # a zombie has exited (pid 1 may not reap it here)
+
+
 def _facsim(*args) -> list[str]:
     return [sys.executable, "-m", "facsim", *args]
 
@@ -226,8 +239,14 @@ def test_cli_killed_mid_run_then_rerun_gives_the_uninterrupted_bytes(spec_file, 
             break
         time.sleep(0.05)
     assert run.poll() is None, "the run ended before it could be killed"
+    workers = _children(run.pid)
+    assert workers, "no worker processes"
     run.send_signal(sig)
     _, err = run.communicate(timeout=60)
+    deadline = time.monotonic() + 15
+    while any(_alive(pid) for pid in workers) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not any(_alive(pid) for pid in workers), "workers outlived the killed run"
     done = journal.read_bytes().count(b"\n")
     assert 3 <= done < N_ITEMS and not (folder / "manifest.csv").exists()
     if sig == signal.SIGTERM:

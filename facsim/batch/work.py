@@ -37,11 +37,28 @@ def set_render_threads(threads: int | None) -> None:
 
 
 def init_worker(threads: int | None) -> None:
-    """Process-pool initializer: renderer threads, and no stray output on interrupt."""
+    """Process-pool initializer: renderer threads, Ctrl-C left to the parent, and exit with the parent."""
     import signal
 
     set_render_threads(threads)
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles Ctrl-C and stops the pool
+    _exit_with_parent()
+
+
+def _exit_with_parent(interval: float = 0.5) -> None:
+    """Stop this process when its parent is gone (killed with SIGKILL, it cannot stop its pool): an
+    orphaned worker would otherwise sit on its queue, or keep rendering items nobody will write."""
+    import threading
+    import time
+
+    parent = os.getppid()
+
+    def watch():
+        while os.getppid() == parent:
+            time.sleep(interval)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="facsim-exit-with-parent", daemon=True).start()
 
 
 def face_for(character: str, engine: str):
