@@ -267,3 +267,24 @@ def test_cli_errors_are_one_line(tmp_path):
                                                "FACS defines no AU3; known codes are 1-2, 4-46, 50-58, 61-66, "
                                                "70-74, 80-82, 84-85, 91-92, 97-98"]
     assert not (tmp_path / "out").exists()
+
+
+def test_timeline_and_muscle_items_render_in_process(tmp_path):
+    """The worker function itself, on the two kinds the tiny set leaves out."""
+    import imageio_ffmpeg
+
+    from facsim.batch.spec import spec_from_dict
+    from facsim.batch.work import render_item
+
+    (tmp_path / "nod.yaml").write_text("fps: 10\ntracks:\n  - au: 12\n    start: 0\n    onset: 0.2\n    apex: 0.1\n"
+                                       "    offset: 0.2\n")
+    spec = spec_from_dict({"characters": ["zola"], "sizes": [40], "engines": ["registers", "muscle"], "blocks": [
+        {"name": "t", "timelines": ["nod.yaml"], "engines": ["registers"], "outputs": {"video": True}},
+        {"name": "m", "facs": ["4+6"], "outputs": {"stills": [1]}}]}, base_dir=tmp_path)
+    items = {it.key: it for it in expand(spec)}
+    video = tmp_path / "nod.mp4"
+    video.write_bytes(render_item(items["t/zola/nod.mp4"]))
+    assert imageio_ffmpeg.count_frames_and_secs(str(video))[0] == 5
+    muscle = render_item(items["m/zola/AU4_6_i100_muscle.png"])
+    registers = render_item(items["m/zola/AU4_6_i100_registers.png"])
+    assert muscle[:8] == registers[:8] == b"\x89PNG\r\n\x1a\n" and muscle != registers

@@ -173,7 +173,8 @@ def test_timeline_blocks_take_their_own_timing(tmp_path):
     (tmp_path / "blink.yaml").write_text("fps: 25\ntracks:\n  - au: 45\n    start: 0.5\n    end: 1.5\n")
     path = write(tmp_path, "blocks:\n  - name: t\n    timelines: [blink.yaml]\n    outputs: {video: true, glb: true}\n")
     video, glb = sorted(expand(load_spec(path)), key=lambda it: it.kind, reverse=True)
-    assert video.kind == "video" and video.duration == 1.5 and video.aus == (45,) and video.file == "t/ava/blink.mp4"
+    assert video.kind == "video" and video.duration == 1.5 and video.fps == 25 and video.aus == (45,)
+    assert video.file == "t/ava/blink.mp4"
     assert glb.kind == "glb" and glb.file == "t/ava/blink.glb"
 
 

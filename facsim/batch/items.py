@@ -37,6 +37,7 @@ Examples
 from __future__ import annotations
 
 import dataclasses
+import json
 from dataclasses import dataclass
 from typing import Iterator
 
@@ -149,12 +150,10 @@ def _slug(character: str) -> str:
     return character.replace(":", "-")
 
 
-def _condition_aus(stim: Stimulus, level: float) -> tuple[int, ...]:
+def _condition_aus(stim: Stimulus) -> tuple[int, ...]:
     if stim.kind == "au":
         return (stim.au,)
     if stim.kind == "timeline":
-        import json
-
         tracks = json.loads(stim.timeline)["tracks"]
         codes: set[int] = set()
         for track in tracks:
@@ -185,7 +184,7 @@ def _items_of(spec: StimulusSet, block: Block, list_no: int, character: str, con
         if len(options) > 1)
     common = dict(block=block.name, list=list_no, character=character, engine=cond.engine, view=cond.view,
                   width=width, height=height, stimulus=stim, peak=cond.intensity,
-                  aus=_condition_aus(stim, cond.intensity), intensities=spec.intensities,
+                  aus=_condition_aus(stim), intensities=spec.intensities,
                   background=spec.background, antialias=spec.antialias)
     out = []
     peak_tag = "" if stim.kind == "timeline" else "_" + _intensity_tag(cond.intensity)
@@ -196,13 +195,10 @@ def _items_of(spec: StimulusSet, block: Block, list_no: int, character: str, con
     video = block.outputs.video
     timing = {}
     if stim.kind == "timeline":
-        import json
-
         from facsim.timeline_io import timeline_from_dict
 
-        timeline = timeline_from_dict(json.loads(stim.timeline))
-        fps = video.fps if video is not None else timeline.fps
-        timing = dict(duration=timeline.length, fps=fps)
+        timeline = timeline_from_dict(json.loads(stim.timeline))  # its own timing and frame rate
+        timing = dict(duration=timeline.length, fps=timeline.fps)
     elif video is not None or block.outputs.glb:  # a glb without a video is animated with the default timing
         v = video if video is not None else VideoOutput()
         timing = dict(duration=v.onset + v.apex + v.offset, fps=v.fps, onset=v.onset, apex=v.apex,
