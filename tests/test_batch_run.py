@@ -75,7 +75,7 @@ def test_pool_makes_every_file_and_the_manifest_says_what_each_shows(spec_file, 
     assert [r["file"] for r in rows] == sorted(it.file for it in items)
     for r in rows:
         data = reference[r["file"]]
-        assert len(data) == int(r["bytes"]) and r["checksum"] == __import__("hashlib").sha256(data).hexdigest()
+        assert len(data) == int(r["file_bytes"]) and r["checksum"] == __import__("hashlib").sha256(data).hexdigest()
     by_file = {r["file"]: r for r in rows}
     still = by_file["au/liam/AU12_i050.png"]
     assert (still["kind"], still["character"], still["facs"], still["aus"], still["intensity"]) == \

@@ -35,12 +35,13 @@ STATE = "state.json"
 MANIFEST_CSV = "manifest.csv"
 MANIFEST_JSON = "manifest.json"
 
-#: Manifest columns, in order (PsychoPy and jsPsych read the CSV as a conditions file).
-COLUMNS = ("file", "kind", "block", "list", "character", "label", "facs", "aus", "emotion", "table", "side",
+#: Manifest columns, in order (PsychoPy and jsPsych read the CSV as a conditions file). PsychoPy's
+#: Builder makes each column a Python variable, so no name shadows a builtin (list, format, bytes).
+COLUMNS = ("file", "kind", "block", "list_no", "character", "label", "facs", "aus", "emotion", "table", "side",
            "intensity", "peak", "engine", "view", "width", "height", "duration", "fps", "onset", "apex", "offset",
-           "format", "checksum", "bytes")
+           "file_format", "checksum", "file_bytes")
 #: What a blind manifest may show: nothing about the expression or the character.
-BLIND_COLUMNS = ("file", "kind", "width", "height", "duration", "fps", "format", "checksum", "bytes")
+BLIND_COLUMNS = ("file", "kind", "width", "height", "duration", "fps", "file_format", "checksum", "file_bytes")
 
 
 def sha256_file(path: os.PathLike) -> str:
@@ -129,7 +130,7 @@ def row(item: Item, entry: Mapping) -> dict[str, str]:
     stim = item.stimulus
     timed = item.kind != "still"
     return {
-        "file": item.file, "kind": item.kind, "block": item.block, "list": str(item.list or ""),
+        "file": item.file, "kind": item.kind, "block": item.block, "list_no": str(item.list or ""),
         "character": item.character, "label": stim.label, "facs": stim.facs,
         "aus": " ".join(str(code) for code in item.aus), "emotion": stim.emotion or "", "table": stim.table or "",
         "side": stim.side if stim.kind == "au" else "", "intensity": _number(item.intensity),
@@ -137,8 +138,8 @@ def row(item: Item, entry: Mapping) -> dict[str, str]:
         "height": str(item.height), "duration": _number(item.duration) if timed else "",
         "fps": _number(item.fps) if timed else "", "onset": _number(item.onset) if timed and item.onset else "",
         "apex": _number(item.apex) if timed and item.apex else "",
-        "offset": _number(item.offset) if timed and item.offset else "", "format": item.format,
-        "checksum": entry["checksum"], "bytes": str(entry["bytes"]),
+        "offset": _number(item.offset) if timed and item.offset else "", "file_format": item.format,
+        "checksum": entry["checksum"], "file_bytes": str(entry["bytes"]),
     }
 
 
