@@ -293,16 +293,19 @@ def _facs_stimuli(block: Mapping, field: str, where: tuple) -> list[Stimulus]:
 
 
 def _emotion_stimuli(block: Mapping, where: tuple) -> list[Stimulus]:
-    from facsim.emotions import emotion, emotion_names
+    from facsim.emotions import emotion, emotion_names, preset_tables
     from facsim.notation import format_expression
 
     names = list(emotion_names()) if block["emotions"] == "all" else block["emotions"]
     tables = block.get("tables", ["hapfacs"])
-    out = []
     for k, table in enumerate(tables):
+        if table not in preset_tables():
+            raise SpecError(f"unknown emotion table {table!r}; choose one of {', '.join(preset_tables())}",
+                            location=(*where, "tables", k))
+    out = []
+    for table in tables:
         for j, name in enumerate(names):
-            field = (*where, "emotions", j) if k == 0 else (*where, "tables", k)
-            track = _checked_track(field, emotion=name, table=table)
+            track = _checked_track((*where, "emotions", j), emotion=name, table=table)
             label = track.emotion if len(tables) == 1 else f"{track.emotion}-{table}"
             out.append(Stimulus("emotion", label, facs=format_expression(emotion(track.emotion, table=table)),
                                 emotion=track.emotion, table=table))
