@@ -87,3 +87,8 @@ def cmd_batch(args) -> None:
     made = f"{result.rendered} rendered" + (f", {result.resumed} already done" if result.resumed else "")
     print(f"wrote {result.items} files to {args.output} ({made}) in {result.seconds:.1f} s; "
           f"manifest: {result.manifest}")
+    if spec.naming == "blind":
+        from pathlib import Path
+
+        print(f"blind names: what each file shows is in {Path(args.output) / spec.key_file} "
+              "(keep it from the coders)")
