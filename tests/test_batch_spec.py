@@ -146,8 +146,8 @@ def test_emotions_carry_their_preset_and_aus():
 
 
 def test_all_emotions_and_all_characters():
-    from facsim.character import preset_names
-    from facsim.emotions import emotion_names
+    from facsim.facs.emotions import emotion_names
+    from facsim.head.character import preset_names
 
     s = spec_from_dict({"characters": "all", "blocks": [block(emotions="all")]})
     assert len(expand(s)) == len(preset_names()) * len(emotion_names())

@@ -167,10 +167,10 @@ def _condition_aus(stim: Stimulus) -> tuple[int, ...]:
 
 def _expression_codes(facs, emotion, table) -> set[int]:
     if emotion is not None:
-        from facsim.emotions import emotion as preset
+        from facsim.facs.emotions import emotion as preset
 
         return set(preset(emotion, table=table or "hapfacs").codes)
-    from facsim.notation import parse
+    from facsim.facs.notation import parse
 
     return set(parse(facs).codes)
 
@@ -195,7 +195,7 @@ def _items_of(spec: StimulusSet, block: Block, list_no: int, character: str, con
     video = block.outputs.video
     timing = {}
     if stim.kind == "timeline":
-        from facsim.timeline_io import timeline_from_dict
+        from facsim.timeline.io import timeline_from_dict
 
         timeline = timeline_from_dict(json.loads(stim.timeline))  # its own timing and frame rate
         timing = dict(duration=timeline.length, fps=timeline.fps)

@@ -39,8 +39,8 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 import facsim
-from facsim import timeline_io
-from facsim.timeline import Hold, TimelineError, Track, _level
+from facsim.timeline import io as timeline_io
+from facsim.timeline.model import Hold, TimelineError, Track, parse_level
 
 SCHEMA_FILE = "stimulus_set.schema.json"
 HAPFACS_TABLE = "hapfacs_stimuli.yaml"
@@ -293,8 +293,8 @@ def _facs_stimuli(block: Mapping, field: str, where: tuple) -> list[Stimulus]:
 
 
 def _emotion_stimuli(block: Mapping, where: tuple) -> list[Stimulus]:
-    from facsim.emotions import emotion, emotion_names, preset_tables
-    from facsim.notation import format_expression
+    from facsim.facs.emotions import emotion, emotion_names, preset_tables
+    from facsim.facs.notation import format_expression
 
     names = list(emotion_names()) if block["emotions"] == "all" else block["emotions"]
     tables = block.get("tables", ["hapfacs"])
@@ -328,7 +328,7 @@ def _timeline_stimuli(block: Mapping, where: tuple, base_dir: Path | None) -> li
 
 
 def _characters(value: Any, seed: int, where: tuple) -> tuple[str, ...]:
-    from facsim.character import CharacterError, preset_names, resolve_character
+    from facsim.head.character import CharacterError, preset_names, resolve_character
 
     if value == "all":
         return tuple(preset_names())
@@ -353,7 +353,7 @@ def _characters(value: Any, seed: int, where: tuple) -> tuple[str, ...]:
 
 
 def _views(value: Sequence[str], where: tuple) -> tuple[str, ...]:
-    from facsim.camera import VIEWS
+    from facsim.render.camera import VIEWS
 
     for j, view in enumerate(value):
         if view not in VIEWS:
@@ -383,7 +383,7 @@ def _outputs(data: Mapping, table: str, where: tuple) -> Outputs:
 
 def _intensity(value: Any, table: str, where: tuple) -> float:
     try:
-        return _level(value, "intensity", table)
+        return parse_level(value, "intensity", table)
     except TimelineError as exc:
         raise SpecError(exc.problem, location=where) from None
 
@@ -434,7 +434,7 @@ def _block(data: Mapping, i: int, top: Mapping, base_dir: Path | None) -> Block:
 
 
 def _background(value: str) -> tuple[float, float, float]:
-    from facsim.appearance import hex_to_rgb
+    from facsim.head.appearance import hex_to_rgb
 
     try:
         return tuple(hex_to_rgb(value))
@@ -461,10 +461,10 @@ def spec_from_dict(data: Any, *, base_dir: str | os.PathLike | None = None) -> S
         what = "nothing (the file is empty)" if data is None else type(data).__name__
         raise SpecError(f"expected a mapping with 'blocks' at the top level, got {what}")
     _check_schema(data)
-    from facsim.timeline import _intensities_table
+    from facsim.timeline.model import intensities_table
 
     try:
-        table = _intensities_table(data.get("intensities", "hapfacs"))
+        table = intensities_table(data.get("intensities", "hapfacs"))
     except TimelineError as exc:
         raise SpecError(exc.problem, location=exc.location) from None
     top: dict[str, Any] = {"intensities": table, "seed": data.get("seed", 0)}

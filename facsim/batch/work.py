@@ -91,8 +91,9 @@ def item_timeline(item: Item, *, level: float | None = None):
     (``level`` given: a constant hold at that level, for stills)."""
     import json
 
-    from facsim.timeline import Hold, Timeline, Track, stimulus_timeline
-    from facsim.timeline_io import timeline_from_dict
+    from facsim.timeline.builders import stimulus_timeline
+    from facsim.timeline.model import Hold, Timeline, Track
+    from facsim.timeline.io import timeline_from_dict
 
     stim = item.stimulus
     if stim.kind == "timeline":
@@ -115,24 +116,24 @@ def render_item(item: Item, threads: int | None = None) -> bytes:
     face = face_for(item.character, item.engine)
     options = dict(view=item.view, size=(item.width, item.height))
     if item.kind == "still":
-        from facsim.timeline import sample
+        from facsim.timeline.sampling import sample
 
         activations = sample(item_timeline(item, level=item.intensity), 0.5)
         image = face.render(activations, background=item.background, antialias=item.antialias, **options)
         return _png_bytes(image)
     if item.kind == "glb":
         from facsim.exchange.gltf import glb_bytes
-        from facsim.registers import register_table
+        from facsim.engines.registers import register_table
 
         # Morph targets for the item's own AUs keep the file small (2.8 MB with all 68); head and eye
         # positions (51-58, 61-66) are joint rotations, animated whatever the targets.
         morphs = sorted(set(item.aus) & set(register_table()["action_units"]))
         return glb_bytes(face, item_timeline(item), aus=morphs or "all", fps=item.fps)
-    from facsim.video import animate
+    from facsim.pipeline import animate
 
     path = _scratch_dir() / f"{os.getpid()}-item.{item.format}"
     try:
-        animate(item_timeline(item), path, face=face, fps=item.fps, progress=False,
+        animate(item_timeline(item), path, face=face, fps=item.fps,
                 background=item.background, **options)
         return path.read_bytes()
     finally:

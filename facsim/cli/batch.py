@@ -20,7 +20,7 @@ def _scheduler(text: str) -> str:
     return text
 
 
-def add_commands(sub, *_ignored) -> None:
+def add_commands(sub) -> None:
     """Register ``batch`` on the ``facsim`` subcommand parser."""
     import os
 
@@ -47,14 +47,14 @@ def cmd_batch(args) -> None:
     from facsim.cli import CliError
 
     if args.schema:
-        from .spec import _schema_text
+        from facsim.batch.spec import _schema_text
 
         print(_schema_text(), end="")
         return
     if args.spec is None:
         raise CliError("batch needs a SPEC file (or --schema)")
-    from .items import expand
-    from .spec import load_spec
+    from facsim.batch.items import expand
+    from facsim.batch.spec import load_spec
 
     spec = load_spec(args.spec)
     if args.dry_run:
@@ -71,7 +71,7 @@ def cmd_batch(args) -> None:
             import distributed  # noqa: F401
         except ImportError:
             raise CliError("--dask and --scheduler need Dask: pip install 'facsim[dask]'") from None
-    from .run import BatchError, run_batch
+    from facsim.batch.run import BatchError, run_batch
 
     try:
         result = run_batch(spec, args.output, workers=args.workers, dask=args.dask, scheduler=args.scheduler,
