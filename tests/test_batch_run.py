@@ -227,7 +227,7 @@ def _facsim(*args) -> list[str]:
     return [sys.executable, "-m", "facsim", *args]
 
 
-@pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGTERM])
+@pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGTERM], ids=["SIGKILL", "SIGTERM"])
 def test_cli_killed_mid_run_then_rerun_gives_the_uninterrupted_bytes(spec_file, reference, tmp_path, sig):
     folder = tmp_path / "set"
     journal = folder / ".facsim-batch" / "journal.jsonl"
