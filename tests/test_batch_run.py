@@ -288,3 +288,17 @@ def test_timeline_and_muscle_items_render_in_process(tmp_path):
     muscle = render_item(items["m/zola/AU4_6_i100_muscle.png"])
     registers = render_item(items["m/zola/AU4_6_i100_registers.png"])
     assert muscle[:8] == registers[:8] == b"\x89PNG\r\n\x1a\n" and muscle != registers
+
+
+def test_pool_worker_killed_mid_run_is_replaced_and_the_set_completes(spec_file, reference, tmp_path):
+    killed = []
+
+    def kill_a_worker(item):
+        if not killed:
+            workers = [pid for pid in _children(os.getpid()) if b"spawn_main" in Path(f"/proc/{pid}/cmdline").read_bytes()]
+            os.kill(workers[0], signal.SIGKILL)
+            killed.append(workers[0])
+
+    result = run_batch(load_spec(spec_file), tmp_path, workers=2, progress=False, on_item=kill_a_worker)
+    assert killed and result.rendered == N_ITEMS and not result.failed
+    assert tree(tmp_path) == reference

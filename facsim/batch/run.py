@@ -155,15 +155,42 @@ def _locality(item: Item) -> tuple:
 
 # ------------------------------------------------------------ executors ---
 
+#: Times a broken process pool (a worker killed or crashed) is started again for the items it lost.
+POOL_RESTARTS = 2
+
+
 def _local_results(todo: list[Item], workers: int, threads: int) -> Iterator[tuple[Item, bytes | BaseException]]:
-    """Render on ``workers`` spawned processes; yields (item, bytes or the exception) as each finishes."""
+    """Render on ``workers`` spawned processes; yields (item, bytes or the exception) as each finishes.
+
+    A worker that dies (killed, out of memory, a crash in the driver) breaks the whole pool; the items
+    it and the others still had are then given to a new pool, up to :data:`POOL_RESTARTS` times.
+    """
+    from concurrent.futures.process import BrokenProcessPool
+
+    pending, restarts = list(todo), 0
+    while pending:
+        lost: list[tuple[Item, BaseException]] = []
+        for item, result in _one_pool(pending, workers, threads):
+            if isinstance(result, BrokenProcessPool):
+                lost.append((item, result))
+            else:
+                yield item, result
+        if lost and restarts < POOL_RESTARTS:
+            restarts += 1
+            pending = sorted((item for item, _ in lost), key=_locality)
+            continue
+        yield from lost
+        return
+
+
+def _one_pool(todo: list[Item], workers: int, threads: int) -> Iterator[tuple[Item, bytes | BaseException]]:
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
     from .work import init_worker, render_item
 
-    pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"),
-                               initializer=init_worker, initargs=(threads,))
+    pool = ProcessPoolExecutor(max_workers=min(workers, len(todo)), initializer=init_worker, initargs=(threads,),
+                               mp_context=multiprocessing.get_context("spawn"))
     finished = False
     try:
         futures = {pool.submit(render_item, item): item for item in todo}
