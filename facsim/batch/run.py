@@ -148,9 +148,14 @@ def verified(folder: Path, items: tuple[Item, ...], journal: Journal) -> dict[st
     return done
 
 
+#: Long items first within a character (videos, then glb, then stills), so the set does not end
+#: with one worker finishing a video while the others are idle.
+_KIND_ORDER = {"video": 0, "glb": 1, "still": 2}
+
+
 def _locality(item: Item) -> tuple:
     """Render order: items of one character and engine together, so workers reuse their faces."""
-    return (item.character, item.engine, item.width, item.height, item.kind, item.key)
+    return (item.character, item.engine, item.width, item.height, _KIND_ORDER[item.kind], item.key)
 
 
 # ------------------------------------------------------------ executors ---
