@@ -20,7 +20,7 @@ if [ ${#need[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${need[@]}"
 fi
 
-python3 -m pip install -q -e ".[test,studio,studio-test,speech]"
+python3 -m pip install -q -e ".[test,studio,studio-test,speech,dask]"
 bash tests/gltf_validator/install.sh   # the Khronos glTF validator the tests run (npm, pinned by its lock file)
 python3 -m facsim.cli data
 python3 -m facsim.studio.vendor   # three.js for the studio page (npm registry tarball, sha512 checked)

@@ -5,13 +5,15 @@ import random
 from pathlib import Path
 
 import pytest
+import yaml
 
 from facsim.exchange import (NotationFileError, dumps_notation, load_any_timeline, loads_notation, read_notation,
                              save_any_timeline, write_notation)
 from facsim.timeline.model import Blinks, Envelope, Hold, Segment, Timeline, Track
 from facsim.timeline.io import load_timeline
 
-EXAMPLES = sorted((Path(__file__).parents[1] / "examples").glob("*.*"))
+EXAMPLES = sorted(p for p in (Path(__file__).parents[1] / "examples").glob("*.*")
+                  if "blocks" not in (yaml.safe_load(p.read_text()) or {}))  # timelines, not stimulus sets
 
 RICH = Timeline((
     Track(facs="1+2+5B+26", timing=Envelope(0.2, 0.4, 0.4, 0.4, easing="sigmoid")),

@@ -15,7 +15,8 @@ from facsim.timeline.builders import stimulus_timeline
 from facsim.timeline.io import load_timeline, save_timeline, timeline_from_dict, timeline_schema, timeline_to_dict
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
-EXAMPLE_FILES = sorted(p for p in EXAMPLES.iterdir() if p.suffix in (".yaml", ".yml", ".json"))
+EXAMPLE_FILES = sorted(p for p in EXAMPLES.iterdir() if p.suffix in (".yaml", ".yml", ".json")
+                       and "blocks" not in (yaml.safe_load(p.read_text()) or {}))  # stimulus sets: test_batch_spec
 
 
 def au_track(code=12, **timing):

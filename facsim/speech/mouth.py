@@ -60,7 +60,7 @@ class MouthGauge:
         from scipy.sparse.csgraph import connected_components
 
         from facsim.head.landmarks import landmarks
-        from facsim.render.inputs import REGIONS
+        from facsim.head.mesh import REGIONS
 
         region = np.asarray(head.region)
         tri = np.asarray(head.triangles)

@@ -49,7 +49,8 @@ _WHERE = {
     "DEFAULT_ENGINE": "facsim.engines",
     "EASINGS": "facsim.timeline.easing",
     "VIEWS": "facsim.render.camera",
-    "hex_to_rgb": "facsim.head.appearance",
+    "hex_to_rgb": "facsim.head.colour",
+    "rigid_table": "facsim.engines.rigid",
     "register_table": "facsim.engines.registers",
     "simulated_codes": "facsim.engines.registers",
 }

@@ -165,7 +165,7 @@ def create_app(*, workdir, token: str | None = None, allowed_hosts: set[str] | N
         units = [{"code": u.code, "name": u.name, "region": u.region, "unilateral": u.unilateral,
                   "description": u.description, "muscles": list(u.muscles), "simulated": u.code in morphs}
                  for u in compat.catalogue().values() if u.rendered]
-        table = compat.register_table()
+        table = compat.rigid_table()
         rigid = {"head": {str(c): {k: v for k, v in s.items() if k in ("axis", "degrees", "translate")}
                           for c, s in table["head_motions"].items()},
                  "eyes": {str(c): {k: v for k, v in s.items() if k in ("axis", "left", "right")}
