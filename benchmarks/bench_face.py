@@ -50,14 +50,14 @@ def main(argv=None) -> int:
     plain = median_time(lambda: face.render("6+12", size=size, antialias=1), args.repeats * 2)
 
     frames = sample_frames(stimulus_timeline("happiness"))
-    positions = [face.deform(a) for a in frames]
+    deformations = [face.deform(a) for a in frames]
     deform = median_time(lambda: [face.deform(a) for a in frames], args.repeats) / len(frames)
 
     def render_sequence(aa):
-        for p in positions:
-            face.render(positions=p, size=size, antialias=aa)
-    sequence = median_time(lambda: render_sequence(args.antialias), max(2, args.repeats // 2)) / len(positions)
-    sequence_fxaa = median_time(lambda: render_sequence("fxaa"), max(2, args.repeats // 2)) / len(positions)
+        for d in deformations:
+            face.render(deformation=d, size=size, antialias=aa)
+    sequence = median_time(lambda: render_sequence(args.antialias), max(2, args.repeats // 2)) / len(deformations)
+    sequence_fxaa = median_time(lambda: render_sequence("fxaa"), max(2, args.repeats // 2)) / len(deformations)
 
     print(f"head model: {face.head.vertex_count} vertices, {len(face.head.topology.faces)} triangles "
           f"({face.head.topology.n_render} render vertices)")
@@ -73,7 +73,7 @@ def main(argv=None) -> int:
             video = median_time(lambda: animate(timeline, tmp / "happy.mp4", face=face, size=size,
                                                 antialias=aa), max(3, args.repeats // 2))
             print(f"3-s 30-fps {size}² MP4, {label}, end to end: {video:6.2f} s "
-                  f"({video / timeline.length:.2f}x real time; {len(positions) / video:.1f} fps overall)")
+                  f"({video / timeline.length:.2f}x real time; {len(deformations) / video:.1f} fps overall)")
     return 0
 
 

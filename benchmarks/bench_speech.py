@@ -27,7 +27,7 @@ SENTENCE = ("The quick brown fox jumps over the lazy dog, while five wizards box
 
 def main(argv=None) -> int:
     from facsim.face import Face
-    from facsim.speech.speak import speech_timeline
+    from facsim.timeline.speech import speech_timeline
     from facsim.speech.synth import _synthesize
     from facsim.pipeline import animate
     from facsim.timeline.model import Hold, Timeline, Track

@@ -92,9 +92,10 @@ def _speech_audio(timeline, fps):
     """A temporary WAV of the timeline's speech, as long as the video (``None`` without speech tracks)."""
     import tempfile
 
-    from facsim.speech.track import timeline_audio
+    from facsim.timeline.sampling import frame_count
+    from facsim.timeline.speech import timeline_audio
 
-    speech = timeline_audio(timeline, fps)
+    speech = timeline_audio(timeline, frame_count(timeline, fps) / fps)
     if speech is None:
         return None
     from scipy.io import wavfile

@@ -16,7 +16,6 @@ import pytest
 from PIL import Image
 
 from facsim.batch.items import expand
-from facsim.batch.manifest import sha256_file
 from facsim.batch.run import BatchError, run_batch
 from facsim.batch.spec import load_spec
 

@@ -42,7 +42,7 @@ def _shapes(face, utterance, names, emotion=None):
     phones = [p for p in utterance.phones if p.name in names]
     gauge = MouthGauge(face.head, face.neutral)
     acts = _activations(utterance, [p.middle for p in phones], emotion)
-    return phones, [gauge.measure(face.deform(a)) for a in acts]
+    return phones, [gauge.measure(face.deform(a).positions) for a in acts]
 
 
 # ------------------------------------------------------------- synthesis ---

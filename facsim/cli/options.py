@@ -42,7 +42,7 @@ def _size(text: str):
 def add_view_options(p: argparse.ArgumentParser) -> None:
     """Options shared by every command that renders."""
     from facsim.engines import DEFAULT_ENGINE, ENGINES
-    from facsim.render.camera import VIEWS
+    from facsim.render.options import VIEWS
 
     p.add_argument("--character", "-c", default="ava", help="preset name (see `facsim characters`) or random:SEED")
     p.add_argument("--engine", choices=tuple(ENGINES), default=DEFAULT_ENGINE, help="how AUs move the face")

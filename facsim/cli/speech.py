@@ -30,7 +30,7 @@ def add_commands(sub) -> None:
 def cmd_speak(args) -> None:
     from facsim.cli.dynamics import _progress
     from facsim.pipeline import animate
-    from facsim.speech.speak import speech_timeline
+    from facsim.timeline.speech import speech_timeline
     from facsim.timeline.io import save_timeline
 
     timeline = speech_timeline(args.text, audio=args.audio, transcript=args.transcript, voice=args.voice,

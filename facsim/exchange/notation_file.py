@@ -21,7 +21,7 @@ Example
     happiness    0.5-1.5@0.5                      <- emotion preset, hold at 50 %
     sadness/emfacs 1+0.5/0/0.5                    <- preset from a named table
     AU12L        0:0>0.8:C~smoothstep>1.6:0;2:0.3>2.5:0   <- AU track, segments
-    say "Pack my box." voice=slt @0.5             <- speech (facsim.speech.track)
+    say "Pack my box." voice=slt @0.5             <- speech (facsim.timeline.speech)
 
 Grammar
 -------
@@ -375,7 +375,7 @@ def _track(line: _Line, table: str, folder=None):
 
 
 def _speech_track(line: _Line, folder=None):
-    from facsim.speech.track import SpeechTrack
+    from facsim.timeline.speech import SpeechTrack
     from facsim.timeline.model import TimelineError
 
     start = line.pos

@@ -30,21 +30,12 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from facsim.render.options import PROJECTIONS, VIEWS
+
 __all__ = [
     "Camera", "VIEWS", "PROJECTIONS", "frame_camera", "frame_points", "view_matrix",
     "projection_matrix", "project", "camera_basis",
 ]
-
-#: Named views as ``(yaw, pitch)`` in degrees. "left" = the character's left side faces the camera.
-VIEWS: dict[str, tuple[float, float]] = {
-    "front": (0.0, 0.0),
-    "three-quarter-left": (45.0, 0.0),
-    "three-quarter-right": (-45.0, 0.0),
-    "profile-left": (90.0, 0.0),
-    "profile-right": (-90.0, 0.0),
-}
-
-PROJECTIONS = ("perspective", "orthographic")
 
 #: Portrait lens: a vertical field of view of 20 degrees (about a 65 mm lens on full frame
 #: in portrait orientation) keeps perspective distortion of the face low.

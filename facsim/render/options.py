@@ -16,7 +16,16 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass
 
-from facsim.render.camera import PROJECTIONS, VIEWS
+#: Named views: (yaw, pitch) in degrees; "...-left" shows the character's left side.
+VIEWS: dict[str, tuple[float, float]] = {
+    "front": (0.0, 0.0),
+    "three-quarter-left": (45.0, 0.0),
+    "three-quarter-right": (-45.0, 0.0),
+    "profile-left": (90.0, 0.0),
+    "profile-right": (-90.0, 0.0),
+}
+
+PROJECTIONS = ("perspective", "orthographic")
 
 #: Image sides facsim renders (pixels): below, faces are unreadable; above, llvmpipe runs out of memory.
 SIZE_RANGE = (16, 8192)

@@ -13,7 +13,7 @@ Examples
 --------
 >>> face = facsim.Face("ava")                               # doctest: +SKIP
 >>> gauge = MouthGauge(face.head, face.neutral)             # doctest: +SKIP
->>> gauge.measure(face.deform("24")).gap < 1.0              # doctest: +SKIP
+>>> gauge.measure(face.deform("24").positions).gap < 1.0              # doctest: +SKIP
 True
 """
 from __future__ import annotations
@@ -111,4 +111,4 @@ def mouth_shape(face, expression=None, *, positions=None) -> MouthShape:
     if gauge is None:
         gauge = MouthGauge(face.head, face.neutral)
         face._mouth_gauge = gauge
-    return gauge.measure(face.deform(expression) if positions is None else positions)
+    return gauge.measure(face.deform(expression).positions if positions is None else positions)

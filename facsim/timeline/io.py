@@ -179,7 +179,7 @@ def _segments_from(items: Sequence[Mapping], table: str) -> tuple[Segment, ...]:
 
 def _track_from_dict(data: Mapping, table: str, folder: Path | None = None) -> Track:
     if "say" in data or "audio" in data:
-        from facsim.speech.track import SpeechTrack
+        from facsim.timeline.speech import SpeechTrack
 
         audio = data.get("audio")
         if audio is not None and folder is not None and not Path(audio).is_absolute():

@@ -52,7 +52,7 @@ timing:
 * a hold (``start``, ``end``): the level is ``intensity`` from ``start`` to
   ``end``, with no ramps (a step on and off; use an envelope for ramps).
 
-Speech tracks (:mod:`facsim.speech.track`) say synthesised text or play a recording::
+Speech tracks (:mod:`facsim.timeline.speech`) say synthesised text or play a recording::
 
       - say: "Pack my box."  # synthesised text ...
         voice: slt           # slt (default), awb, rms, kal16, kal, piper:MODEL
@@ -189,7 +189,7 @@ class TimelineError(ValueError):
 
 # ------------------------------------------------------------ validation ---
 
-def _seconds(value: Any, name: str) -> float:
+def seconds(value: Any, name: str) -> float:
     """A finite time or duration >= 0, else a TimelineError at ``name``."""
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
         raise TimelineError(f"expected a number of seconds, got {value!r}", location=(name,))
@@ -204,7 +204,7 @@ def _seconds(value: Any, name: str) -> float:
 
 def _set_interval(item) -> None:
     """Check a frozen ``item``'s ``start`` and ``end`` (seconds, start before end); store them as floats."""
-    start, end = _seconds(item.start, "start"), _seconds(item.end, "end")
+    start, end = seconds(item.start, "start"), seconds(item.end, "end")
     if end <= start:
         raise TimelineError(f"must be after start ({start:g} s), got {end:g} s", location=("end",))
     object.__setattr__(item, "start", start)
@@ -330,7 +330,7 @@ class Envelope:
 
     def __post_init__(self):
         for name in ("start", *ENVELOPE_KEYS):
-            object.__setattr__(self, name, _seconds(getattr(self, name), name))
+            object.__setattr__(self, name, seconds(getattr(self, name), name))
         if self.onset + self.apex + self.offset <= 0:
             raise TimelineError("onset, apex and offset are all 0; the envelope would never show",
                                 location=("apex",))
@@ -569,6 +569,14 @@ class Blinks:
         object.__setattr__(self, "seed", int(self.seed))
 
 
+class SoundTrack:
+    """Base of tracks that carry sound and make their own AU curves (speech: :mod:`facsim.timeline.speech`).
+
+    A subclass gives ``start``, ``end``, ``label`` and ``curves(times)``; sampling
+    adds its curves to the AU tracks' by the subclass's own rule.
+    """
+
+
 @dataclass(frozen=True)
 class Timeline:
     """Everything a video shows: tracks, length, frame rate and pass-through settings.
@@ -602,11 +610,9 @@ class Timeline:
     description: str | None = None
 
     def __post_init__(self):
-        from facsim.speech.track import SpeechTrack
-
         tracks = tuple(self.tracks)
         for i, track in enumerate(tracks):
-            if not isinstance(track, (Track, SpeechTrack)):
+            if not isinstance(track, (Track, SoundTrack)):
                 raise TimelineError(f"expected a Track, got {type(track).__name__}", location=("tracks", i))
         object.__setattr__(self, "tracks", tracks)
         object.__setattr__(self, "fps", positive(self.fps, "fps"))
@@ -628,7 +634,7 @@ class Timeline:
             raise TimelineError(f"expected Blinks, got {self.blinks!r}", location=("blinks",))
         intensities_table(self.intensities)
         for i, track in enumerate(tracks):     # letters must read in this table too
-            if isinstance(track, SpeechTrack):
+            if isinstance(track, SoundTrack):
                 continue
             try:
                 track_activations(track, self.intensities)
@@ -676,8 +682,8 @@ class Timeline:
         Hold(start=0.0, end=1.0, intensity=1.0)
         """
         text = facs if isinstance(facs, str) else expression_text(facs, intensities)
-        start, end = _seconds(start, "start"), _seconds(end, "end")
-        onset, offset = _seconds(onset, "onset"), _seconds(offset, "offset")
+        start, end = seconds(start, "start"), seconds(end, "end")
+        onset, offset = seconds(onset, "onset"), seconds(offset, "offset")
         if end <= start:
             raise TimelineError(f"must be after start ({start:g} s), got {end:g} s", location=("end",))
         if onset == 0 and offset == 0:

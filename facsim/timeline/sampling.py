@@ -146,7 +146,7 @@ def activation_curves(timeline: Timeline, times) -> dict[tuple[int, str], np.nda
             totals[key] = totals.get(key, np.zeros(times.shape)) + value * level
     curves = {key: np.clip(np.round(totals[key], DECIMALS), 0.0, 1.0) for key in sorted(totals)}
     if speech:
-        from facsim.speech.track import with_speech
+        from facsim.timeline.speech import with_speech
 
         curves = with_speech(curves, speech, times)
     return curves

@@ -19,17 +19,16 @@ from pathlib import Path
 
 import numpy as np
 
-from .coarticulation import SpeechCurves, speech_curves
-from .utterance import Utterance
+from facsim.speech.coarticulation import SpeechCurves, speech_curves
+from facsim.speech.utterance import Utterance
+from facsim.timeline.model import DEFAULT_FPS, Blinks, Hold, SoundTrack, Timeline, TimelineError, Track, seconds
 
 def _error(problem: str, where: str):
-    from facsim.timeline.model import TimelineError
-
     return TimelineError(problem, location=(where,))
 
 
 @dataclass(frozen=True, kw_only=True)
-class SpeechTrack:
+class SpeechTrack(SoundTrack):
     """Speech that starts at ``start`` seconds: synthesised text, or a recording with its transcript.
 
     Parameters
@@ -53,14 +52,12 @@ class SpeechTrack:
     start: float = 0.0
 
     def __post_init__(self):
-        from facsim.timeline.model import _seconds
-
         if (self.say is None) == (self.audio is None):
             raise _error("a speech track takes either 'say' (text) or 'audio' (a WAV file) with 'transcript'",
                          "say")
-        object.__setattr__(self, "start", _seconds(self.start, "start"))
+        object.__setattr__(self, "start", seconds(self.start, "start"))
         if self.say is not None:
-            from .synth import check_text, check_voice
+            from facsim.speech.synth import check_text, check_voice
 
             if self.transcript is not None:
                 raise _error("'transcript' goes with 'audio'; 'say' is its own transcript", "transcript")
@@ -85,7 +82,7 @@ class SpeechTrack:
     def utterance(self) -> Utterance:
         """The audio and phone timings (synthesised or aligned once per process)."""
         if self.say is not None:
-            from .synth import synthesize
+            from facsim.speech.synth import synthesize
 
             return synthesize(self.say, self.voice or "slt")
         return _aligned(self.audio, Path(self.audio).stat().st_mtime_ns, self.transcript)
@@ -112,7 +109,7 @@ _ALIGNED: dict = {}
 def _aligned(path: str, mtime: int, transcript: str) -> Utterance:
     key = (path, mtime, transcript)
     if key not in _ALIGNED:
-        from .align import align_recording
+        from facsim.speech.align import align_recording
 
         try:
             _ALIGNED[key] = align_recording(path, transcript)
@@ -125,22 +122,18 @@ def speech_tracks(timeline) -> tuple[SpeechTrack, ...]:
     return tuple(t for t in timeline.tracks if isinstance(t, SpeechTrack))
 
 
-def timeline_audio(timeline, fps: float | None = None, rate: int | None = None) -> tuple[np.ndarray, int] | None:
+def timeline_audio(timeline, duration: float, rate: int | None = None) -> tuple[np.ndarray, int] | None:
     """The timeline's speech mixed into one mono track as long as its video, and its sample rate
     (``None`` without speech).
 
-    The track lasts exactly ``frame_count / fps`` seconds, so audio and video end together.
+    The track lasts ``duration`` seconds (the video's: frame count / fps), so audio and video end together.
     ``rate`` defaults to the highest rate among the clips (flite's 16 kHz needs no resampling).
     """
-    from facsim.timeline.sampling import frame_count
-
-    from .audio import mix
+    from facsim.speech.audio import mix
 
     tracks = speech_tracks(timeline)
     if not tracks:
         return None
-    fps = fps or timeline.fps
-    duration = frame_count(timeline, fps) / fps
     clips = [(t.start, t.utterance.samples, t.utterance.rate) for t in tracks]
     rate = rate or max(clip[2] for clip in clips)
     out = mix(clips, duration, rate)
@@ -153,7 +146,7 @@ def with_speech(curves, tracks, times) -> dict:
 
     Overlapping speech tracks add (clamped to 1) and speak while any of them does.
     """
-    from .combine import combine_curves
+    from facsim.speech.combine import combine_curves
 
     speech: dict = {}
     speaking = np.zeros(len(times))
@@ -164,3 +157,44 @@ def with_speech(curves, tracks, times) -> dict:
             speech[key] = speech[key] + values if key in speech else values
     combined = combine_curves(curves, speech, speaking)
     return {key: np.round(values, 12) for key, values in combined.items()}
+
+
+# ------------------------------------------------------ speaking timelines ---
+
+#: Blinks a minute while talking: people blink more in conversation (about 26) than at rest
+#: (about 17; Bentivoglio et al. 1997, Movement Disorders 12(6)).
+TALKING_BLINK_RATE = 26.0
+
+
+def speech_timeline(text: str | None = None, *, audio=None, transcript: str | None = None, voice: str | None = None,
+                    emotion: str | None = None, intensity="100%", table: str | None = None, blinks: bool = True,
+                    seed: int = 0, fps: float = DEFAULT_FPS, intensities: str = "hapfacs", **settings) -> Timeline:
+    """The timeline of a speaking character.
+
+    Parameters
+    ----------
+    text : str, optional
+        What to say (synthesised with ``voice``); or give ``audio`` and ``transcript``.
+    emotion, intensity, table
+        An emotion preset held for the whole clip at ``intensity`` (its lips and jaw
+        yield to speech while talking, see :mod:`facsim.speech.combine`).
+    blinks, seed
+        Spontaneous blinks (seeded, so the same inputs give the same video).
+    **settings
+        ``character``, ``engine``, ``description`` as for :class:`~facsim.timeline.model.Timeline`.
+    """
+    if text is not None and audio is not None:
+        raise ValueError("give text to say or --audio with --transcript, not both")
+    if audio is None and text is None:
+        raise ValueError("nothing to say: give the text, or --audio FILE.wav with --transcript")
+    if audio is not None:
+        speech = SpeechTrack(audio=str(audio), transcript=transcript)
+    else:
+        if transcript is not None:
+            raise ValueError("--transcript goes with --audio")
+        speech = SpeechTrack(say=text, voice=voice)
+    tracks = [speech]
+    if emotion:
+        tracks.append(Track(emotion=emotion, table=table, timing=Hold(0.0, speech.end, intensity)))
+    return Timeline(tuple(tracks), fps=fps, intensities=intensities,
+                    blinks=Blinks(rate_per_minute=TALKING_BLINK_RATE, seed=seed) if blinks else None, **settings)
