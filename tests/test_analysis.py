@@ -135,7 +135,7 @@ def test_round_trip_reads_the_rendered_au(ava_readings):
 
 
 def test_round_trip_head_pose_has_the_right_direction(ava_readings):
-    from facsim.exchange import head_levels
+    from facsim.engines.rigid import head_levels
 
     _, out = ava_readings
     turned = head_levels(out["51D"].rotvec - out["0"].rotvec)

@@ -79,7 +79,7 @@ class FrameAnalysis:
 
     def rigid_levels(self) -> dict[int, float]:
         """Levels of head codes 51–56 and eye codes 61–64 from pose and gaze."""
-        from facsim.exchange import eye_levels, head_levels
+        from facsim.engines.rigid import eye_levels, head_levels
 
         if not self.success:
             return {}

@@ -235,7 +235,7 @@ def _check_schema(data: Any) -> None:
 @lru_cache(maxsize=1)
 def hapfacs_stimuli() -> dict:
     """HapFACS 3.0's validation stimuli (``facsim/data/hapfacs_stimuli.yaml``):
-    ``{"single_aus": [49 codes], "combinations": [52 FACS strings]}``.
+    ``{"single_aus": [49 codes], "combinations": [54 FACS strings]}``.
 
     Examples
     --------

@@ -55,10 +55,12 @@ def build_cases(*, quick: bool) -> list[Case]:
     letters = table["quick_single_intensities" if quick else "single_intensities"]
     cases = [Case(f"{code}{letter}", "single", f"{code}{letter}") for code in rendered
              if code in FITTED or code in NOT_FITTED_WHY for letter in letters]
+    from facsim.batch.spec import hapfacs_stimuli
+
     level = table["combination_intensity"]
-    for row in table["combinations"]:
-        expr = "+".join(f"{code}@{level}" for code in row["aus"].split("+"))
-        cases.append(Case(row["aus"], "combination", expr))
+    for combination in hapfacs_stimuli()["combinations"]:
+        expr = "+".join(f"{code}@{level}" for code in combination.split("+"))
+        cases.append(Case(combination, "combination", expr))
     for name in EMOTIONS:
         for intensity in table["emotion_intensities"][-1:] if quick else table["emotion_intensities"]:
             expr = format_expression(emotion(name, intensity=intensity))
@@ -131,7 +133,7 @@ def run_validation(*, engines=("registers", "muscle"), characters=None, quick: b
     from facsim.analysis.processor import PRESENT, PRESENT_RIGID, format_levels
     from facsim.analysis.fit import build_basis, fit_frame, fit_identity
     from facsim.analysis.landmarks import LandmarkDetector
-    from facsim.exchange import eye_levels, head_levels
+    from facsim.engines.rigid import eye_levels, head_levels
     from facsim.facs.activations import activations
     from facsim.face import Face
     from facsim.facs.notation import parse
@@ -229,7 +231,7 @@ def score_combinations(readings, model, threshold: float, rigid_threshold: float
     groups: dict = {}
     for r in readings:
         groups.setdefault(r.case.name, []).append(r)
-    paper = {row["aus"]: row for row in case_table()["combinations"]}
+    paper = {row["aus"]: row for row in case_table()["coders"]}
     rows = []
     for name, group in groups.items():
         tp = fp = tn = fn = 0
