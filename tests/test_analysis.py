@@ -224,3 +224,21 @@ def test_retarget_makes_a_character_video_of_the_same_length_with_sound(face_vid
     assert main(["retarget", str(face_video), "--character", "kwame", "--size", "128", "-o", str(out)]) == 0
     assert _frame_count(out) == _frame_count(face_video)
     assert has_audio(out)
+
+
+def test_cli_folder_lists_each_image_and_writes_openface_rows(tmp_path, astronaut, capsys):
+    import imageio.v2 as imageio
+
+    from facsim.cli import main
+
+    folder = tmp_path / "photos"
+    folder.mkdir()
+    imageio.imwrite(folder / "a_astronaut.png", astronaut)
+    imageio.imwrite(folder / "b_cat.png", skimage_data.chelsea())
+    assert main(["analyse", str(folder)]) == 0
+    lines = capsys.readouterr().out.strip().splitlines()
+    assert lines[0].startswith("a_astronaut.png\t") and AU12.search(lines[0].split("\t")[1])
+    assert lines[1] == "b_cat.png\tno face found"
+    assert main(["analyse", str(folder), "-o", str(tmp_path / "photos.csv")]) == 0
+    rows = (tmp_path / "photos.csv").read_text().splitlines()
+    assert len(rows) == 3 and [r.split(", ")[4] for r in rows[1:]] == ["1", "0"]
