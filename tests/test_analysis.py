@@ -47,6 +47,9 @@ def test_smiling_astronaut_reads_as_au12(astronaut_result):
 
 
 def test_result_is_frozen_and_reports_unobservable_aus(astronaut_result):
+    import facsim
+
+    assert facsim.analyse is analyse and isinstance(astronaut_result, facsim.Analysis)
     with pytest.raises(Exception):
         astronaut_result.fps = 3
     assert 19 in astronaut_result.unobservable  # the tongue: no landmark on it
