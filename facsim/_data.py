@@ -49,3 +49,18 @@ def require(table, name: str, key: str, kind: type = dict):
     if not isinstance(value, kind):
         raise DataError(f"{name}, {key}: expected a {kind.__name__}, got {type(value).__name__}")
     return value
+
+
+@lru_cache(maxsize=None)
+def load_arrays(name: str) -> dict:
+    """``facsim/data/NAME`` (an ``.npz``) as a dict of read-only arrays (cached)."""
+    import numpy as np
+
+    try:
+        with resources.files("facsim").joinpath("data", name).open("rb") as f, np.load(f, allow_pickle=False) as z:
+            arrays = {k: z[k] for k in z.files}
+    except (OSError, ValueError) as exc:
+        raise DataError(f"{name}: cannot be read ({exc})") from None
+    for array in arrays.values():
+        array.setflags(write=False)
+    return arrays

