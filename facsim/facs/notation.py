@@ -167,11 +167,17 @@ class ActionUnit:
                                  f"{self.intensity} in any intensity table; use letter=None")
 
     def __str__(self) -> str:
-        if self.letter is not None:
+        return self.format()
+
+    def format(self, intensities: str | None = None) -> str:
+        """This unit's notation. With ``intensities``, the text reads back to exactly this
+        unit under that letter table (a letter only where it means this intensity there,
+        otherwise the full-precision amount); without, the canonical short form."""
+        if self.letter is not None and (intensities is None or INTENSITY_TABLES[intensities][self.letter] == self.intensity):
             amount = self.letter
         else:
-            written = _format_amount(self.intensity)
-            amount = "" if written == "1" else f"@{written}"
+            written = _format_amount(self.intensity) if intensities is None else repr(self.intensity)
+            amount = "" if written in ("1", "1.0") else f"@{written}"
         return f"{_SIDE_PREFIX[self.side]}{self.code}{amount}"
 
 
@@ -349,8 +355,11 @@ def parse(text: str, *, intensities: str = "hapfacs") -> Expression:
     return Expression(tuple(units))
 
 
-def format_expression(expr: Expression) -> str:
+def format_expression(expr: Expression, *, intensities: str | None = None) -> str:
     """The canonical notation of an expression (see the module docstring).
+
+    With ``intensities`` (a letter table), the text reads back to exactly ``expr``
+    under that table (see :meth:`ActionUnit.format`).
 
     Examples
     --------
@@ -359,4 +368,4 @@ def format_expression(expr: Expression) -> str:
     >>> format_expression(Expression())
     '0'
     """
-    return "+".join(str(unit) for unit in expr.units) or "0"
+    return "+".join(unit.format(intensities) for unit in expr.units) or "0"

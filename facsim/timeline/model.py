@@ -120,7 +120,6 @@ DEFAULT_INTENSITIES = "hapfacs"
 BLINK_AU = 45
 #: Share of a blink's duration spent closing the lids (the rest re-opens them).
 BLINK_CLOSE_FRACTION = 0.4
-_SIDE_PREFIX = {"both": "", "left": "L", "right": "R", "unilateral": "U"}
 SIDE_SUFFIX = {"left": "L", "right": "R"}
 ENVELOPE_KEYS = ("onset", "apex", "offset")
 #: Levels are rounded to this many decimals (float noise from time arithmetic).
@@ -712,19 +711,11 @@ TABLE_ONLY_FOR_EMOTION = "'table' applies only to 'emotion' tracks (it names the
 
 def expression_text(expr, intensities: str) -> str:
     """FACS notation that reads back to ``expr`` exactly under ``intensities``."""
-    from facsim.facs.notation import Expression
+    from facsim.facs.notation import Expression, format_expression
 
     if not isinstance(expr, Expression):
         raise TypeError(f"expected FACS notation (str) or an Expression, got {type(expr).__name__}")
-    tokens = []
-    for unit in expr.units:
-        prefix = _SIDE_PREFIX[unit.side]
-        if unit.letter is not None and intensity_of(unit.letter, intensities) == unit.intensity:
-            amount = unit.letter
-        else:
-            amount = "" if unit.intensity == 1.0 else f"@{unit.intensity!r}"
-        tokens.append(f"{prefix}{unit.code}{amount}")
-    return "+".join(tokens) or "0"
+    return format_expression(expr, intensities=intensities)
 
 
 @lru_cache(maxsize=1024)

@@ -29,7 +29,7 @@ import numpy as np
 import yaml
 from scipy.spatial import cKDTree
 
-from facsim.engines.muscle.net import LID, OUTER, SIDES, SOCKET, Anatomy, Arcs, TensionNet, carry_points, patch, resolve_vertex
+from facsim.engines.muscle.net import LID, MOUTH, OUTER, SIDES, SOCKET, Anatomy, Arcs, TensionNet, carry_points, patch, resolve_vertex
 
 AU_FILE = "muscle_aus.yaml"
 #: Depth (in tissue depths below the skin) of an insertion's muscle point.
@@ -518,7 +518,7 @@ def build_tongue(head, anat: Anatomy, net: TensionNet, spec: dict, positions: np
     reach = t["reach"] * net.scale
     # Points the tip can meet: the lining, and the lips and cheeks (through their thickness).
     d = np.linalg.norm(net.rest - tip, axis=1)
-    lining = (anat.kind == 3) & (d < reach + 0.3 * net.scale)
+    lining = (anat.kind == MOUTH) & (d < reach + 0.3 * net.scale)
     outer = (anat.kind == OUTER) & (d < reach + 0.25 * net.scale) & (net.rest[:, 1] < tip[1] + 0.25 * net.scale)
     contact = np.flatnonzero(lining | outer)
     offset = np.where(anat.kind[contact] == OUTER, 0.6 * net.depth[contact], 0.0)

@@ -886,13 +886,13 @@ def _lerp_drive(a: Drive, b: Drive, t: float) -> Drive:
 
 
 def solve(model: Model, state: State, target: Drive, *, steps: int = 3, iterations: int = 12,
-          settle: bool = True, callback=None) -> State:
+          settle: bool = True) -> State:
     """Apply the change from ``state.drive`` to ``target`` in ``steps`` increments.
 
     Each increment adds 1/steps of the change and relaxes the net toward
     equilibrium from the previous one (Platt & Badler's n-step contraction);
-    every intermediate state is a valid expression, and ``callback(state)``
-    sees each one (animation frames).
+    every intermediate state is a valid expression (an animation steps with
+    ``steps=1`` per frame).
 
     ``settle`` re-chooses, at the end, the bone each point lies over after
     sliding and projects onto it (a static solve's last word). Without it (the
@@ -932,6 +932,4 @@ def solve(model: Model, state: State, target: Drive, *, steps: int = 3, iteratio
                     break
                 x, _ = project_contacts(model, x, floors)
             known = None
-        if callback is not None:
-            callback(State(x, d, ld.jaw, memory, floors, age, known))
     return State(x, target, ld.jaw, memory, floors, age, known)
