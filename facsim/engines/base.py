@@ -61,7 +61,16 @@ class Deformation:
 
 
 class Engine(Protocol):
-    """What :class:`facsim.face.Face` needs of an engine (see the module docstring)."""
+    """What :class:`facsim.face.Face` needs of an engine (see the module docstring).
+
+    Parameters
+    ----------
+    head : HeadModel
+    data : FaceData
+    character : Character
+    base_positions : (19158, 3) array
+        The character's neutral base mesh.
+    """
 
     name: str
     #: Neutral geometry positions (N_geo, 3) float32.

@@ -101,13 +101,8 @@ def register_weights(act: Activations) -> dict[Column, float]:
 class RegisterEngine:
     """The register engine (an :class:`~facsim.engines.base.Engine`): Activations → :class:`Deformation`.
 
-    Parameters
-    ----------
-    head : HeadModel
-    data : FaceData
-    character : Character
-    base_positions : (19158, 3) array
-        The character's neutral base mesh.
+    Built once per character from ``(head, data, character, base_positions)``, as every
+    :class:`~facsim.engines.base.Engine` is.
     """
 
     name = "registers"

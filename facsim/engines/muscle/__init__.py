@@ -118,13 +118,8 @@ class MuscleEngine:
     only the change from the previous frame's activations. Each result carries
     the skin's creases (computed when a renderer first asks for them).
 
-    Parameters
-    ----------
-    head : HeadModel
-    data : FaceData
-    character : Character
-    base_positions : (19158, 3) array
-        The character's neutral base mesh.
+    Built once per character from ``(head, data, character, base_positions)``, as every
+    :class:`~facsim.engines.base.Engine` is.
     """
 
     name = "muscle"
