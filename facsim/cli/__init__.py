@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import signal
 import sys
 from importlib import import_module
 
@@ -38,23 +39,49 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND", parser_class=_Parser)
     for group in COMMAND_GROUPS:
         import_module(f"facsim.cli.{group}").add_commands(sub)
+    from facsim.cli.options import add_overwrite_option
+
+    add_overwrite_option(parser)
     return parser
 
 
 def main(argv=None) -> int:
+    from facsim.atomic import overwriting
+
     parser = build_parser()
     args = parser.parse_args(argv)
+    stopped = _stop_on_signals()
     try:
-        args.handler(args)
-    except KeyboardInterrupt:
-        print("facsim: interrupted", file=sys.stderr)
-        return 130
+        with overwriting(getattr(args, "overwrite", False)):
+            args.handler(args)
+    except KeyboardInterrupt:  # Ctrl-C, SIGTERM or SIGHUP: temporaries were removed on the way out
+        name = signal.Signals(stopped[-1]).name if stopped else "SIGINT"
+        print(f"facsim: interrupted ({name}); nothing was left half-written", file=sys.stderr)
+        return 128 + (stopped[-1] if stopped else signal.SIGINT)
     except Exception as exc:  # one clear line, never a traceback (unless asked for)
         if os.environ.get("FACSIM_DEBUG"):
             raise
         print(f"facsim: error: {_message(exc)}", file=sys.stderr)
         return EXIT_USAGE if _is_user_error(exc) else 1
     return 0
+
+
+def _stop_on_signals() -> list:
+    """SIGTERM and SIGHUP stop a command like Ctrl-C (KeyboardInterrupt), so every ``with``
+    block and ``finally`` runs and no temporary file or folder stays behind. Returns the
+    list the signals received are appended to."""
+    received = []
+
+    def stop(signum, frame):
+        received.append(signum)
+        raise KeyboardInterrupt
+
+    for signum in (signal.SIGTERM, signal.SIGHUP):
+        try:
+            signal.signal(signum, stop)
+        except ValueError:  # not the main thread (main() called from a worker thread)
+            break
+    return received
 
 
 def _message(exc: BaseException) -> str:

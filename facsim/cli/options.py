@@ -62,3 +62,16 @@ def render_options(args) -> dict:
     """The Face.render keyword arguments from the shared view options."""
     return dict(view=args.view, yaw=args.yaw, pitch=args.pitch, size=args.size, projection=args.projection,
                 background=args.background, antialias=args.antialias)
+
+
+def add_overwrite_option(parser: argparse.ArgumentParser) -> None:
+    """``--overwrite`` on every (sub)command that writes ``-o/--output`` (see :func:`facsim.atomic.check_target`)."""
+    actions = parser._actions
+    if any(a.dest == "output" for a in actions) and not any(a.dest == "overwrite" for a in actions):
+        parser.add_argument("--overwrite", action="store_true",
+                            help="replace an existing folder of facsim's frames, or a file of another kind "
+                                 "(never a folder holding other files)")
+    for action in actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for sub in set(action.choices.values()):
+                add_overwrite_option(sub)

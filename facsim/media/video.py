@@ -2,7 +2,8 @@
 
 :class:`VideoWriter` is a resource (``with`` / ``close()``) that writes to a
 temporary file beside the target and moves it into place only when every frame
-was written, so an interrupted render never leaves a half-written video.
+was written and the file holds them all, so an interrupted or failed render
+never leaves a half-written video, and never reports one as written.
 
 Wiring a timeline, a face and a writer together is :func:`facsim.pipeline.animate`'s job.
 
@@ -33,8 +34,17 @@ def video_format(path) -> str:
     raise ValueError(f"unknown video format {path.suffix!r} for {str(path)!r}; use .mp4, .webm, .gif, .png or a folder name")
 
 
+class VideoError(RuntimeError):
+    """ffmpeg failed, or the finished file does not hold every frame (one line: the file and ffmpeg's reason)."""
+
+
 class VideoWriter:
     """Append RGBA or RGB uint8 frames; ``close()`` finalises the file atomically.
+
+    MP4, WebM and GIF frames stream into one ffmpeg process (memory flat in the
+    video's length); ``close()`` checks ffmpeg's exit status and counts the
+    frames in the finished file before moving it into place. Identical frames
+    give byte-identical files in every format.
 
     Parameters
     ----------
@@ -50,29 +60,36 @@ class VideoWriter:
         End the file with the shorter stream (ffmpeg ``-shortest``, for audio longer than
         the video). False for audio made to the video's length: ``-shortest`` ends on whole
         audio codec frames and can drop the last video frame.
+    overwrite : bool, optional
+        May replace a folder of facsim's own frames or a file of another kind
+        (see :func:`facsim.atomic.check_target`); default: the CLI's ``--overwrite``.
     """
 
-    def __init__(self, path, fps: float = 30.0, *, audio=None, quality: int = 8, cut_audio: bool = True):
+    def __init__(self, path, fps: float = 30.0, *, audio=None, quality: int = 8, cut_audio: bool = True,
+                 overwrite: bool | None = None):
         self.path = Path(path)
         self.format = video_format(self.path)
         self.fps = float(fps)
-        if not self.fps > 0:
+        if not self.fps > 0 or not np.isfinite(self.fps):
             raise ValueError(f"fps must be > 0, got {fps}")
         if audio is not None and not Path(audio).is_file():
             raise FileNotFoundError(f"audio file {audio} does not exist")
         if audio is not None and self.format not in ("mp4", "webm"):
             raise ValueError(f"an audio track can only be muxed into .mp4 or .webm, not {self.format}")
+        if audio is not None:
+            _check_audio(audio)
         self.audio = None if audio is None else str(audio)
         self.cut_audio = cut_audio
         self.quality = quality
+        self.overwrite = overwrite
         self.frames_written = 0
-        self._encoder = None
-        self._gif_frames: list = []
+        self._encoder = None     # the ffmpeg process
+        self._log = None         # its stderr
         if self.format == "png" and self.path.suffix:  # "frames.png" names the folder "frames"
             self.path = self.path.with_suffix("")
         if not self.path.parent.is_dir():
             raise FileNotFoundError(f"folder {self.path.parent} does not exist")
-        self._tmp = temp_beside(self.path, directory=self.format == "png")
+        self._tmp = temp_beside(self.path, directory=self.format == "png", overwrite=overwrite)
         self._closed = False
 
     def append(self, frame: np.ndarray) -> None:
@@ -84,61 +101,115 @@ class VideoWriter:
             from facsim.media.images import write_png
 
             write_png(self._tmp / f"frame_{self.frames_written:05d}.png", frame)
-        elif self.format == "gif":
-            self._gif_frames.append(_rgb(frame))
         else:
             if self._encoder is None:
-                self._encoder = self._start(frame.shape[1], frame.shape[0])
-            self._encoder.send(_opaque_rgba(frame))
+                self._size = (frame.shape[1], frame.shape[0])
+                self._encoder = self._start(*self._size)
+            elif (frame.shape[1], frame.shape[0]) != self._size:
+                raise ValueError(f"frame {self.frames_written} is {frame.shape[1]}x{frame.shape[0]}, "
+                                 f"the video {self._size[0]}x{self._size[1]}")
+            try:
+                self._encoder.stdin.write(memoryview(_opaque_rgba(frame)).cast("B"))
+            except (BrokenPipeError, OSError):   # ffmpeg stopped: say why
+                raise self._failure() from None
         self.frames_written += 1
 
     def _start(self, width: int, height: int):
+        import subprocess
+        import tempfile
+        from fractions import Fraction
+
         import imageio_ffmpeg
 
-        if width % 2 or height % 2:
+        if self.format != "gif" and (width % 2 or height % 2):
             raise ValueError(f"H.264/VP9 with yuv420p need even frame sizes, got {width}x{height}")
-        codec, extra = ("libx264", ["-preset", "veryfast", "-movflags", "+faststart"]) if self.format == "mp4" else ("libvpx-vp9", ["-row-mt", "1", "-deadline", "realtime", "-cpu-used", "8"])
-        audio_codec = None if self.audio is None else ("aac" if self.format == "mp4" else "libopus")
-        encoder = imageio_ffmpeg.write_frames(
-            str(self._tmp), (width, height), fps=self.fps, codec=codec, pix_fmt_in="rgba", pix_fmt_out="yuv420p",
-            quality=self.quality, macro_block_size=1, output_params=extra + (["-shortest"] if self.audio and self.cut_audio else []),
-            audio_path=self.audio, audio_codec=audio_codec, ffmpeg_log_level="error",
-        )
-        encoder.send(None)  # start the generator
-        return encoder
+        loss = 1 - self.quality / 10.0   # imageio-ffmpeg's quality scale, so files match earlier versions
+        cmd = [imageio_ffmpeg.get_ffmpeg_exe(), "-y", "-v", "error", "-f", "rawvideo", "-vcodec", "rawvideo",
+               "-s", f"{width}x{height}", "-pix_fmt", "rgba", "-r", str(Fraction(self.fps).limit_denominator()),
+               "-i", "-"]
+        if self.audio is not None:
+            cmd += ["-i", self.audio, "-map", "0:v:0", "-map", "1:a:0",
+                    "-acodec", "aac" if self.format == "mp4" else "libopus"]
+            cmd += ["-shortest"] if self.cut_audio else []
+        else:
+            cmd += ["-an"]
+        if self.format == "mp4":
+            cmd += ["-vcodec", "libx264", "-pix_fmt", "yuv420p", "-crf", str(int(loss * 51)),
+                    "-preset", "veryfast", "-movflags", "+faststart"]
+        elif self.format == "webm":
+            # bitexact + no metadata: the muxer writes no random segment UID, date or encoder
+            # version, so identical frames give identical files.
+            cmd += ["-vcodec", "libvpx-vp9", "-pix_fmt", "yuv420p", "-qscale:v", str(int(loss * 30) + 1),
+                    "-row-mt", "1", "-deadline", "realtime", "-cpu-used", "8",
+                    "-fflags", "+bitexact", "-flags:v", "+bitexact", "-flags:a", "+bitexact", "-map_metadata", "-1"]
+        else:
+            # A palette per frame, made and used as the frame passes: nothing is kept for the whole clip.
+            cmd += ["-lavfi", "split[a][b];[a]palettegen=stats_mode=single[p];[b][p]paletteuse=new=1",
+                    "-loop", "0"]
+        cmd += ["-f", self.format, str(self._tmp)]
+        self._log = tempfile.TemporaryFile()
+        # A session of its own: Ctrl-C in a terminal stops facsim, which then stops ffmpeg and
+        # removes the temporary file, rather than ffmpeg dying first with a broken pipe.
+        return subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=self._log,
+                                start_new_session=True)
+
+    def _failure(self) -> Exception:
+        """The error to raise when ffmpeg failed: its exit status and the last line it wrote."""
+        try:
+            self._encoder.stdin.close()
+        except OSError:
+            pass
+        status = self._encoder.wait()
+        self._log.seek(0)
+        lines = [line.strip() for line in self._log.read().decode("utf-8", "replace").splitlines() if line.strip()]
+        if status == 0:  # it ended the file on its own: -shortest with shorter audio
+            if self.audio and self.cut_audio:   # a user error (exit 2 in the CLI), not a failure of ffmpeg's
+                return ValueError(f"could not write {self.path}: the audio {self.audio} is shorter than the "
+                                  f"video (it ends at frame {self.frames_written})")
+            return VideoError(f"could not write {self.path}: ffmpeg stopped taking frames at frame {self.frames_written}")
+        reason = lines[-1] if lines else f"exit status {status}"
+        return VideoError(f"could not write {self.path}: ffmpeg failed ({reason[:300]})")
 
     def close(self) -> Path:
-        """Finish the file and move it into place; returns the final path."""
+        """Finish the file, check it holds every frame, and move it into place; returns the final path."""
         if self._closed:
             return self.path
         self._closed = True
         try:
             if self.frames_written == 0:
                 raise ValueError("no frames were written")
-            if self.format == "gif":
-                from PIL import Image
-
-                images = [Image.fromarray(f) for f in self._gif_frames]
-                # GIF delays are whole centiseconds: spread the rounding so the clip keeps its length.
-                ends = np.round(np.arange(1, len(images) + 1) * 100.0 / self.fps) * 10
-                durations = np.diff(np.concatenate([[0], ends])).astype(int).tolist()
-                images[0].save(self._tmp, format="GIF", save_all=True, append_images=images[1:],
-                               duration=durations, loop=0, optimize=False)
-            elif self._encoder is not None:
-                self._encoder.close()
-            return commit(self._tmp, self.path)
+            if self._encoder is not None:
+                try:
+                    self._encoder.stdin.close()
+                except OSError:
+                    pass
+                if self._encoder.wait() != 0:
+                    raise self._failure()
+                found = count_frames(self._tmp)
+                # -shortest ends on whole audio codec frames: it may drop the last video frame.
+                least = self.frames_written - (1 if self.audio and self.cut_audio else 0)
+                if not least <= found <= self.frames_written:
+                    hint = " (is the audio shorter than the video?)" if self.audio and found < least else ""
+                    raise VideoError(f"could not write {self.path}: it holds {found} of "
+                                     f"{self.frames_written} frames{hint}")
+            return commit(self._tmp, self.path, overwrite=self.overwrite)
         except BaseException:
             self.abort()
             raise
 
     def abort(self) -> None:
-        """Drop everything written so far."""
+        """Drop everything written so far (stops ffmpeg, removes the temporary file)."""
         self._closed = True
         if self._encoder is not None:
+            if self._encoder.poll() is None:
+                self._encoder.kill()
             try:
-                self._encoder.close()
-            except Exception:
+                self._encoder.stdin.close()
+            except OSError:
                 pass
+            self._encoder.wait()
+        if self._log is not None:
+            self._log.close()
         discard(self._tmp)
 
     def __enter__(self):
@@ -149,6 +220,36 @@ class VideoWriter:
             self.close()
         else:
             self.abort()
+
+
+def count_frames(path) -> int:
+    """Video frames in an MP4, WebM or GIF file (its packets, read without decoding)."""
+    import re
+    import subprocess
+
+    import imageio_ffmpeg
+
+    run = subprocess.run([imageio_ffmpeg.get_ffmpeg_exe(), "-nostdin", "-v", "error", "-nostats", "-i", str(path),
+                          "-map", "0:v:0", "-c", "copy", "-f", "null", "-progress", "pipe:1", "-"],
+                         capture_output=True, text=True)
+    counts = re.findall(r"^frame=(\d+)", run.stdout, re.M)
+    if run.returncode != 0 or not counts:
+        return 0
+    return int(counts[-1])
+
+
+def _check_audio(audio) -> None:
+    """Refuse a file ffmpeg cannot read as sound, before any frame is rendered."""
+    import subprocess
+
+    import imageio_ffmpeg
+
+    run = subprocess.run([imageio_ffmpeg.get_ffmpeg_exe(), "-nostdin", "-v", "error", "-i", str(audio),
+                          "-map", "0:a:0", "-c", "copy", "-f", "null", "-"], capture_output=True, text=True)
+    if run.returncode != 0:
+        lines = [line.strip() for line in run.stderr.splitlines() if line.strip()]
+        reason = lines[-1] if lines else f"ffmpeg exit status {run.returncode}"
+        raise ValueError(f"audio file {audio} is not sound ffmpeg can read: {reason[:200]}")
 
 
 def _opaque_rgba(frame: np.ndarray) -> np.ndarray:
