@@ -134,3 +134,122 @@ def test_progress_into_a_log_writes_a_line_per_tenth(capsys):
     silent = Progress(90, enabled=False)
     silent.update(90)
     assert capsys.readouterr().err == ""
+
+
+# ------------------------------------------------ safety of outputs (issue 12) ---
+
+def _cli(tmp_path, *args, **kw):
+    return subprocess.run([sys.executable, "-m", "facsim", *args], capture_output=True, text=True, cwd=tmp_path, **kw)
+
+
+def _one_line_error(r, code=2):
+    lines = r.stderr.strip().splitlines()
+    return r.returncode == code and len(lines) == 1 and lines[0].startswith("facsim: error:")
+
+
+def test_cli_never_replaces_a_folder_it_did_not_make(tmp_path, short_clip):
+    from facsim.timeline.io import save_timeline
+
+    save_timeline(short_clip, tmp_path / "t.yaml")
+    (tmp_path / "shots").mkdir()
+    (tmp_path / "shots" / "a.jpg").write_text("a photo")
+    for extra in ([], ["--overwrite"]):
+        r = _cli(tmp_path, "animate", "t.yaml", "-o", "shots.png", "--size", "32", "--quiet", *extra)
+        assert _one_line_error(r) and "shots is a folder holding files facsim did not write (a.jpg)" in r.stderr
+    r = _cli(tmp_path, "animate", "t.yaml", "-o", ".", "--size", "32", "--quiet", "--overwrite")
+    assert _one_line_error(r) and "current folder" in r.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["shots", "t.yaml"]
+    assert [p.name for p in (tmp_path / "shots").iterdir()] == ["a.jpg"]
+
+
+def test_frames_replace_facsims_own_frames_only_with_overwrite(tmp_path, face_of, short_clip):
+    from facsim.atomic import OutputError, overwriting
+
+    folder = animate(short_clip, tmp_path / "frames", face=face_of("ava"), size=32)
+    with pytest.raises(OutputError, match="already holds 6 frames; use --overwrite"):
+        animate(short_clip, folder, face=face_of("ava"), size=32)
+    with overwriting():
+        animate(short_clip, folder, face=face_of("ava"), size=32)
+    assert len(list(folder.iterdir())) == 6 and [p.name for p in tmp_path.iterdir()] == ["frames"]
+
+
+def test_audio_that_is_not_sound_fails_in_one_line_and_leaves_nothing(tmp_path, short_clip):
+    from facsim.timeline.io import save_timeline
+
+    save_timeline(short_clip, tmp_path / "t.yaml")
+    (tmp_path / "not-really.wav").write_text("not sound at all\n")
+    r = _cli(tmp_path, "animate", "t.yaml", "-o", "x.mp4", "--size", "32", "--quiet", "--audio", "not-really.wav")
+    assert _one_line_error(r) and "not-really.wav is not sound" in r.stderr and "wrote" not in r.stdout
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["not-really.wav", "t.yaml"]
+
+
+def test_audio_shorter_than_the_video_is_an_error_not_a_cut_video(tmp_path):
+    wav = tmp_path / "short.wav"
+    subprocess.run([imageio_ffmpeg.get_ffmpeg_exe(), "-v", "error", "-f", "lavfi", "-i", "sine=duration=0.2",
+                    str(wav)], check=True)
+    frame = np.zeros((16, 16, 3), np.uint8)
+    with pytest.raises(ValueError, match="short.wav is shorter than the video"):
+        with VideoWriter(tmp_path / "x.mp4", 10, audio=wav) as writer:
+            for i in range(300):  # 30 s: ffmpeg stops taking frames once the sound ends
+                writer.append(frame + i % 200)
+    assert [p.name for p in tmp_path.iterdir()] == ["short.wav"]
+
+
+def test_a_file_missing_frames_is_not_reported_as_written(tmp_path, monkeypatch):
+    import facsim.media.video as video
+
+    monkeypatch.setattr(video, "count_frames", lambda path: 2)  # as if the muxer had dropped frames
+    with pytest.raises(video.VideoError, match=r"x.webm: it holds 2 of 3 frames"):
+        with VideoWriter(tmp_path / "x.webm", 10) as writer:
+            for _ in range(3):
+                writer.append(np.zeros((16, 16, 3), np.uint8))
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("signame, output", [("SIGTERM", "long.mp4"), ("SIGHUP", "frames")])
+def test_sigterm_and_sighup_leave_no_debris(tmp_path, signame, output):
+    import signal
+    import time
+
+    (tmp_path / "t.yaml").write_text("fps: 25\nduration: 120\ntracks:\n  - au: 12\n    start: 0\n    end: 120\n")
+    proc = subprocess.Popen([sys.executable, "-m", "facsim", "animate", "t.yaml", "-o", output, "--size", "16",
+                             "--quiet"], cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while not any(".part" in p.name for p in tmp_path.iterdir()):
+        assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
+        time.sleep(0.05)
+    time.sleep(0.5)  # frames are flowing
+    proc.send_signal(getattr(signal, signame))
+    out, err = proc.communicate(timeout=60)
+    assert proc.returncode == 128 + getattr(signal, signame), err
+    assert err.strip().splitlines() == [f"facsim: interrupted ({signame}); nothing was left half-written"]
+    assert [p.name for p in tmp_path.iterdir()] == ["t.yaml"]
+
+
+def test_gif_memory_is_flat_in_the_videos_length(tmp_path):
+    import tracemalloc
+
+    frame_bytes = 64 * 64 * 4
+    frames = [np.full((64, 64, 4), (i * 7 % 256, 90, 200 - i % 150, 255), np.uint8) for i in range(8)]
+    tracemalloc.start()
+    try:
+        with VideoWriter(tmp_path / "long.gif", 25) as writer:
+            for i in range(600):  # 24 s; a GIF holding every frame would need 600 frames' worth
+                writer.append(frames[i % 8].copy())  # a new array each time, as a renderer gives
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 40 * frame_bytes, peak
+    with Image.open(tmp_path / "long.gif") as im:
+        assert im.n_frames == 600 and im.size == (64, 64)
+
+
+@pytest.mark.parametrize("suffix", [".webm", ".mp4", ".gif"])
+def test_identical_frames_give_byte_identical_files(tmp_path, suffix):
+    rng = np.random.default_rng(3)
+    frames = [rng.integers(0, 256, (32, 32, 3), np.uint8) for _ in range(5)]
+    for name in ("a", "b"):
+        with VideoWriter(tmp_path / f"{name}{suffix}", 10) as writer:
+            for frame in frames:
+                writer.append(frame)
+    assert (tmp_path / f"a{suffix}").read_bytes() == (tmp_path / f"b{suffix}").read_bytes()
