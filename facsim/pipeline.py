@@ -53,11 +53,12 @@ def animate(timeline, path, *, face=None, character=None, engine=None, fps: floa
     GIFs have no sound.
     """
     from facsim.face import Face
-    from facsim.media.video import VideoWriter, video_format
+    from facsim.media.video import VideoWriter, check_output, video_format
     from facsim.timeline.sampling import sample_frames
 
     if face is not None and (character is not None or engine is not None):
         raise ValueError("give either face= or character=/engine=, not both (a Face already has its character and engine)")
+    check_output(path, audio=audio)  # refuse a bad target before the face is built and frames rendered
     render_options.setdefault("antialias", "fxaa")
     own_face = face is None
     if own_face:

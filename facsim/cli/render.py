@@ -41,6 +41,9 @@ def cmd_render(args) -> None:
         from facsim.facs.notation import parse
 
         expression = parse(args.expression or "neutral", intensities=args.intensities)
+    from facsim.atomic import check_target
+
+    check_target(args.output)  # before the face is built: a refusal should not wait for it
     with Face(args.character, engine=args.engine) as face:
         face.save(args.output, expression, **render_options(args))
     print(f"wrote {args.output}")

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from facsim.atomic import commit, discard, temp_beside
+from facsim.atomic import check_target, commit, discard, temp_beside
 
 FORMATS = {".mp4": "mp4", ".m4v": "mp4", ".webm": "webm", ".gif": "gif"}
 
@@ -32,6 +32,22 @@ def video_format(path) -> str:
     if path.suffix.lower() == ".png" or path.suffix == "":
         return "png"
     raise ValueError(f"unknown video format {path.suffix!r} for {str(path)!r}; use .mp4, .webm, .gif, .png or a folder name")
+
+
+def check_output(path, *, audio=None, overwrite: bool | None = None) -> Path:
+    """Refuse, before any frame is rendered, an output :class:`VideoWriter` would refuse at its
+    start (format, folder, a target facsim must not replace, audio ffmpeg cannot read); returns
+    the path the video will have."""
+    path = Path(path)
+    fmt = video_format(path)
+    if fmt == "png" and path.suffix:
+        path = path.with_suffix("")
+    if not path.parent.is_dir():
+        raise FileNotFoundError(f"folder {path.parent} does not exist")
+    check_target(path, directory=fmt == "png", overwrite=overwrite)
+    if audio is not None and Path(audio).is_file() and fmt in ("mp4", "webm"):
+        _check_audio(audio)
+    return path
 
 
 class VideoError(RuntimeError):
