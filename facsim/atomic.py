@@ -59,7 +59,10 @@ def check_target(path, *, directory: bool = False, overwrite: bool | None = None
     path = Path(path)
     overwrite = _overwrite.get() if overwrite is None else overwrite
     resolved = path.resolve()
-    cwd = Path.cwd().resolve()
+    try:
+        cwd = Path.cwd().resolve()
+    except FileNotFoundError:  # the current folder was removed: nothing of it to protect
+        cwd = Path("/nonexistent")
     if resolved == cwd or resolved in cwd.parents or resolved == Path.home().resolve():
         raise OutputError(f"refusing to write over {str(path)!r}: it is the current folder, one above it or "
                           "the home folder; name a new file or folder")

@@ -305,7 +305,9 @@ def _store(folder: Path, journal: Journal, item: Item, data: bytes) -> dict:
     """Write one finished file atomically, then journal it (in that order: a line means a whole file)."""
     path = folder / item.file
     path.parent.mkdir(parents=True, exist_ok=True)
-    atomic_write(path, lambda tmp: tmp.write_bytes(data))
+    # overwrite: the set's folder is claimed for this spec (_claim), and a file it names that failed
+    # verification (damaged, half-written by another tool) is replaced by the one the spec defines.
+    atomic_write(path, lambda tmp: tmp.write_bytes(data), overwrite=True)
     journal.append(item.key, item.file, hashlib.sha256(data).hexdigest(), len(data))
     return journal.entries[item.key]
 
