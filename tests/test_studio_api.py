@@ -338,3 +338,99 @@ def test_three_js_integrity_check_refuses_other_bytes():
 
     with pytest.raises(VendorError, match="sha512"):
         check_integrity(b"not three.js")
+
+
+# ------------------------------------------------------------------ speech ---
+
+SPEECH = {"fps": 10, "tracks": [{"au": 12, "start": 0, "onset": 0.3, "apex": 0.4, "offset": 0.3},
+                                 {"say": "Hello there.", "voice": "slt", "start": 0.2}]}
+
+
+def test_speech_clip_is_sampled_and_drawn(client):
+    body = client.post("/api/timeline/preview", json={"timeline": SPEECH}).json()
+    speech = body["speech"]["1"]
+    assert speech["start"] == 0.2 and speech["end"] > 0.6 and "Hello there." in speech["label"]
+    assert body["length"] == pytest.approx(speech["end"])
+    assert max(body["curves"]["26"]["left"]) > 0.1            # the jaw moves while it speaks
+    assert max(body["shapes"]["levels"][1]) > 0.1 and body["shapes"]["levels"][1][0] < 0.05
+    bad_voice = {"tracks": [{"say": "Hi.", "voice": "nobody"}]}
+    assert "nobody" in problem(client.post("/api/timeline/preview", json={"timeline": bad_voice}), 422)["error"]
+    recording = {"tracks": [{"audio": "/etc/passwd", "transcript": "root"}]}
+    body = problem(client.post("/api/timeline/preview", json={"timeline": recording}), 422)
+    assert body["location"] == ["tracks", 0, "audio"]
+    problem(client.post("/api/jobs", json={"kind": "video", "timeline": recording}), 422)
+    assert "slt" in client.get("/api/catalogue").json()["voices"]
+
+
+def test_video_of_a_speech_clip_carries_its_audio(client, tmp_path):
+    from facsim.cli.analysis import has_audio
+
+    job = client.post("/api/jobs", json={"kind": "video", "format": "mp4", "timeline": SPEECH,
+                                         "options": {"size": 32}}).json()
+    assert wait_job(client, job["id"])["state"] == "done"
+    clip = tmp_path / "speech.mp4"
+    clip.write_bytes(client.get(f"/api/jobs/{job['id']}/download").content)
+    assert has_audio(clip)
+
+
+# ----------------------------------------------------------------- analyse ---
+
+def analyse(client, data: bytes, kind="image/png"):
+    return client.post("/api/analyse", content=data, headers={"content-type": kind})
+
+
+def png_of(array) -> bytes:
+    import io
+
+    from PIL import Image
+
+    buf = io.BytesIO()
+    Image.fromarray(array).save(buf, format="PNG")
+    return buf.getvalue()
+
+
+def test_analyse_a_photograph_gives_its_facs(client):
+    skimage_data = pytest.importorskip("skimage.data")
+    job = analyse(client, png_of(skimage_data.astronaut()))
+    assert job.status_code == 202 and job.json()["kind"] == "analyse"
+    assert wait_job(client, job.json()["id"])["state"] == "done"
+    result = client.get(f"/api/jobs/{job.json()['id']}/download").json()
+    assert result["kind"] == "image" and result["found"] == 1
+    assert "12" in result["expression"]                         # she smiles
+    assert client.post("/api/parse", json={"expression": result["expression"]}).status_code == 200
+
+
+def test_analyse_a_video_gives_a_timeline(client, tmp_path):
+    skimage_data = pytest.importorskip("skimage.data")
+    import imageio.v2 as imageio
+
+    path = tmp_path / "clip.mp4"
+    with imageio.get_writer(path, fps=5, macro_block_size=16) as writer:
+        for _ in range(5):
+            writer.append_data(skimage_data.astronaut())
+    job = analyse(client, path.read_bytes(), "video/mp4").json()
+    events = []
+    with client.stream("GET", f"/api/jobs/{job['id']}/events") as stream:
+        events = [line.split(":", 1)[1].strip() for line in stream.iter_lines() if line.startswith("event:")]
+    assert events[-1] == "done" and events.count("progress") >= 2
+    result = client.get(f"/api/jobs/{job['id']}/download").json()
+    assert result["kind"] == "video" and result["frames"] == 5
+    assert any(t.get("au") == 12 for t in result["timeline"]["tracks"])
+    preview = client.post("/api/timeline/preview", json={"timeline": result["timeline"]}).json()
+    assert preview["frames"] == 5 and max(preview["curves"]["12"]["left"]) > 0   # what the 3-D view plays
+
+
+def test_analyse_refuses_what_is_not_a_face_picture(client):
+    assert "not an image" in problem(analyse(client, b"hello, world", "application/octet-stream"), 415)["error"]
+    problem(analyse(client, b"", "image/png"), 422)
+    problem(analyse(client, b"\x89PNG\r\n\x1a\n", "text/plain"), 415)     # a form elsewhere could send this
+    from facsim.studio.requests import MAX_UPLOAD
+
+    assert str(MAX_UPLOAD) in problem(analyse(client, b"\xff\xd8\xff" + bytes(MAX_UPLOAD)), 413)["error"]
+    broken = wait_job(client, analyse(client, b"\x89PNG\r\n\x1a\n" + b"junk" * 16).json()["id"])
+    assert broken["state"] == "failed" and "cannot read the uploaded image" in broken["error"]
+    assert "jobs" not in broken["error"]                                   # no server path in the message
+    import numpy as np
+
+    blank = wait_job(client, analyse(client, png_of(np.full((96, 96, 3), 200, np.uint8))).json()["id"])
+    assert blank["state"] == "failed" and "no face found in the uploaded image" in blank["error"]

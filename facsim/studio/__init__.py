@@ -24,8 +24,10 @@ HTTP API (JSON in and out; errors are ``{"error": ..., "field": ...}`` with a 4x
     POST /api/character    {character} | {random: SEED}   checked parameters
     POST /api/character/yaml, /api/character/load, /api/character/glb
     POST /api/render       {expression, character, engine, options}   PNG, as ``facsim render``
-    POST /api/timeline/preview | load | save | stimulus
+    POST /api/timeline/preview | load | save | stimulus   (speech clips: {say, voice, start})
     POST /api/jobs         {kind: png|video|glb|arkit-csv|facs, ...}   → job; then
     GET  /api/jobs/ID, /api/jobs/ID/events (server-sent events), /api/jobs/ID/download
     POST /api/jobs/ID/cancel
+    POST /api/analyse      (the raw image or video file)   → an ``analyse`` job; its download is
+                                          analysis.json: the FACS string, and for a video the timeline
 """

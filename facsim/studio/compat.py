@@ -21,6 +21,8 @@ _WHERE = {
     "frame_times": "facsim.timeline.sampling",
     "activation_curves": "facsim.timeline.sampling",
     "TimelineError": "facsim.timeline.model",
+    "Track": "facsim.timeline.model",
+    "voice_names": "facsim.speech.synth",
     "timeline_from_dict": "facsim.timeline.io",
     "timeline_to_dict": "facsim.timeline.io",
     "timeline_schema": "facsim.timeline.io",

@@ -23,8 +23,11 @@ def error(status: int, message: str, **extra) -> JSONResponse:
 class Guard:
     """ASGI middleware: token check, ``Host`` check and the body size limit, before any handler runs."""
 
-    def __init__(self, app, *, token: str | None, allowed_hosts: set[str] | None, max_body: int):
+    def __init__(self, app, *, token: str | None, allowed_hosts: set[str] | None, max_body: int,
+                 uploads: dict[str, int] | None = None):
         self.app, self.token, self.allowed_hosts, self.max_body = app, token, allowed_hosts, max_body
+        #: path → its own, larger body limit (file uploads)
+        self.uploads = uploads or {}
 
     async def __call__(self, scope, receive, send):
         if scope["type"] != "http":
@@ -33,23 +36,24 @@ class Guard:
         problem = self._refuse(scope, headers)
         if problem is not None:
             return await problem(scope, receive, send)
+        limit = self.uploads.get(scope.get("path", ""), self.max_body)
         length = headers.get("content-length")
-        if length is not None and (not length.isdigit() or int(length) > self.max_body):
-            return await error(413, f"request body is larger than {self.max_body} bytes")(scope, receive, send)
+        if length is not None and (not length.isdigit() or int(length) > limit):
+            return await error(413, f"request body is larger than {limit} bytes")(scope, receive, send)
         seen = 0
 
         async def limited_receive():
             nonlocal seen
             message = await receive()
             seen += len(message.get("body", b""))
-            if seen > self.max_body:
+            if seen > limit:
                 raise _TooLarge()
             return message
 
         try:
             await self.app(scope, limited_receive, send)
         except _TooLarge:
-            await error(413, f"request body is larger than {self.max_body} bytes")(scope, receive, send)
+            await error(413, f"request body is larger than {limit} bytes")(scope, receive, send)
 
     def _refuse(self, scope, headers):
         if self.allowed_hosts is not None:

@@ -129,11 +129,16 @@ class RenderQueue:
         return await asyncio.wait_for(asyncio.wrap_future(self.submit(fn, *args)), timeout)
 
     # ------------------------------------------------------------- jobs ---
-    def start_job(self, kind: str, spec: dict) -> Job:
-        """Create a job folder and queue the job; raises :class:`Busy` when the queue is full."""
+    def start_job(self, kind: str, spec: dict, files: dict[str, bytes] | None = None) -> Job:
+        """Create a job folder (with ``files``: server-chosen name → bytes, e.g. an upload) and queue
+        the job; raises :class:`Busy` when the queue is full."""
+        from facsim.atomic import atomic_write
+
         job_id = uuid.uuid4().hex
         folder = self.jobs_dir / job_id
         folder.mkdir()
+        for name, data in (files or {}).items():
+            atomic_write(folder / name, lambda tmp, data=data: tmp.write_bytes(data))
         job = Job(job_id, kind, folder)
         try:
             job.future = self.submit(worker.run_job, job_id, str(folder), kind, spec)

@@ -245,6 +245,13 @@ def timeline_from_document(document: Any):
     if not isinstance(document, Mapping):
         raise RequestError("timeline must be a JSON object in facsim's timeline format (`facsim schema`)",
                            field="timeline")
+    tracks = document.get("tracks")
+    for i, track in enumerate(tracks if isinstance(tracks, list) else ()):
+        # a recording is a path on the server: the page may only send text to speak
+        if isinstance(track, Mapping) and "audio" in track:
+            raise RequestError("timeline: a speech clip in the studio says text ('say' with a 'voice'); "
+                               "recordings ('audio') go through `facsim animate`", field="timeline",
+                               location=["tracks", i, "audio"])
     try:
         timeline = compat.timeline_from_dict(document)
     except compat.TimelineError as exc:
@@ -318,6 +325,48 @@ def timeline_preview(document: Any) -> dict:
     import numpy as np
 
     grid = np.linspace(0.0, timeline.length, DRAW_SAMPLES)
-    shapes = [[round(float(v), 4) for v in track.levels(grid)] for track in timeline.tracks]
+    shapes, speech = [], {}
+    for i, track in enumerate(timeline.tracks):
+        if isinstance(track, compat.Track):
+            shapes.append([round(float(v), 4) for v in track.levels(grid)])
+            continue
+        # a speech clip: draw how much its mouth moves (the largest of its AU levels), and say where it ends
+        moving = track.curves(grid).aus.values()
+        level = np.max(np.stack(list(moving)), axis=0) if moving else np.zeros_like(grid)
+        shapes.append([round(float(v), 4) for v in np.clip(level, 0.0, 1.0)])
+        speech[str(i)] = {"start": round(track.start, 4), "end": round(track.end, 4), "label": track.label}
     return {"fps": timeline.fps, "length": timeline.length, "frames": len(times), "curves": out,
-            "shapes": {"step": timeline.length / (DRAW_SAMPLES - 1), "levels": shapes}}
+            "shapes": {"step": timeline.length / (DRAW_SAMPLES - 1), "levels": shapes}, "speech": speech}
+
+
+#: Largest upload the "Analyse" button accepts (an image or a short video).
+MAX_UPLOAD = 32 << 20
+#: Longest video the studio analyses, in frames.
+MAX_ANALYSE_FRAMES = 30 * 60
+#: Leading bytes of each accepted file type → (kind, suffix the job folder stores it under).
+SIGNATURES = (
+    (b"\x89PNG\r\n\x1a\n", "image", ".png"), (b"\xff\xd8\xff", "image", ".jpg"), (b"BM", "image", ".bmp"),
+    (b"II*\x00", "image", ".tif"), (b"MM\x00*", "image", ".tif"), (b"GIF87a", "video", ".gif"),
+    (b"GIF89a", "video", ".gif"), (b"\x1aE\xdf\xa3", "video", ".webm"),
+)
+
+
+def upload_kind(data: bytes) -> tuple[str, str]:
+    """``("image" | "video", suffix)`` of an uploaded file, by its content (never by the name the page sends).
+
+    >>> upload_kind(b"\\x89PNG\\r\\n\\x1a\\n" + bytes(8))
+    ('image', '.png')
+    """
+    if not data:
+        raise RequestError("the upload is empty: send an image or a short video", field="file")
+    if data[:4] == b"RIFF" and data[8:12] == b"WEBP":
+        return "image", ".webp"
+    if data[:4] == b"RIFF" and data[8:12] == b"AVI ":
+        return "video", ".avi"
+    if data[4:8] == b"ftyp":
+        return "video", ".mov" if data[8:10] == b"qt" else ".mp4"
+    for magic, kind, suffix in SIGNATURES:
+        if data.startswith(magic):
+            return kind, suffix
+    raise RequestError("the upload is not an image (PNG, JPEG, BMP, TIFF, WebP) or a video (MP4, MOV, WebM, "
+                       "MKV, AVI, GIF)", field="file", status=415)

@@ -30,11 +30,13 @@ from .vendor import VENDOR_ROOTS, VendorError, ensure_three, safe_vendor_path
 
 #: Largest request body accepted (a timeline or character file is a few kB).
 MAX_BODY = 1 << 20
+#: Content types a page elsewhere can send without a CORS preflight (so never accepted as uploads).
+SIMPLE_TYPES = ("application/x-www-form-urlencoded", "multipart/form-data", "text/plain")
 STATIC_FILES = {"app.js": "text/javascript", "timeline.js": "text/javascript", "style.css": "text/css",
                 "index.html": "text/html"}
 THUMBNAIL_VERSION = 1
 MEDIA_TYPES = {".png": "image/png", ".mp4": "video/mp4", ".webm": "video/webm", ".gif": "image/gif",
-               ".glb": "model/gltf-binary", ".csv": "text/csv", ".facs": "text/plain"}
+               ".glb": "model/gltf-binary", ".csv": "text/csv", ".facs": "text/plain", ".json": "application/json"}
 
 
 async def json_body(request: Request):
@@ -50,7 +52,8 @@ async def json_body(request: Request):
 
 
 def create_app(*, workdir, token: str | None = None, allowed_hosts: set[str] | None = None,
-               max_pending: int = 8, max_body: int = MAX_BODY, render_timeout: float = 300.0) -> FastAPI:
+               max_pending: int = 8, max_body: int = MAX_BODY, max_upload: int = checks.MAX_UPLOAD,
+               render_timeout: float = 300.0) -> FastAPI:
     """The studio application (the render worker starts with the app and stops with it).
 
     Parameters
@@ -63,6 +66,8 @@ def create_app(*, workdir, token: str | None = None, allowed_hosts: set[str] | N
         Accepted ``Host`` header names (without port); None accepts any.
     max_pending : int
         Render-queue bound; excess requests get 503.
+    max_upload : int
+        Largest file ``/api/analyse`` accepts, bytes (other bodies: ``max_body``).
     """
     from contextlib import asynccontextmanager
 
@@ -174,7 +179,8 @@ def create_app(*, workdir, token: str | None = None, allowed_hosts: set[str] | N
                 "intensity_tables": {k: dict(v) for k, v in compat.INTENSITY_TABLES.items()},
                 "views": {k: {"yaw": v[0], "pitch": v[1]} for k, v in compat.VIEWS.items()},
                 "engines": list(compat.ENGINES), "antialias": list(checks.ANTIALIAS), "rigid": rigid,
-                "max_size": checks.MAX_SIZE, "easings": list(compat.EASINGS)}
+                "max_size": checks.MAX_SIZE, "easings": list(compat.EASINGS),
+                "voices": [v for v in compat.voice_names() if ":" not in v]}
 
     @app.get("/api/emotions")
     async def emotions():
@@ -357,6 +363,25 @@ def create_app(*, workdir, token: str | None = None, allowed_hosts: set[str] | N
             raise RequestError(f"no job {job_id!r}", field="id", status=404)
         return job
 
+    @app.post("/api/analyse", status_code=202)
+    async def analyse_upload(request: Request):
+        """The camera processor on an uploaded image or short video (the raw file as the body).
+
+        Starts an ``analyse`` job; its ``analysis.json`` holds the FACS string (image) or the
+        analysed timeline (video). The file is stored only in the job's folder, under a name
+        the server picks from its content.
+        """
+        kind = request.headers.get("content-type", "").split(";")[0].strip().lower()
+        if kind in SIMPLE_TYPES or not kind:
+            # types a form on another page could send without a CORS preflight: never read them
+            raise RequestError("send the file itself as the body with its type (e.g. Content-Type: image/png)",
+                               field="file", status=415)
+        data = await request.body()
+        media, suffix = checks.upload_kind(data)
+        job = queue().start_job("analyse", {"kind": media, "upload": "upload" + suffix},
+                                files={"upload" + suffix: data})
+        return job.to_json()
+
     @app.get("/api/jobs/{job_id}")
     async def job_status(job_id: str):
         return find_job(job_id).to_json()
@@ -408,7 +433,8 @@ def create_app(*, workdir, token: str | None = None, allowed_hosts: set[str] | N
         return FileResponse(path, media_type=MEDIA_TYPES.get(path.suffix, "application/octet-stream"),
                             filename=path.name)
 
-    return Guard(app, token=token, allowed_hosts=allowed_hosts, max_body=max_body)
+    return Guard(app, token=token, allowed_hosts=allowed_hosts, max_body=max_body,
+                 uploads={"/api/analyse": max_upload})
 
 
 def serve(*, host: str = "127.0.0.1", port: int = 8000, open_browser: bool = False, token: str | None = None,

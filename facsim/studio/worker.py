@@ -112,11 +112,14 @@ def run_job(job_id: str, folder: str, kind: str, spec: dict) -> str:
     """Run one export job; writes a single file in ``folder`` and returns its name.
 
     ``kind`` is ``png``, ``video`` (``spec["format"]`` mp4/webm/gif), ``glb``,
-    ``arkit-csv`` or ``facs``. Progress is reported per frame for videos,
+    ``arkit-csv``, ``facs`` or ``analyse`` (the camera processor on ``spec["upload"]``,
+    a file in the job folder, into ``analysis.json``). Progress is reported per frame for videos,
     as one step otherwise. Raises :class:`Cancelled` when the folder is flagged.
     """
     folder = Path(folder)
     _check_cancel(folder)
+    if kind == "analyse":
+        return _analyse(job_id, folder, spec)
     if kind == "png":
         data = render_png(spec["character"], spec["engine"], spec["expression"], spec["intensities"],
                           spec["options"])
@@ -170,3 +173,42 @@ def _video(job_id: str, folder: Path, timeline, spec: dict) -> str:
     animate(timeline, folder / name, face=face_for(spec["character"], spec["engine"]), on_frame=on_frame,
             **_options(spec["options"]))
     return name
+
+
+def _analyse(job_id: str, folder: Path, spec: dict) -> str:
+    """The camera processor on the uploaded file: ``analysis.json`` with the FACS string (an image)
+    or the analysed timeline (a video), as ``facsim analyse`` finds them."""
+    from facsim.analysis.processor import AnalysisError, analyse, iter_frames
+    from facsim.studio.requests import MAX_ANALYSE_FRAMES
+    from facsim.timeline.io import timeline_to_dict
+
+    source = folder / spec["upload"]
+    what = "the uploaded image" if spec["kind"] == "image" else "the uploaded video"
+    try:
+        _, fps, total = iter_frames(source)
+        if total and total > MAX_ANALYSE_FRAMES:
+            raise AnalysisError(f"{what} has {total} frames; the studio analyses up to {MAX_ANALYSE_FRAMES} "
+                                f"(use `facsim analyse` for longer videos)")
+        _report(job_id, 0, total or 0)
+
+        def on_frame(done: int) -> None:
+            _check_cancel(folder)
+            if done > MAX_ANALYSE_FRAMES:
+                raise AnalysisError(f"{what} is longer than {MAX_ANALYSE_FRAMES} frames")
+            _report(job_id, done, max(total or 0, done))
+
+        result = analyse(source, on_frame=on_frame)
+    except AnalysisError as exc:
+        # the message names the server's path; the user knows the file by what they uploaded
+        message = str(exc)
+        for name in (f"image {source}", f"video {source}", str(source), source.name):
+            message = message.replace(name, what)
+        raise AnalysisError(message) from None
+    if not result.success:
+        raise AnalysisError(f"no face found in {what}")
+    found = sum(f.success for f in result.frames)
+    out = {"kind": spec["kind"], "frames": len(result.frames), "found": found, "fps": result.fps,
+           "expression": result.notation, "unobservable": {str(k): v for k, v in result.unobservable.items()}}
+    if spec["kind"] == "video":
+        out["timeline"] = timeline_to_dict(result.timeline())
+    return _write(folder, "analysis.json", json.dumps(out).encode(), job_id)
