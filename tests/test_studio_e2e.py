@@ -216,6 +216,32 @@ def test_character_and_timeline_files_round_trip(page, tmp_path):
     assert json.loads((tmp_path / "t.json").read_text())["tracks"][0]["segments"][0]["easing"] == "smoothstep"
 
 
+def test_speech_lane_and_analysed_photo(page, tmp_path):
+    page.click("#timeline-clear")
+    page.evaluate("() => studio.editor.seek(0)")            # a new clip starts at the playhead
+    page.fill("#say-text", "Hello there.")
+    page.click("#add-speech")
+    page.wait_for_function("studio.editor.speech[0] !== undefined && studio.curves && '26' in studio.curves.curves")
+    assert [lane["label"] for lane in page.evaluate("() => studio.editor.lanes()")] == ["Speech"]
+    doc = page.evaluate("() => studio.editor.doc")
+    assert doc["tracks"] == [{"say": "Hello there.", "voice": "slt", "start": 0}]
+    end = page.evaluate("() => studio.editor.speech[0].end")
+    assert doc["duration"] >= end > 0.5                       # the clip grew to hold the speech
+    jaw = page.evaluate("() => Math.max(...studio.curves.curves['26'].left)")
+    assert jaw > 0.1                                          # the 3-D view plays the server's speech curves
+    skimage_data = pytest.importorskip("skimage.data")
+    from PIL import Image
+
+    photo = tmp_path / "astronaut.png"
+    Image.fromarray(skimage_data.astronaut()).save(photo)
+    page.set_input_files("#analyse-file", str(photo))
+    page.wait_for_function("document.querySelector('#analyse-state').textContent.startsWith('astronaut.png:')",
+                           timeout=180_000)
+    assert "12" in page.input_value("#facs") and not page.is_visible("#analyse-error")
+    page.wait_for_function("+document.querySelector('#au-12-left').value > 0 || "
+                           "+document.querySelector('#au-12').value > 0")
+
+
 def test_fifty_concurrent_renders_are_answered_or_refused(server):
     from facsim.studio.loadtest import describe, run
 

@@ -4,7 +4,7 @@
 import * as THREE from 'three';
 import {GLTFLoader} from 'three/addons/loaders/GLTFLoader.js';
 import {OrbitControls} from 'three/addons/controls/OrbitControls.js';
-import {TimelineEditor, clipOf, writeClip} from '/static/timeline.js';
+import {TimelineEditor, clipOf, isSpeech, writeClip} from '/static/timeline.js';
 
 const $ = s => document.querySelector(s);
 const el = (tag, attrs = {}, ...kids) => {
@@ -335,7 +335,11 @@ const refreshPreview = debounce(async (doc, serial) => {
   try {
     const preview = await api('/api/timeline/preview', {timeline: doc});
     if (serial !== previewSerial) return;          // the document changed meanwhile
-    S.curves = preview; editor.setShapes(preview.shapes);
+    const longest = Math.max(0, ...Object.values(preview.speech).map(s => s.end));
+    if (doc.duration && longest > doc.duration + 1e-3) {     // grow the clip so the speech is not cut off
+      doc.duration = Math.ceil(longest * 10) / 10; editor.changed(); return;
+    }
+    S.curves = preview; editor.setShapes(preview.shapes, preview.speech);
     showError($('#timeline-error'), null);
     if (S.mode === 'timeline') showTime(editor.time);
   } catch (err) { showError($('#timeline-error'), err); }
@@ -345,6 +349,7 @@ function inspector(i) {
   box.replaceChildren(); box.hidden = i < 0;
   if (i < 0) return;
   const track = editor.doc.tracks[i], clip = clipOf(track);
+  if (isSpeech(track)) return speechInspector(box, i, track);
   const what = track.au !== undefined ? `AU${track.au} ${S.units[track.au]?.name || ''}` : track.emotion || track.facs;
   box.append(el('strong', {}, what));
   const update = () => { writeClip(track, clip); editor.changed(); inspector(i); };
@@ -368,6 +373,29 @@ function inspector(i) {
     box.append(el('span', {}, `hold ${clip.start}–${clip.end} s at ${pct(clip.intensity)}`));
   } else box.append(el('span', {}, 'segments (edit the file to change them)'));
   box.append(el('button', {onclick: () => editor.remove(i)}, 'Delete clip'));
+}
+function speechInspector(box, i, track) {
+  const changed = () => editor.changed();
+  box.append(el('strong', {}, 'Speech'));
+  if (track.say === undefined) box.append(el('span', {}, `a recording (${track.audio}): edit the file to change it`));
+  else {
+    box.append(el('label', {class: 'grow'}, 'says ', el('input', {type: 'text', value: track.say, 'data-field': 'say', style: 'flex:1',
+      onchange: e => { track.say = e.target.value; changed(); }})));
+    box.append(el('label', {}, 'voice ', el('select', {'data-field': 'voice', onchange: e => { track.voice = e.target.value; changed(); }},
+      ...S.catalogue.voices.map(v => el('option', {selected: (track.voice || 'slt') === v}, v)))));
+  }
+  box.append(el('label', {}, 'start ', el('input', {type: 'number', min: 0, step: 0.1, value: +(track.start || 0), 'data-field': 'start',
+    onchange: e => { track.start = Math.max(0, +e.target.value); changed(); }}), ' s'));
+  const span = editor.speech[i];
+  if (span) box.append(el('span', {class: 'hint'}, `${(span.end - span.start).toFixed(2)} s of speech`));
+  box.append(el('button', {onclick: () => editor.remove(i)}, 'Delete clip'));
+}
+function addSpeechClip() {
+  const text = $('#say-text').value.trim();
+  if (!text) { showError($('#timeline-error'), new Error('Type the text the face should say first.')); return; }
+  showError($('#timeline-error'), null);
+  const start = editor.time >= editor.duration - 0.05 ? 0 : +editor.time.toFixed(2);
+  editor.add({say: text, voice: $('#say-voice').value, start});
 }
 function addExpressionClips() {
   const start = editor.time >= editor.duration - 0.05 ? 0 : +editor.time.toFixed(2);
@@ -456,6 +484,47 @@ async function startExport(kind, format) {
   events.onerror = () => { if (events.readyState === EventSource.CLOSED) finish('connection lost'); };
 }
 
+// ------------------------------------------------------------------ analyse
+/** Send a photo or video to the camera processor; a photo's FACS code goes into the sliders, a video's
+ *  timeline into the editor. Progress and cancel go through the job machinery like the exports. */
+async function analyseFile(file) {
+  const state = $('#analyse-state'), bar = $('#analyse-progress'), cancel = $('#analyse-cancel'), box = $('#analyse-error');
+  showError(box, null); state.textContent = `uploading ${file.name}…`; bar.hidden = false; bar.value = 0; bar.max = 1;
+  const done = text => { state.textContent = text; bar.hidden = true; cancel.hidden = true; };
+  let job;
+  try {
+    const headers = {'Content-Type': file.type || 'application/octet-stream'};
+    if (token) headers['X-Facsim-Token'] = token;
+    const r = await fetch('/api/analyse', {method: 'POST', headers, body: file});
+    job = await r.json();
+    if (!r.ok) throw new Error(job.error || r.statusText);
+  } catch (err) { done(''); showError(box, err); return; }
+  cancel.hidden = false; cancel.onclick = () => api(`/api/jobs/${job.id}/cancel`, {});
+  const events = new EventSource(`/api/jobs/${job.id}/events`);
+  events.addEventListener('progress', e => {
+    const j = JSON.parse(e.data); bar.max = j.total || 1; bar.value = j.done;
+    state.textContent = j.state === 'queued' ? 'waiting…' : j.total > 1 ? `frame ${j.done} of ${j.total}` : 'looking for a face…';
+  });
+  events.addEventListener('done', async e => {
+    events.close();
+    try {
+      const result = await api(JSON.parse(e.data).download);
+      if (result.kind === 'video') {
+        editor.setDocument(result.timeline); editor.seek(0);
+        done(`${file.name}: a face in ${result.found} of ${result.frames} frames → the timeline`);
+      } else {
+        $('#facs').value = result.expression; S.emotion = null;
+        const r = await api('/api/parse', {expression: result.expression, intensities: S.intensities});
+        facsError(null); setFromUnits(r.units);
+        done(`${file.name}: ${result.expression}`);
+      }
+    } catch (err) { done(''); showError(box, err); }
+  });
+  events.addEventListener('failed', e => { events.close(); done(''); showError(box, new Error(JSON.parse(e.data).error)); });
+  events.addEventListener('cancelled', () => { events.close(); done('cancelled'); });
+  events.onerror = () => { if (events.readyState === EventSource.CLOSED) done('connection lost'); };
+}
+
 // ------------------------------------------------------------------- start
 let viewer;
 async function main() {
@@ -515,6 +584,9 @@ async function main() {
     editor.add(writeClip({au: +$('#add-au').value}, {start, onset: 1, apex: 1, offset: 1, intensity: 1, ein: 'linear', eout: 'linear'}));
   });
   $('#add-expression').addEventListener('click', addExpressionClips);
+  for (const v of catalogue.voices) $('#say-voice').append(el('option', {value: v}, v));
+  $('#add-speech').addEventListener('click', addSpeechClip);
+  $('#analyse-file').addEventListener('change', e => { const file = e.target.files[0]; if (file) analyseFile(file); e.target.value = ''; });
   $('#play').addEventListener('click', play);
   $('#duration').addEventListener('change', e => { editor.doc.duration = Math.max(0.1, +e.target.value); editor.changed(); });
   $('#fps').addEventListener('change', e => { editor.doc.fps = Math.max(1, +e.target.value); editor.changed(); });

@@ -1,5 +1,6 @@
 // The timeline editor: one lane per AU (and per FACS/emotion track), clips with
-// onset / apex / offset handles. The document it edits IS facsim's timeline format
+// onset / apex / offset handles, and a speech lane ({say, voice, start} tracks: drag
+// to move; how long each lasts, and how its mouth moves, come from the server). The document it edits IS facsim's timeline format
 // (facsim/data/timeline.schema.json): an envelope track when both ramps ease alike,
 // two HapFACS segments when they differ. The server samples it for the preview.
 
@@ -44,7 +45,13 @@ export function writeClip(track, c) {
   return track;
 }
 
-function trackEnd(track) {
+/** Whether ``track`` is a speech track (text the face says). */
+export const isSpeech = track => track.say !== undefined || track.audio !== undefined;
+/** Seconds a speech clip lasts before the server has said (about 13 characters a second). */
+const guessSpeech = track => Math.max(0.5, String(track.say || '').length / 13);
+
+function trackEnd(track, spans) {
+  if (isSpeech(track)) return (spans && spans.end) || (track.start || 0) + guessSpeech(track);
   const c = clipOf(track);
   if (c) return c.hold ? c.end : c.start + c.onset + c.apex + c.offset;
   return Math.max(0, ...(track.segments || []).map(s => s.end));
@@ -57,27 +64,29 @@ export class TimelineEditor {
     this.doc = {duration: 3, fps: 30, intensities: 'hapfacs', tracks: []};
     this.time = 0; this.selected = -1; this.drag = null;
     this.shapes = null;   // each track's sampled level from the server (easings drawn exactly)
+    this.speech = {};     // track index → {start, end, label} of each speech clip, from the server
     canvas.addEventListener('pointerdown', e => this.down(e));
     canvas.addEventListener('pointermove', e => this.move(e));
     canvas.addEventListener('pointerup', e => this.up(e));
     new ResizeObserver(() => this.draw()).observe(canvas);
   }
 
-  get duration() { return this.doc.duration || Math.max(1, ...this.doc.tracks.map(trackEnd)); }
-  setDocument(doc) { this.doc = doc; this.selected = -1; this.onSelect(-1); this.changed(); }
+  get duration() { return this.doc.duration || Math.max(1, ...this.doc.tracks.map((t, i) => trackEnd(t, this.speech[i]))); }
+  setDocument(doc) { this.doc = doc; this.speech = {}; this.selected = -1; this.onSelect(-1); this.changed(); }
   changed() { this.shapes = null; this.draw(); this.onChange(this.doc); }
   /** The server's sampled shapes for the document as it is now. */
-  setShapes(shapes) { this.shapes = shapes; this.draw(); }
+  setShapes(shapes, speech = {}) { this.shapes = shapes; this.speech = speech; this.draw(); }
 
   lanes() {
     const lanes = new Map();
     this.doc.tracks.forEach((t, i) => {
-      const key = t.au !== undefined ? `au:${t.au}` : `track:${i}`;
+      const speech = isSpeech(t);
+      const key = speech ? 'speech' : t.au !== undefined ? `au:${t.au}` : `track:${i}`;
       if (!lanes.has(key)) {
         const unit = t.au !== undefined && this.units[t.au];
-        const label = t.au !== undefined ? `AU${t.au}${unit ? ' ' + unit.name : ''}`
+        const label = speech ? 'Speech' : t.au !== undefined ? `AU${t.au}${unit ? ' ' + unit.name : ''}`
           : t.emotion ? `emotion: ${t.emotion}` : `FACS: ${t.facs}`;
-        lanes.set(key, {key, label, order: t.au !== undefined ? t.au : 1000 + i, tracks: []});
+        lanes.set(key, {key, label, order: speech ? 5000 : t.au !== undefined ? t.au : 1000 + i, tracks: []});
       }
       lanes.get(key).tracks.push(i);
     });
@@ -125,7 +134,32 @@ export class TimelineEditor {
     g.beginPath(); g.moveTo(px, 0); g.lineTo(px, height); g.stroke(); g.lineWidth = 1;
   }
 
+  /** A speech clip: a box from its start to its end, the mouth's movement inside, and its words. */
+  drawSpeech(g, i, top) {
+    const track = this.doc.tracks[i], bottom = top + LANE - 3, span = LANE - 8;
+    const start = Number(track.start || 0), end = trackEnd(track, this.speech[i]);
+    const x0 = this.x(start), x1 = this.x(end);
+    g.fillStyle = i === this.selected ? 'rgba(143,95,47,0.30)' : 'rgba(143,95,47,0.14)';
+    g.strokeStyle = '#8f5f2f';
+    g.fillRect(x0, top + 3, x1 - x0, LANE - 6); g.strokeRect(x0, top + 3, x1 - x0, LANE - 6);
+    const levels = this.shapes && !this.drag && this.shapes.levels[i];
+    if (levels) {
+      g.beginPath();
+      const step = this.shapes.step;
+      for (let k = Math.floor(start / step); k * step <= end && k < levels.length; k++) {
+        const x = this.x(k * step), y = bottom - levels[k] * span;
+        k * step <= start ? g.moveTo(x, y) : g.lineTo(x, y);
+      }
+      g.stroke();
+    }
+    g.save(); g.beginPath(); g.rect(x0, top, x1 - x0, LANE); g.clip();
+    g.fillStyle = '#5a3a1a'; g.fillText(`“${track.say ?? track.transcript}”`, x0 + 4, top + 13);
+    g.restore();
+    this.hits.push({i, top, bottom, span, p: [start, start, end, end], clip: {hold: true, speech: true, start, end}});
+  }
+
   drawTrack(g, i, top) {
+    if (isSpeech(this.doc.tracks[i])) return this.drawSpeech(g, i, top);
     const track = this.doc.tracks[i], clip = clipOf(track), bottom = top + LANE - 3, span = LANE - 8;
     const y = level => bottom - level * span;
     const selected = i === this.selected;
@@ -213,6 +247,7 @@ export class TimelineEditor {
       const shift = round(this.t(ex) - this.drag.t0);
       c.start = clamp(round(clip0.start + shift), 0, this.duration);
       if (c.hold) c.end = c.start + (clip0.end - clip0.start);
+      if (c.speech) this.speech[hit.i] = {...this.speech[hit.i], start: c.start, end: c.end};
     } else if (handle === 'level') {
       c.intensity = clamp(round((hit.bottom - ey) / hit.span), 0, 1);
     } else if (c.hold) {
@@ -227,7 +262,8 @@ export class TimelineEditor {
       c.offset = Math.max(MIN_RAMP, t - ends[2]);
     }
     for (const k of ['start', 'onset', 'apex', 'offset', 'end']) if (c[k] !== undefined) c[k] = round(c[k]);
-    writeClip(this.doc.tracks[hit.i], c);
+    if (c.speech) this.doc.tracks[hit.i].start = c.start;     // speech moves; its words set how long it lasts
+    else writeClip(this.doc.tracks[hit.i], c);
     this.drag.moved = true;
     this.draw(); this.onSelect(hit.i);
   }
@@ -243,12 +279,12 @@ export class TimelineEditor {
   /** Add a track (facsim format) and select it; grows the duration to fit. */
   add(track) {
     this.doc.tracks.push(track);
-    const end = trackEnd(track);
+    const end = trackEnd(track, null);
     if (end > (this.doc.duration || 0)) this.doc.duration = Math.ceil(end * 10) / 10;
     this.selected = this.doc.tracks.length - 1;
     this.onSelect(this.selected);
     this.changed();
   }
 
-  remove(i) { this.doc.tracks.splice(i, 1); this.select(-1); this.changed(); }
+  remove(i) { this.doc.tracks.splice(i, 1); this.speech = {}; this.select(-1); this.changed(); }
 }
