@@ -301,7 +301,9 @@ def create_app(*, workdir, token: str | None = None, allowed_hosts: set[str] | N
     @app.post("/api/timeline/preview")
     async def timeline_preview(request: Request):
         body = await json_body(request)
-        return checks.timeline_preview(body.get("timeline") if isinstance(body, dict) else None)
+        # off the event loop: a speech clip is synthesised here (flite, a fraction of a second per sentence)
+        return await asyncio.get_running_loop().run_in_executor(
+            None, checks.timeline_preview, body.get("timeline") if isinstance(body, dict) else None)
 
     @app.post("/api/timeline/load")
     async def timeline_load(request: Request):
