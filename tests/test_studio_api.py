@@ -356,10 +356,19 @@ def test_speech_clip_is_sampled_and_drawn(client):
     bad_voice = {"tracks": [{"say": "Hi.", "voice": "nobody"}]}
     assert "nobody" in problem(client.post("/api/timeline/preview", json={"timeline": bad_voice}), 422)["error"]
     recording = {"tracks": [{"audio": "/etc/passwd", "transcript": "root"}]}
-    body = problem(client.post("/api/timeline/preview", json={"timeline": recording}), 422)
-    assert body["location"] == ["tracks", 0, "audio"]
+    refused = problem(client.post("/api/timeline/preview", json={"timeline": recording}), 422)
+    assert refused["location"] == ["tracks", 0, "audio"]
     problem(client.post("/api/jobs", json={"kind": "video", "timeline": recording}), 422)
     assert "slt" in client.get("/api/catalogue").json()["voices"]
+    wav = client.post("/api/timeline/audio", json={"timeline": SPEECH})
+    assert wav.status_code == 200 and wav.content[:4] == b"RIFF" and wav.headers["content-type"] == "audio/wav"
+    import io
+
+    from scipy.io import wavfile
+
+    rate, samples = wavfile.read(io.BytesIO(wav.content))
+    assert len(samples) / rate == pytest.approx(body["frames"] / 10, abs=1e-3) and abs(samples).max() > 1000
+    assert client.post("/api/timeline/audio", json={"timeline": CLIP}).status_code == 204
 
 
 def test_video_of_a_speech_clip_carries_its_audio(client, tmp_path):

@@ -229,6 +229,7 @@ def test_speech_lane_and_analysed_photo(page, tmp_path):
     assert doc["duration"] >= end > 0.5                       # the clip grew to hold the speech
     jaw = page.evaluate("() => Math.max(...studio.curves.curves['26'].left)")
     assert jaw > 0.1                                          # the 3-D view plays the server's speech curves
+    page.wait_for_function("studio.audio && studio.audio.src.startsWith('blob:')")   # Play sounds the voice
     skimage_data = pytest.importorskip("skimage.data")
     from PIL import Image
 

@@ -25,6 +25,7 @@ HTTP API (JSON in and out; errors are ``{"error": ..., "field": ...}`` with a 4x
     POST /api/character/yaml, /api/character/load, /api/character/glb
     POST /api/render       {expression, character, engine, options}   PNG, as ``facsim render``
     POST /api/timeline/preview | load | save | stimulus   (speech clips: {say, voice, start})
+    POST /api/timeline/audio {timeline}   the speech as WAV (204 without speech)
     POST /api/jobs         {kind: png|video|glb|arkit-csv|facs, ...}   → job; then
     GET  /api/jobs/ID, /api/jobs/ID/events (server-sent events), /api/jobs/ID/download
     POST /api/jobs/ID/cancel

@@ -339,6 +339,26 @@ def timeline_preview(document: Any) -> dict:
             "shapes": {"step": timeline.length / (DRAW_SAMPLES - 1), "levels": shapes}, "speech": speech}
 
 
+def timeline_wav(document: Any) -> bytes | None:
+    """The timeline's speech as 16-bit WAV bytes, as long as its video (what an MP4 export carries);
+    None without speech. The page plays it along with the 3-D preview."""
+    import io
+
+    from scipy.io import wavfile
+
+    from facsim.speech.audio import to_pcm16
+    from facsim.timeline.sampling import frame_count
+    from facsim.timeline.speech import timeline_audio
+
+    timeline = timeline_from_document(document)
+    audio = timeline_audio(timeline, frame_count(timeline, timeline.fps) / timeline.fps)
+    if audio is None:
+        return None
+    buf = io.BytesIO()
+    wavfile.write(buf, int(audio[1]), to_pcm16(audio[0]))
+    return buf.getvalue()
+
+
 #: Largest upload the "Analyse" button accepts (an image or a short video).
 MAX_UPLOAD = 32 << 20
 #: Longest video the studio analyses, in frames.

@@ -305,6 +305,15 @@ def create_app(*, workdir, token: str | None = None, allowed_hosts: set[str] | N
         return await asyncio.get_running_loop().run_in_executor(
             None, checks.timeline_preview, body.get("timeline") if isinstance(body, dict) else None)
 
+    @app.post("/api/timeline/audio")
+    async def timeline_audio(request: Request):
+        """The timeline's speech as WAV (as long as the video), for playing along with the preview;
+        204 when the timeline has no speech."""
+        body = await json_body(request)
+        wav = await asyncio.get_running_loop().run_in_executor(
+            None, checks.timeline_wav, body.get("timeline") if isinstance(body, dict) else None)
+        return Response(status_code=204) if wav is None else Response(wav, media_type="audio/wav")
+
     @app.post("/api/timeline/load")
     async def timeline_load(request: Request):
         body = await json_body(request)

@@ -340,10 +340,20 @@ const refreshPreview = debounce(async (doc, serial) => {
       doc.duration = Math.ceil(longest * 10) / 10; editor.changed(); return;
     }
     S.curves = preview; editor.setShapes(preview.shapes, preview.speech);
+    loadSpeechAudio(doc, serial, Object.keys(preview.speech).length > 0);
     showError($('#timeline-error'), null);
     if (S.mode === 'timeline') showTime(editor.time);
   } catch (err) { showError($('#timeline-error'), err); }
 }, 120);
+/** The timeline's speech as WAV from the server, so Play sounds like the exported video. */
+async function loadSpeechAudio(doc, serial, speaks) {
+  if (S.audio) { S.audio.pause(); URL.revokeObjectURL(S.audio.src); S.audio = null; }
+  if (!speaks) return;
+  try {
+    const r = await api('/api/timeline/audio', {timeline: doc}, {raw: true});
+    if (serial === previewSerial && r.status === 200) S.audio = new Audio(URL.createObjectURL(await r.blob()));
+  } catch (err) { showError($('#timeline-error'), err); }
+}
 function inspector(i) {
   const box = $('#clip-inspector');
   box.replaceChildren(); box.hidden = i < 0;
@@ -418,6 +428,7 @@ function play() {
   S.playing = true; $('#play').textContent = '❚❚ Pause';
   if (editor.time >= editor.duration - 1e-3) editor.time = 0;
   const t0 = performance.now() - editor.time * 1000;
+  if (S.audio) { S.audio.currentTime = editor.time; S.audio.play().catch(() => {}); }
   const tick = now => {
     if (!S.playing) return;
     const t = (now - t0) / 1000;
@@ -426,7 +437,7 @@ function play() {
   };
   requestAnimationFrame(tick);
 }
-function stop() { S.playing = false; $('#play').textContent = '▶ Play'; }
+function stop() { S.playing = false; $('#play').textContent = '▶ Play'; if (S.audio) S.audio.pause(); }
 
 // ------------------------------------------------------------------ outputs
 function renderOptions() {
