@@ -94,10 +94,75 @@ class Face:
         return self.head.positions(self.base_positions)
 
     @cached_property
+    def proxies(self) -> list:
+        """The character's hair, brow and lash proxies (:class:`facsim.head.proxies.BoundProxy`)."""
+        from facsim.head.proxies import bind_character_proxies
+
+        return bind_character_proxies(self.character, self.head, self.base_positions, self.neutral)
+
+    @cached_property
+    def proxy_meshes(self) -> list:
+        """What the renderer uploads of each proxy (:class:`facsim.render.proxies.ProxyMesh`), in draw order."""
+        from facsim.render.proxies import ProxyMesh
+
+        return [ProxyMesh(b.proxy.name, b.proxy.kind, b.proxy.triangles, b.proxy.corner_vertex, b.proxy.uv,
+                          b.proxy.texture, b.depth) for b in self.proxies]
+
+    def proxy_draws(self, positions: np.ndarray) -> list:
+        """This frame's :class:`facsim.render.proxies.ProxyDraw` s for geometry ``positions``."""
+        from facsim.render.proxies import ProxyDraw
+
+        return [ProxyDraw(mesh, bound.binding.positions(positions), tuple(self.colors[bound.color_key]), bound.sheen)
+                for bound, mesh in zip(self.proxies, self.proxy_meshes)]
+
+    @cached_property
+    def colors(self) -> dict:
+        """The character's sRGB colours, hair included (:func:`facsim.head.appearance.character_colors`)."""
+        from facsim.head.appearance import character_colors
+
+        return character_colors(self.character)
+
+    @cached_property
     def appearance(self):
         from facsim.head.appearance import character_appearance
 
-        return character_appearance(self.character, self.head)
+        brows = any(p.proxy.kind == "eyebrows" for p in self.proxies)
+        return character_appearance(self.character, self.head, painted_brows=not brows)
+
+    @cached_property
+    def topology(self):
+        """What the renderer draws of the head: hm08's lash strips give way to a lash proxy,
+        and the teeth get coordinates for separate crowns and gums."""
+        from facsim.head.mesh import REGIONS, RenderTopology
+        from facsim.head.proxies import teeth_coordinates
+
+        topo = self.head.topology
+        faces = topo.faces
+        if any(p.proxy.kind == "eyelashes" for p in self.proxies):
+            faces = faces[topo.face_regions() != REGIONS.index("lashes")]
+        # Teeth have no skin UVs: give them (arc length from the midline, root-ward height),
+        # which the teeth shader turns into separate teeth and gums.
+        uv = np.array(topo.uv, copy=True)
+        coords = teeth_coordinates(self.head, self.data, self.base_positions)
+        on_teeth = np.flatnonzero(topo.region == REGIONS.index("teeth"))
+        uv[on_teeth] = coords[topo.render_to_geo[on_teeth]]
+        return RenderTopology(faces=faces, render_to_geo=topo.render_to_geo, uv=uv,
+                              region=topo.region, eye_coord=topo.eye_coord)
+
+    @cached_property
+    def shading_occlusion(self) -> np.ndarray:
+        """:attr:`occlusion` with the skin under the hair shadowed by it and the mouth darkening with depth."""
+        from facsim.head.proxies import hair_shadow, mouth_depth_visibility
+
+        occlusion = np.array(self.occlusion, np.float32, copy=True)
+        interior, visibility = mouth_depth_visibility(self.head, self.neutral)
+        occlusion[interior] = visibility
+        for bound in self.proxies:
+            if bound.proxy.kind == "hair":
+                skin = self.head.skin
+                hair = bound.binding.positions(self.neutral)
+                occlusion[skin] *= hair_shadow(self.neutral[skin], hair)
+        return occlusion
 
     @cached_property
     def occlusion(self) -> np.ndarray:
@@ -112,7 +177,8 @@ class Face:
         from facsim.head.assets import cache_dir
         from facsim.render.occlusion import bake_occlusion
 
-        key = hashlib.sha256(repr((OCCLUSION_VERSION, self.character.with_(name="", description="", colors={})))
+        shape = self.character.with_(name="", description="", colors={}, hair="", brows="", lashes="")
+        key = hashlib.sha256(repr((OCCLUSION_VERSION, shape))
                              .encode()).hexdigest()[:16]
         path = cache_dir() / "occlusion" / f"{key}.npy"
         try:
@@ -156,7 +222,7 @@ class Face:
         options = _options(options, option_values)
         key = (options.size, options.antialias, options.background)
         if key not in self._renderers:
-            self._renderers[key] = Renderer(self.head.topology, size=options.size, background=options.background,
+            self._renderers[key] = Renderer(self.topology, size=options.size, background=options.background,
                                             **options.renderer_settings())
         return self._renderers[key]
 
@@ -178,9 +244,11 @@ class Face:
             deformation = self.deform(expression)
         camera = self.camera(view=options.view, yaw=options.yaw, pitch=options.pitch, projection=options.projection,
                              size=options.size)
+        positions = np.asarray(deformation.positions, np.float32)
         return self.renderer(options).render(
-            np.asarray(deformation.positions, np.float32), appearance=self.appearance, camera=camera,
-            wrinkle=deformation.wrinkle, crease_phase=deformation.crease_phase, occlusion=self.occlusion,
+            positions, appearance=self.appearance, camera=camera,
+            wrinkle=deformation.wrinkle, crease_phase=deformation.crease_phase, occlusion=self.shading_occlusion,
+            proxies=self.proxy_draws(positions),
         )
 
     def start_animation(self) -> Engine:

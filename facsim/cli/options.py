@@ -45,6 +45,8 @@ def add_view_options(p: argparse.ArgumentParser) -> None:
     from facsim.render.options import VIEWS
 
     p.add_argument("--character", "-c", default="ava", help="preset name (see `facsim characters`) or random:SEED")
+    p.add_argument("--hair", help="hair style (bob01, bob02, short01-04, long01, ponytail01, braid01, afro01) "
+                                  "or none; default: the character's own")
     p.add_argument("--engine", choices=tuple(ENGINES), default=DEFAULT_ENGINE, help="how AUs move the face")
     p.add_argument("--view", choices=sorted(VIEWS), default="front")
     p.add_argument("--yaw", type=float, help="camera yaw in degrees (positive: toward the character's left)")
@@ -56,6 +58,16 @@ def add_view_options(p: argparse.ArgumentParser) -> None:
                    help="MSAA samples (1 = off, 4 = default) or fxaa (fast post-process smoothing)")
     p.add_argument("--intensities", choices=("hapfacs", "facshuman"), default="hapfacs",
                    help="what the letters A-E mean (HapFACS: 15/30/55/85/100 %%)")
+
+
+def character_of(args, fallback=None):
+    """The character the view options name (``--character``, else ``fallback``), with ``--hair`` applied."""
+    name = args.character or fallback
+    if getattr(args, "hair", None) is None:
+        return name
+    from facsim.head.character import resolve_character
+
+    return resolve_character(name).with_(hair=args.hair)
 
 
 def render_options(args) -> dict:

@@ -1,7 +1,7 @@
 """``facsim render``: one FACS expression, emotion or timeline frame to a PNG."""
 from __future__ import annotations
 
-from facsim.cli.options import add_view_options, render_options
+from facsim.cli.options import add_view_options, character_of, render_options
 
 
 def add_commands(sub) -> None:
@@ -44,6 +44,6 @@ def cmd_render(args) -> None:
     from facsim.atomic import check_target
 
     check_target(args.output)  # before the face is built: a refusal should not wait for it
-    with Face(args.character, engine=args.engine) as face:
+    with Face(character_of(args), engine=args.engine) as face:
         face.save(args.output, expression, **render_options(args))
     print(f"wrote {args.output}")

@@ -7,7 +7,12 @@ What the file holds
       indices; vertices split at UV seams) without the eyeballs, one
       primitive per material: ``skin`` (colour texture baked from the
       character's paint: skin, lips, lids, blush, brows), ``mouth_interior``,
-      ``teeth``, ``tongue``, ``lashes``. All primitives share the vertex data.
+      ``teeth``, ``tongue``, ``lashes`` (hm08's lash strips, when no lash
+      proxy replaces them). All primitives share the vertex data.
+    * Meshes ``hair``, ``brows``, ``eyelashes``: the character's MakeHuman
+      proxies (``facsim.head.proxies``), each with its own alpha-masked texture
+      tinted with the character's colour, skinned like the face and with the
+      same AU morph targets (brows follow AU 1, 2 and 4).
     * Morph targets, one per AU the register engine simulates with morphs,
       per side for AUs that can act on one side: ``AU12_L``, ``AU12_R``,
       ``AU26``. A target is the register engine at that AU (and side) at
@@ -269,11 +274,16 @@ def glb_bytes(face, timeline=None, *, aus="all", interpolation: str = "LINEAR", 
     skin = {"name": "neck_head", "joints": [0, 1], "skeleton": 0,
             "inverseBindMatrices": b.accessor(inverse_bind, "MAT4")}
     nodes.append({"name": "face", "mesh": 0, "skin": 0})
+    scene_nodes = [0, 4]
+    for mesh in _proxy_meshes(b, face, keys, pivot, materials):
+        meshes.append(mesh)
+        scene_nodes.append(len(nodes))
+        nodes.append({"name": mesh["name"], "mesh": len(meshes) - 1, "skin": 0})
     document = {
         "asset": {"version": "2.0", "generator": _generator(),
                   "extras": {"character": face.character.name or "custom",
                              "units": "metres (facsim decimetres x 0.1)"}},
-        "scene": 0, "scenes": [{"name": "facsim", "nodes": [0, 4]}],
+        "scene": 0, "scenes": [{"name": "facsim", "nodes": scene_nodes}],
         "nodes": nodes, "meshes": meshes, "skins": [skin], **materials,
     }
     if timeline is not None:
@@ -292,7 +302,8 @@ def _face_mesh(b: GlbBuilder, face, keys, pivot, material_index: dict, normals: 
     from facsim.head.mesh import REGIONS
     from facsim.head.surface import vertex_normals
 
-    head, topo = face.head, face.head.topology
+    head = face.head
+    topo = getattr(face, "topology", head.topology)  # without hm08's lash strips when a lash proxy replaces them
     engine = face.engine if face.engine_name == "registers" else RegisterEngine(
         head, face.data, face.character, face.base_positions)
     neutral = np.asarray(face.neutral, np.float64)
@@ -342,6 +353,67 @@ def _face_mesh(b: GlbBuilder, face, keys, pivot, material_index: dict, normals: 
         mesh["weights"] = [0.0] * len(targets)
         mesh["extras"] = {"targetNames": [target_name(*k) for k in keys]}
     return mesh
+
+
+def _proxy_meshes(b: GlbBuilder, face, keys, pivot, materials: dict) -> list[dict]:
+    """Hair, brows and lashes (MakeHuman proxies): one skinned mesh each, with their own
+    alpha-masked texture (tinted with the character's colour) and the AU morph targets
+    that move them with the skin (brows under AU 1, 2, 4). Adds their materials."""
+    from facsim.engines.registers import RegisterEngine
+    from facsim.engines.rigid import neck_weight
+    from facsim.render.proxies import shade_texture
+
+    if not face.proxies:
+        return []
+    engine = face.engine if face.engine_name == "registers" else RegisterEngine(
+        face.head, face.data, face.character, face.base_positions)
+    moved = [np.asarray(engine.deform(Activations({(code, s): 1.0 for s in (("left", "right") if side == "both" else (side,))})).positions,
+                        np.float32) for code, side in keys]
+    follow_head = neck_weight(face.head, np.asarray(face.neutral, np.float64), face.base_positions)
+    out = []
+    for bound in face.proxies:
+        proxy, binding = bound.proxy, bound.binding
+        rest = binding.positions(face.neutral).astype(np.float64)
+        corner = proxy.corner_vertex
+        # Texture: the strand brightness times the character's colour, alpha kept.
+        shade = shade_texture(proxy.texture)[::-1].astype(np.float32) / 255.0  # back to image row order
+        tint = _linear(face.colors[bound.color_key])
+        rgba = np.empty(shade.shape, np.uint8)
+        rgba[..., :3] = _srgb8(tint * (0.6 + 0.8 * shade[..., :1]))
+        rgba[..., 3] = (shade[..., 3] * 255 + 0.5).astype(np.uint8)
+        image = len(materials["images"])
+        materials["images"].append({"name": proxy.name, "mimeType": "image/png", "bufferView": b.image(_png(rgba))})
+        materials["textures"].append({"source": image, "sampler": 0, "name": proxy.name})
+        materials["materials"].append({
+            "name": proxy.name, "alphaMode": "MASK", "alphaCutoff": 0.5, "doubleSided": True,
+            "pbrMetallicRoughness": {"metallicFactor": 0.0, "roughnessFactor": 0.6 if proxy.kind == "hair" else 0.9,
+                                     "baseColorTexture": {"index": len(materials["textures"]) - 1}}})
+        weights = np.zeros((len(corner), 4), np.float32)
+        # Each proxy vertex follows the head as the skin it is bound to does.
+        follow = np.einsum("vk,vk->v", binding.weights, follow_head[binding.ref])
+        weights[:, 1] = np.clip(follow, 0.0, 1.0)[corner]  # bindings may extrapolate a little
+        weights[:, 0] = 1.0 - weights[:, 1]
+        joints = np.zeros((len(corner), 4), np.uint8)
+        joints[:, 1] = weights[:, 1] > 0
+        uv = proxy.uv * np.array([1.0, -1.0], np.float32) + np.array([0.0, 1.0], np.float32)  # glTF v runs down
+        primitive = {
+            "attributes": {
+                "POSITION": b.accessor(rest[corner] * METRES, "VEC3", target=ARRAY_BUFFER, bounds=True),
+                "TEXCOORD_0": b.accessor(uv, "VEC2", target=ARRAY_BUFFER),
+                "JOINTS_0": b.accessor(joints, "VEC4", UBYTE, target=ARRAY_BUFFER),
+                "WEIGHTS_0": b.accessor(weights, "VEC4", target=ARRAY_BUFFER)},
+            "indices": b.accessor(proxy.triangles.reshape(-1).astype(np.uint32), "SCALAR",
+                                  USHORT if len(corner) < 65536 else UINT, target=ELEMENT_ARRAY_BUFFER, bounds=True),
+            "material": len(materials["materials"]) - 1, "mode": 4}
+        if keys:
+            primitive["targets"] = [{"POSITION": b.delta_accessor((binding.positions(m)[corner] - rest[corner]) * METRES)}
+                                    for m in moved]
+        mesh = {"name": proxy.kind if proxy.kind != "eyebrows" else "brows", "primitives": [primitive]}
+        if keys:
+            mesh["weights"] = [0.0] * len(keys)
+            mesh["extras"] = {"targetNames": [target_name(*k) for k in keys], "proxy": proxy.name}
+        out.append(mesh)
+    return out
 
 
 def _generator() -> str:

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Mapping
 
-from facsim.head.character import COLOR_NAMES, Character
+from facsim.head.character import COLOR_NAMES, EXTRA_COLOR_NAMES, Character
 from facsim.head.colour import hex_to_rgb, linear_to_srgb, srgb_to_linear
 from facsim.head.surface import smoothstep
 
@@ -57,10 +57,21 @@ class Appearance:
         stores its masks; flip an image file's rows with ``paint[::-1]``). Each mask is the
         weight of its colour over the skin colour (255 = the colour itself), so the blush
         or eyelid strength is painted into the mask. ``None`` = no paint.
+    detail : (H, W, 4) uint8, optional
+        Skin detail in the same UV space and row order: R = redness (nose, cheeks, ears,
+        caruncle), G = beard area, B = oiliness (the T-zone's sheen, wet lid margins),
+        A = age lines and shadows (forehead lines, crow's feet, nasolabial folds, tear troughs).
+    beard : float
+        0 … 1: how much the beard area shows a shaved stubble shadow.
+    age : float
+        0 … 1: how strongly the age lines of ``detail`` show (and the skin's mottling).
     """
 
     colors: Mapping[str, tuple[float, float, float]] = field(default_factory=lambda: DEFAULT_COLORS)
     paint: np.ndarray | None = None
+    detail: np.ndarray | None = None
+    beard: float = 0.0
+    age: float = 0.0
 
     def __post_init__(self):
         colors = dict(self.colors)
@@ -82,6 +93,15 @@ class Appearance:
                 raise ValueError(f"paint must be an (H, W, 4) uint8 array, got "
                                  f"{paint.dtype} {paint.shape}")
             object.__setattr__(self, "paint", paint)
+        if self.detail is not None:
+            detail = np.asarray(self.detail)
+            if detail.ndim != 3 or detail.shape[2] != 4 or detail.dtype != np.uint8:
+                raise ValueError(f"detail must be an (H, W, 4) uint8 array, got {detail.dtype} {detail.shape}")
+        for name in ("beard", "age"):
+            value = float(getattr(self, name))
+            if not 0.0 <= value <= 1.0:
+                raise ValueError(f"{name} must be in [0, 1], got {value}")
+            object.__setattr__(self, name, value)
 
 
 
@@ -100,7 +120,7 @@ FIXED_COLORS = {
     "tongue": "#c46f6c",
     "mouth_interior": "#4a1a1c",
 }
-GREY_HAIR = "#9a9692"
+GREY_HAIR = "#a8a299"
 PAINT_SIZE = (2048, 1024)  # rows (v), columns (u) over assets.PAINT_UV_BOX
 _POSITION_MAP_SIZE = (512, 256)
 _POSITION_MAP_FILE = "paint-positions-v1.npy"
@@ -116,7 +136,7 @@ BROW = {
 
 
 def character_colors(character: Character) -> dict[str, tuple[float, float, float]]:
-    """sRGB colours (0 … 1) for every key in :data:`COLOR_NAMES`."""
+    """sRGB colours (0 … 1) for every key in :data:`COLOR_NAMES`, and the scalp ``hair``."""
     mix = character.ethnicity
 
     def blend(key):
@@ -125,38 +145,183 @@ def character_colors(character: Character) -> dict[str, tuple[float, float, floa
 
     skin = blend("skin")
     older = float(np.clip((character.age - 50) / 40, 0, 1))
+    greying = float(np.clip((character.age - 45) / 25, 0, 1))
+    female = float(np.clip(1.0 - character.gender, 0, 1))
     skin = skin * (1 - 0.12 * older) + 0.12 * older * skin.mean()  # a little less saturated with age
     colors = {
         "skin": skin,
-        "lips": skin * np.array([0.78, 0.50, 0.52]) * (1.0 - 0.1 * older),
-        "eyelid": skin * np.array([0.92, 0.80, 0.80]),
+        # Women's lips are redder and more contrasted against the skin than men's (a cue
+        # observers use to tell the sexes apart); both fade a little with age.
+        "lips": skin * (female * np.array([0.80, 0.44, 0.47]) + (1 - female) * np.array([0.78, 0.53, 0.54]))
+        * (1.0 - 0.1 * older),
+        "eyelid": skin * (female * np.array([0.86, 0.74, 0.74]) + (1 - female) * np.array([0.92, 0.80, 0.80])),
         "cheek": skin * np.array([1.0, 0.70, 0.70]),
-        "brows": (1 - 0.75 * older) * blend("brows") + 0.75 * older * srgb_to_linear(hex_to_rgb(GREY_HAIR)),
+        "brows": (1 - 0.5 * older) * blend("brows") + 0.5 * older * srgb_to_linear(hex_to_rgb(GREY_HAIR)),
         "iris": blend("iris"),
+        # Scalp hair greys earlier and further than the brows.
+        "hair": (1 - 0.85 * greying) * blend("brows") * 1.15 + 0.85 * greying * srgb_to_linear(hex_to_rgb(GREY_HAIR)),
     }
     colors = {k: tuple(linear_to_srgb(v).tolist()) for k, v in colors.items()}
     colors.update({k: hex_to_rgb(v) for k, v in FIXED_COLORS.items()})
     if older:  # teeth yellow with age
-        colors["teeth"] = tuple(np.array(colors["teeth"]) * (1 - 0.08 * older * np.array([0.0, 0.3, 1.0])))
+        colors["teeth"] = tuple(np.array(colors["teeth"]) * (1 - 0.05 * older * np.array([0.0, 0.3, 1.0])))
     colors.update({k: hex_to_rgb(v) for k, v in character.colors.items()})
-    assert set(colors) == set(COLOR_NAMES)
+    assert set(colors) == set(COLOR_NAMES) | set(EXTRA_COLOR_NAMES)
     return colors
 
 
-def character_appearance(character: Character, head, *, blush: float | None = None) -> Appearance:
-    """The renderer's :class:`Appearance` for ``character`` on ``head``."""
+def character_appearance(character: Character, head, *, blush: float | None = None,
+                         painted_brows: bool = True) -> Appearance:
+    """The renderer's :class:`Appearance` for ``character`` on ``head``.
+
+    ``painted_brows=False`` leaves the brows out of the paint (a brow proxy draws them).
+    """
     if blush is None:
         blush = 0.35 * (1.0 - character.gender) + 0.12
-    return Appearance(colors=character_colors(character), paint=paint_texture(head, round(blush, 3)))
+    colors = {k: v for k, v in character_colors(character).items() if k in COLOR_NAMES}
+    # A shaved beard shows as a faint blue-grey shadow on men; age lines from about 35.
+    beard = float(np.clip((character.gender - 0.5) * 2, 0, 1) * np.clip((character.age - 16) / 6, 0, 1)) * 0.8
+    age = float(np.clip((character.age - 32) / 45, 0, 1))
+    return Appearance(colors=colors, paint=paint_texture(head, round(blush, 3), painted_brows),
+                      detail=detail_texture(head), beard=round(beard, 3), age=round(age, 3))
+
+
+DETAIL_SIZE = (1024, 512)  # rows (v), columns (u) over assets.PAINT_UV_BOX
+
+
+#: Bump when the detail recipe changes, so cached detail textures are redone.
+DETAIL_VERSION = 1
+
+
+@lru_cache(maxsize=2)
+def detail_texture(head) -> np.ndarray:
+    """(rows, cols, 4) uint8 skin detail: redness, beard area, oiliness, age lines (see
+    :class:`Appearance`), placed by anatomy on the base mesh.
+    It depends on the base mesh only, so it is computed once and cached on disk."""
+    path = cache_dir() / f"skin-detail-v{DETAIL_VERSION}.npy"
+    try:
+        detail = np.load(path)
+        if detail.shape == (*DETAIL_SIZE, 4) and detail.dtype == np.uint8:
+            return detail
+    except (OSError, ValueError):
+        pass  # missing or damaged: (re)build below
+    detail = _build_detail(head)
+    path.parent.mkdir(parents=True, exist_ok=True)
+
+    def write(tmp):
+        with open(tmp, "wb") as f:
+            np.save(f, detail)
+    atomic_write(path, write)
+    return detail
+
+
+def _build_detail(head) -> np.ndarray:
+    positions = _resize(position_map(head), DETAIL_SIZE)
+    lips = _resize(head.masks["lips"].astype(np.float32) / 255, DETAIL_SIZE)
+    centre, radius = head.eye_pivot(head.base_vertices, "left")
+    margin = lid_margin_density(positions, centre, radius)
+    channels = (np.maximum(redness_density(positions), caruncle_density(positions, centre, radius)),
+                beard_density(positions) * (1 - np.clip(lips * 2, 0, 1)),
+                np.maximum(oil_density(positions), margin), age_line_density(positions))
+    detail = np.empty((*DETAIL_SIZE, 4), np.uint8)
+    for k, mask in enumerate(channels):
+        detail[..., k] = np.clip(mask * 255 + 0.5, 0, 255)
+    return detail
+
+
+def _blob(positions, centre, radius, *, mirror=True) -> np.ndarray:
+    d = np.array(positions, np.float64, copy=True)
+    if mirror:
+        d[..., 0] = np.abs(d[..., 0])
+    r2 = (((d - np.asarray(centre)) / np.asarray(radius)) ** 2).sum(-1)
+    return np.exp(-r2)
+
+
+def lid_margin_density(positions: np.ndarray, centre, radius: float) -> np.ndarray:
+    """The wet rim of the lids: skin within half a millimetre or so of the eyeball's front."""
+    p = np.array(positions, np.float64, copy=True)
+    p[..., 0] = np.abs(p[..., 0])
+    gap = np.abs(np.linalg.norm(p - np.asarray(centre), axis=-1) - radius)
+    front = smoothstep(centre[2] + 0.3 * radius, centre[2] + 0.6 * radius, p[..., 2])
+    return (smoothstep(0.012, 0.0, gap) * front).astype(np.float32)
+
+
+def caruncle_density(positions: np.ndarray, centre, radius: float) -> np.ndarray:
+    """The caruncle: a small pink mound in the inner corner of each eye."""
+    # Where the lid margins meet at the inner canthus (measured on hm08: 0.208, 7.280, 1.360).
+    inner = (float(centre[0]) - 0.68 * radius, float(centre[1]) - 0.03 * radius, float(centre[2]) + 0.76 * radius)
+    return np.clip(1.3 * _blob(positions, inner, (0.022, 0.016, 0.04)), 0, 1).astype(np.float32)
+
+
+def redness_density(positions: np.ndarray) -> np.ndarray:
+    """Where skin is redder: nose tip and wings, the cheeks, chin, ears, lids."""
+    red = (0.9 * _blob(positions, (0.0, 6.95, 1.68), (0.10, 0.09, 0.12))
+           + 0.6 * _blob(positions, (0.14, 6.87, 1.52), (0.06, 0.06, 0.1))
+           + 0.55 * _blob(positions, (0.45, 6.92, 1.30), (0.16, 0.14, 0.2))
+           + 0.35 * _blob(positions, (0.0, 6.32, 1.48), (0.12, 0.08, 0.15))
+           + 0.35 * _blob(positions, (0.3, 7.28, 1.42), (0.16, 0.09, 0.12))
+           + 0.7 * _blob(positions, (0.72, 7.1, 0.75), (0.12, 0.35, 0.3)))
+    return np.clip(red, 0, 1).astype(np.float32)
+
+
+def beard_density(positions: np.ndarray) -> np.ndarray:
+    """A man's beard area: upper lip, chin, jaw and lower cheeks, fading up the cheek."""
+    x, y, z = np.abs(positions[..., 0]), positions[..., 1], positions[..., 2]
+    top = 6.86 - 0.55 * np.clip(x - 0.12, 0, None)          # beard line, lower toward the ear
+    below_line = smoothstep(top + 0.05, top - 0.08, y)
+    not_neck = smoothstep(5.85, 6.05, y) * smoothstep(0.45, 0.8, z)
+    off_nose = 1 - _blob(positions, (0.0, 6.86, 1.6), (0.11, 0.05, 0.3))
+    return np.clip(below_line * not_neck * off_nose * smoothstep(0.72, 0.6, x), 0, 1).astype(np.float32)
+
+
+def oil_density(positions: np.ndarray) -> np.ndarray:
+    """The T-zone (forehead, nose, chin) is oilier, hence glossier, than the cheeks."""
+    oil = (0.85 * _blob(positions, (0.0, 7.75, 1.45), (0.35, 0.25, 0.3))
+           + 1.0 * _blob(positions, (0.0, 7.1, 1.62), (0.09, 0.3, 0.2))
+           + 0.6 * _blob(positions, (0.0, 6.32, 1.48), (0.14, 0.1, 0.2)))
+    return np.clip(0.35 + oil, 0, 1).astype(np.float32)
+
+
+def age_line_density(positions: np.ndarray) -> np.ndarray:
+    """Lines and shadows that come with age: forehead lines, crow's feet, nasolabial and
+    marionette folds, tear troughs. The renderer scales them by the character's age."""
+    x, y, z = positions[..., 0], positions[..., 1], positions[..., 2]
+    ax = np.abs(x)
+    # Forehead: three or four gently arched horizontal lines.
+    arch = y - 0.12 * ax ** 2 + 0.012 * np.sin(9.0 * x)
+    forehead = smoothstep(7.6, 7.66, arch) * smoothstep(7.9, 7.8, arch) * smoothstep(0.42, 0.22, ax) * smoothstep(1.1, 1.3, z)
+    lines = (0.5 + 0.5 * np.cos(2 * np.pi * (arch - 7.62) / 0.09)) ** 12
+    out = 0.6 * forehead * lines
+    # Crow's feet: short lines fanning out from the outer eye corner.
+    cx, cy = 0.47, 7.28
+    dx, dy = ax - cx, y - cy
+    radius = np.hypot(dx, dy)
+    angle = np.arctan2(dy, np.maximum(dx, 1e-6))
+    fan = (0.5 + 0.5 * np.cos(angle * 11.0)) ** 6 * smoothstep(0.03, 0.06, radius) * smoothstep(0.16, 0.09, radius)
+    out += 0.7 * fan * (dx > 0) * smoothstep(0.6, 0.9, z)
+    # Folds: distance to the nasolabial (nose wing -> past the lip corner) and marionette segments.
+    for (ax0, ay0), (ax1, ay1), depth, width in (((0.15, 6.86), (0.29, 6.60), 0.8, 0.018),
+                                                 ((0.26, 6.58), (0.24, 6.38), 0.45, 0.02)):
+        out += depth * np.exp(-(_segment_distance(ax, y, ax0, ay0, ax1, ay1) / width) ** 2) * smoothstep(1.1, 1.3, z)
+    # Tear trough: a soft shadow under the lower lid, inner half.
+    out += 0.5 * _blob(positions, (0.22, 7.13, 1.42), (0.08, 0.035, 0.1))
+    out = np.where(np.isfinite(out), out, 0.0)
+    return np.clip(out, 0, 1).astype(np.float32)
+
+
+def _segment_distance(x, y, x0, y0, x1, y1):
+    dx, dy = x1 - x0, y1 - y0
+    t = np.clip(((x - x0) * dx + (y - y0) * dy) / (dx * dx + dy * dy), 0, 1)
+    return np.hypot(x - (x0 + t * dx), y - (y0 + t * dy))
 
 
 @lru_cache(maxsize=4)
-def paint_texture(head, blush: float) -> np.ndarray:
+def paint_texture(head, blush: float, brows: bool = True) -> np.ndarray:
     """(rows, cols, 4) uint8 paint in the head's normalised UV box: brows, lips, lids, blush."""
     data_masks = head.masks
     # Densities are smooth at half the paint resolution; computing them there saves ~0.4 s.
     positions = _resize(position_map(head), (PAINT_SIZE[0] // 2, PAINT_SIZE[1] // 2))
-    brows = _resize(brow_density(positions), PAINT_SIZE)
+    brows = _resize(brow_density(positions), PAINT_SIZE) if brows else np.zeros(PAINT_SIZE, np.float32)
     cheeks = _resize(blush * cheek_density(positions), PAINT_SIZE)
     lips = _resize(data_masks["lips"].astype(np.float32) / 255, PAINT_SIZE)
     lids = _resize(data_masks["eyelids"].astype(np.float32) / 255, PAINT_SIZE)

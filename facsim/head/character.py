@@ -53,6 +53,8 @@ _POSITIVE_ENDS = ("incr", "up", "out", "forward", "convex", "uncompress")
 #: The colours a character has (display sRGB, 0..1), each overridable in ``colors``.
 COLOR_NAMES = ("skin", "lips", "brows", "lashes", "sclera", "iris", "pupil", "teeth", "tongue",
                "mouth_interior", "eyelid", "cheek")
+#: Colours a character has beyond the face renderer's: the scalp hair (its proxy's tint).
+EXTRA_COLOR_NAMES = ("hair",)
 
 
 class CharacterError(ValueError):
@@ -76,7 +78,11 @@ class Character:
     face : mapping
         Face-shape sliders, ``{"nose/nose-hump": 0.4, ...}``, each in [-1, 1].
     colors : mapping
-        Colour overrides, ``{"iris": "#3b6ea5", ...}``; keys in :data:`COLOR_NAMES`.
+        Colour overrides, ``{"iris": "#3b6ea5", ...}``; keys in :data:`COLOR_NAMES` or ``hair``.
+    hair, brows, lashes : str
+        MakeHuman proxy names (``facsim.head.proxies.HAIR_STYLES``, ``EYEBROWS``, ``EYELASHES``),
+        ``"none"``, or ``""`` for one chosen from gender, age and ethnicity
+        (``facsim/data/hair.yaml``).
     name : str
         Preset name, or "" for a custom character.
     """
@@ -90,6 +96,9 @@ class Character:
     weight: float = 0.5
     face: Mapping[str, float] = field(default_factory=dict)
     colors: Mapping[str, str] = field(default_factory=dict)
+    hair: str = ""
+    brows: str = ""
+    lashes: str = ""
     name: str = ""
     description: str = ""
 
@@ -104,8 +113,14 @@ class Character:
             if not -1.0 <= float(value) <= 1.0:
                 raise CharacterError(f"face-shape slider {key!r} must be in [-1, 1], got {value}")
         for key in self.colors:
-            if key not in COLOR_NAMES:
-                raise CharacterError(f"unknown colour {key!r}; choose from {', '.join(COLOR_NAMES)}")
+            if key not in COLOR_NAMES + EXTRA_COLOR_NAMES:
+                raise CharacterError(f"unknown colour {key!r}; choose from {', '.join(COLOR_NAMES + EXTRA_COLOR_NAMES)}")
+        from facsim.head.proxies import EYEBROWS, EYELASHES, HAIR_STYLES
+
+        for key, names in (("hair", HAIR_STYLES), ("brows", EYEBROWS), ("lashes", EYELASHES)):
+            value = getattr(self, key)
+            if value not in ("", "none", *names):
+                raise CharacterError(f"unknown {key} {value!r}; choose from {', '.join(names)} or 'none'")
         object.__setattr__(self, "face", dict(self.face))
         object.__setattr__(self, "colors", dict(self.colors))
 

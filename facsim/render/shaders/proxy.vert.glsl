@@ -1,0 +1,23 @@
+// Proxy (hair, eyebrow, eyelash card) vertex shader; see facsim/render/proxies.py.
+in vec3 in_pos;
+in vec3 in_normal;
+in vec3 in_tangent;   // strand direction (dP/dv)
+in float in_depth;    // 0 at the scalp .. 1 at the outer strands
+in vec2 in_uv;
+
+uniform mat4 u_view_proj;
+
+out vec3 v_pos;
+out vec3 v_normal;
+out vec3 v_tangent;
+out float v_depth;
+out vec2 v_uv;
+
+void main() {
+    v_pos = in_pos;
+    v_normal = in_normal;
+    v_tangent = in_tangent;
+    v_depth = in_depth;
+    v_uv = in_uv;
+    gl_Position = u_view_proj * vec4(in_pos, 1.0);
+}

@@ -1,0 +1,160 @@
+"""MakeHuman hair / brow / lash proxies: fetching checks, parsing, fitting and following the face."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from facsim.head import proxies
+from facsim.head.assets import FaceDataError
+from facsim.head.character import CharacterError, Character, preset, preset_names
+
+
+def test_parse_threejs_splits_quads_and_uv_seams():
+    doc = {
+        "vertices": [0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0],
+        "ref_vIdxs": [[0, 1, 2]] * 4, "weights": [[1, 0, 0]] * 4, "offsets": [[0, 0, 0]] * 4,
+        "uvs": [[0, 0, 1, 0, 1, 1, 0, 1, 0.5, 0.5]],
+        # a quad with material and vertex UVs (type 11), then a triangle (type 10) reusing
+        # vertex 2 with another UV (a seam)
+        "faces": [11, 0, 1, 2, 3, 0, 0, 1, 2, 3, 10, 0, 2, 3, 0, 0, 4, 3],
+    }
+    mesh = proxies.parse_threejs(doc)
+    assert mesh["triangles"].shape == (3, 3)
+    assert len(mesh["corner_vertex"]) == 5  # vertex 2 appears with two UVs
+    assert sorted(mesh["corner_vertex"].tolist()) == [0, 1, 2, 2, 3]
+    # every triangle corner keeps its own vertex and uv
+    corners = mesh["corner_vertex"][mesh["triangles"]]
+    assert corners.tolist()[0] == [0, 1, 2]
+
+
+def test_parse_threejs_rejects_a_binding_of_the_wrong_length():
+    doc = {"vertices": [0, 0, 0] * 2, "ref_vIdxs": [[0, 1, 2]], "weights": [[1, 0, 0]],
+           "offsets": [[0, 0, 0]], "uvs": [[]], "faces": []}
+    with pytest.raises(FaceDataError, match="refs for 2 vertices"):
+        proxies.parse_threejs(doc)
+
+
+def test_integrity_and_licence_checks_refuse_what_is_not_ours():
+    with pytest.raises(FaceDataError, match="integrity"):
+        proxies.check_integrity(b"not the tarball")
+    team = {"author": "Manuel Bastioni", "license": "AGPL3 (see also ...)"}
+    proxies.check_licence("bob01", team, "hm08")
+    with pytest.raises(FaceDataError, match="not the MakeHuman team"):
+        proxies.check_licence("curly", {"author": "Unknown, adaptation by punkduck", "license": "AGPL3"}, "hm08")
+    with pytest.raises(FaceDataError, match="CC BY"):
+        proxies.check_licence("x", {"author": "Manuel Bastioni", "license": "CC BY 4.0"}, "hm08")
+    with pytest.raises(FaceDataError, match="base mesh"):
+        proxies.check_licence("x", team, "hm1")
+
+
+@pytest.fixture(scope="module")
+def library():
+    return proxies.load_proxies(progress=False)
+
+
+def test_library_holds_the_team_assets_only(library):
+    assert set(library.names) == set(proxies.ASSETS)
+    for name in library.names:
+        p = library[name]
+        assert any(a in p.author.lower() for a in proxies.TEAM_AUTHORS)
+        assert p.ref.max() < 19158 and np.allclose(p.weights.sum(1), 1.0, atol=0.02)
+        assert p.texture.shape[2] == 4
+
+
+def test_fitted_hair_sits_on_the_scalp_and_brows_above_the_eyes(library, head):
+    base = head.base_vertices
+    bob = proxies.fit_proxy(library["bob01"], base)
+    assert 8.4 < bob[:, 1].max() < 8.9  # over the crown (head top ~8.5 dm)
+    brows = proxies.fit_proxy(library["eyebrow001"], base)
+    eye = head.eye_pivot(base, "left")[0]
+    assert np.all(brows[:, 1] > eye[1]) and np.all(brows[:, 1] < eye[1] + 0.35)
+    assert np.all(brows[:, 2] > eye[2] - 0.1)  # in front of the face
+
+
+def test_offsets_scale_with_the_head(head):
+    base = head.base_vertices
+    bigger = base * np.float32(1.1)
+    np.testing.assert_allclose(proxies.offset_scale(bigger, base), 1.1, rtol=1e-4)
+
+
+def test_presets_name_brow_clear_hair_and_choices_are_stable():
+    clear = set(proxies.hair_table()["brow_clear"])
+    for name in preset_names():
+        chosen = proxies.character_proxies(preset(name))
+        assert chosen["hair"] in clear, name
+        assert chosen["eyebrows"] in proxies.EYEBROWS and chosen["eyelashes"] in proxies.EYELASHES
+    custom = Character(gender=0.0, age=70)
+    assert proxies.character_proxies(custom) == proxies.character_proxies(Character(gender=0.0, age=70))
+    assert proxies.character_proxies(custom)["hair"] in clear
+    assert proxies.character_proxies(custom.with_(hair="none"))["hair"] is None
+
+
+def test_unknown_hair_is_a_character_error():
+    with pytest.raises(CharacterError, match="unknown hair 'mohawk'"):
+        Character(hair="mohawk")
+
+
+def test_brows_follow_the_skin_and_hair_follows_the_head(face_of):
+    face = face_of("ava")
+    bound = {b.proxy.kind: b for b in face.proxies}
+    neutral_brows = bound["eyebrows"].binding.positions(face.neutral)
+    # the binding reproduces MakeHuman's fit exactly at neutral
+    fitted = proxies.fit_proxy(bound["eyebrows"].proxy, face.base_positions,
+                               scale=proxies.offset_scale(face.base_positions, face.head.base_vertices))
+    np.testing.assert_allclose(neutral_brows, fitted, atol=1e-5)
+    raised = bound["eyebrows"].binding.positions(face.deform("1+2E").positions)
+    assert (raised[:, 1] - neutral_brows[:, 1]).mean() > 0.02  # brows go up with the skin
+    lowered = bound["eyebrows"].binding.positions(face.deform("4E").positions)
+    inner = np.abs(neutral_brows[:, 0]) < np.median(np.abs(neutral_brows[:, 0]))
+    assert (lowered[inner, 1] - neutral_brows[inner, 1]).mean() < -0.01  # AU 4 lowers the inner brows ...
+    assert (np.abs(lowered[inner, 0]) - np.abs(neutral_brows[inner, 0])).mean() < 0  # ... and draws them together
+    turned = face.deform("51E").positions  # head turn left
+    hair = bound["hair"].binding.positions(turned)
+    top = np.argmax(bound["hair"].binding.positions(face.neutral)[:, 1])
+    assert abs(hair[top, 0] - bound["hair"].binding.positions(face.neutral)[top, 0]) > 0.05 or \
+        np.linalg.norm(hair - bound["hair"].binding.positions(face.neutral), axis=1).max() > 0.3
+
+
+def test_gltf_export_carries_hair_brows_and_lashes(face_of):
+    import json
+    import struct
+
+    from facsim.exchange.gltf import glb_bytes
+
+    face = face_of("ava")
+    blob = glb_bytes(face, aus=[1, 2, 4])
+    length = struct.unpack_from("<I", blob, 12)[0]
+    doc = json.loads(blob[20 : 20 + length])
+    meshes = {m["name"]: m for m in doc["meshes"]}
+    assert {"hair", "brows", "eyelashes"} <= set(meshes)
+    brows = meshes["brows"]
+    assert brows["extras"]["proxy"] == face.character.brows == "eyebrow002"
+    assert any(n.startswith("AU01") for n in brows["extras"]["targetNames"])
+    material = doc["materials"][meshes["hair"]["primitives"][0]["material"]]
+    assert material["alphaMode"] == "MASK" and material["doubleSided"]
+    scene = doc["scenes"][0]["nodes"]
+    assert all(any(doc["nodes"][i].get("mesh") == doc["meshes"].index(m) for i in scene) for m in meshes.values()
+               if m["name"] in ("hair", "brows", "eyelashes"))
+
+
+def test_cli_hair_option(tmp_path, capsys):
+    from facsim.cli import main
+
+    out = tmp_path / "bald.png"
+    assert main(["render", "12", "-o", str(out), "--size", "64", "--hair", "none", "--antialias", "1"]) == 0
+    assert out.exists()
+    assert main(["render", "12", "-o", str(tmp_path / "x.png"), "--size", "64", "--hair", "mohawk"]) == 2
+    err = capsys.readouterr().err
+    assert "unknown hair 'mohawk'" in err and "Traceback" not in err
+
+
+def test_hair_changes_the_render(face_of):
+    bald = face_of("liam").character.with_(hair="none")
+    from facsim.face import Face
+
+    with Face(bald) as without:
+        a = without.render(None, size=96, antialias=1)
+    b = face_of("liam").render(None, size=96, antialias=1)
+    top = slice(0, 25)
+    # hair darkens the top of the head (liam's brown hair over light skin)
+    assert b[top, :, :3].astype(float).mean() < a[top, :, :3].astype(float).mean() - 10
