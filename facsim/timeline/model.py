@@ -108,6 +108,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from facsim.limits import check_fps, check_frames, limit, override_hint
 from facsim.facs.catalogue import INTENSITY_TABLES, LETTERS, UnknownActionUnitError, info, intensity_of
 from facsim.timeline.easing import get_easing
 from facsim.facs.activations import Activations, activations
@@ -169,7 +170,10 @@ class TimelineError(ValueError):
         if where and line is not None:
             where += f":{line}"
         parts = [p for p in (where, self.path) if p]
-        super().__init__(": ".join([*parts, problem]))
+        from facsim.limits import clip
+
+        # One line, bounded: a hostile file must not make a megabyte-long message.
+        super().__init__(clip(": ".join([*parts, str(problem)])))
 
     @property
     def path(self) -> str:
@@ -614,7 +618,14 @@ class Timeline:
             if not isinstance(track, (Track, SoundTrack)):
                 raise TimelineError(f"expected a Track, got {type(track).__name__}", location=("tracks", i))
         object.__setattr__(self, "tracks", tracks)
+        if len(tracks) > limit("max_tracks"):
+            raise TimelineError(f"{len(tracks):,} tracks is too many {override_hint('max_tracks')}",
+                                location=("tracks",))
         object.__setattr__(self, "fps", positive(self.fps, "fps"))
+        try:
+            check_fps(self.fps)
+        except ValueError as exc:
+            raise TimelineError(str(exc).removeprefix("fps "), location=("fps",)) from None
         if self.duration is None:
             if not tracks:
                 raise TimelineError("a timeline without tracks needs a duration", location=("duration",))
@@ -632,6 +643,12 @@ class Timeline:
         if self.blinks is not None and not isinstance(self.blinks, Blinks):
             raise TimelineError(f"expected Blinks, got {self.blinks!r}", location=("blinks",))
         intensities_table(self.intensities)
+        ends = [track.end for track in tracks if isinstance(track, Track)]   # speech: known once synthesised
+        length = self.duration if self.duration is not None else max(ends, default=0.0)
+        try:
+            check_frames(length * self.fps, f"{length:g} s at {self.fps:g} fps")
+        except ValueError as exc:
+            raise TimelineError(str(exc), location=("duration",) if self.duration is not None else ()) from None
         for i, track in enumerate(tracks):     # letters must read in this table too
             if isinstance(track, SoundTrack):
                 continue
