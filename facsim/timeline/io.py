@@ -412,6 +412,50 @@ def _yaml_line(text: str, location: Sequence[str | int]) -> int | None:
     return line
 
 
+def read_data_file(path: Path, kind: str, error) -> tuple[str, Any]:
+    """The text of a YAML or JSON file from an untrusted source, and its data, within the input limits.
+
+    Parameters
+    ----------
+    path : Path
+    kind : {"yaml", "json"}
+    error : callable
+        ``error(problem, file=..., line=...)`` makes the exception to raise
+        (:class:`TimelineError`, a spec error...).
+
+    Returns
+    -------
+    text : str
+    data : object
+        Plain dicts, lists, strings and numbers.
+    """
+    import yaml
+
+    if path.is_dir():
+        raise error("is a folder, not a file", file=path)
+    check_file_size(path, lambda problem: error(problem, file=path))
+    try:
+        text = path.read_bytes().decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise error(f"not UTF-8 text ({exc.reason} at byte {exc.start})", file=path) from None
+    if kind == "yaml":
+        try:
+            return text, yaml.load(text, Loader=_guarded_loader())
+        except yaml.MarkedYAMLError as exc:
+            mark = exc.problem_mark
+            raise error(f"malformed YAML: {exc.problem or exc}", file=path,
+                        line=None if mark is None else mark.line + 1) from None
+        except Exception as exc:  # noqa: BLE001 - tags such as '!!int x' fail with ValueError, dates too
+            raise error(f"malformed YAML: {exc}", file=path) from None
+    try:
+        return text, json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise error(f"malformed JSON: {exc.msg} (column {exc.colno})", file=path, line=exc.lineno) from None
+    except RecursionError:
+        raise error(f"malformed JSON: lists and mappings nested too deeply {override_hint('max_depth')}",
+                    file=path) from None
+
+
 def load_timeline(path: str | os.PathLike) -> Timeline:
     """Read a timeline from ``.yaml``/``.yml`` or ``.json`` (by suffix).
 
@@ -427,31 +471,7 @@ def load_timeline(path: str | os.PathLike) -> Timeline:
 
     path = Path(path)
     kind = _format_of(path)
-    if path.is_dir():
-        raise TimelineError("is a folder, not a timeline file", file=path)
-    check_file_size(path, lambda problem: TimelineError(problem, file=path))
-    try:
-        text = path.read_bytes().decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        raise TimelineError(f"not UTF-8 text ({exc.reason} at byte {exc.start})", file=path) from None
-    if kind == "yaml":
-        try:
-            data = yaml.load(text, Loader=_guarded_loader())
-        except yaml.MarkedYAMLError as exc:
-            mark = exc.problem_mark
-            raise TimelineError(f"malformed YAML: {exc.problem or exc}", file=path,
-                                line=None if mark is None else mark.line + 1) from None
-        except Exception as exc:  # noqa: BLE001 - tags such as '!!int x' fail with ValueError, dates too
-            raise TimelineError(f"malformed YAML: {exc}", file=path) from None
-    else:
-        try:
-            data = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise TimelineError(f"malformed JSON: {exc.msg} (column {exc.colno})", file=path,
-                                line=exc.lineno) from None
-        except RecursionError:
-            raise TimelineError(f"malformed JSON: lists and mappings nested too deeply "
-                                f"{override_hint('max_depth')}", file=path) from None
+    text, data = read_data_file(path, kind, TimelineError)
     try:
         return timeline_from_dict(data, folder=path.parent)
     except TimelineError as exc:
@@ -476,4 +496,4 @@ def save_timeline(timeline: Timeline, path: str | os.PathLike) -> Path:
     return atomic_write(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
 
 
-__all__ = ["load_timeline", "save_timeline", "timeline_from_dict", "timeline_schema", "timeline_to_dict"]
+__all__ = ["load_timeline", "read_data_file", "save_timeline", "timeline_from_dict", "timeline_schema", "timeline_to_dict"]
