@@ -50,8 +50,8 @@ from pathlib import Path
 import numpy as np
 
 from facsim.engines.rigid import eye_levels, eye_motion, head_levels, head_motion, rigid_table
-from facsim.exchange import ExchangeError, csv_number, read_csv_rows, require_columns, write_file
-from facsim.timeline.builders import timeline_from_samples
+from facsim.exchange import (ExchangeError, csv_number, read_csv_rows, require_columns, samples_timeline,
+                             write_file)
 
 REGISTER_PREFIX = "faceunits/"
 #: Frame rates a Live Link Face take's frame numbers are snapped up to.
@@ -272,7 +272,7 @@ def read_arkit_csv(path, *, fps: float | None = None):
         raise ExchangeError(f"Timecode {data[bad[0] + 1][1][lookup['timecode']].strip()!r} does not come after "
                             "the previous row's", file=path, line=data[bad[0] + 1][0])
     curves = _curves(np.clip(weights, 0.0, 1.0), angles)
-    return timeline_from_samples(times, curves, fps=fps, description=f"ARKit blendshapes from {path.name}")
+    return samples_timeline(path, times, curves, fps=fps, description=f"ARKit blendshapes from {path.name}")
 
 
 def _curves(weights: np.ndarray, angles: np.ndarray) -> dict:

@@ -510,7 +510,10 @@ def loads_notation(text: str, *, folder=None):
 
 def read_notation(path):
     """Read a ``.facs`` file (see :func:`loads_notation`); errors name the file."""
+    from facsim.exchange import check_input_size
+
     path = Path(path)
+    check_input_size(path)
     try:
         return loads_notation(path.read_text(encoding="utf-8"), folder=path.parent)
     except NotationFileError as exc:

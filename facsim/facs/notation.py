@@ -291,7 +291,7 @@ def _parse_token(token: str, position: int, text: str, table: dict) -> ActionUni
         raise error("malformed action unit", "write e.g. '12', 'AU12', 'L12C' or '12@0.7'")
     if len(match["code"].lstrip("0")) > _MAX_CODE_DIGITS:
         raise error("unknown action unit", "FACS codes have at most two digits")
-    code = int(match["code"])
+    code = int(match["code"].lstrip("0") or "0")
     if code == 0:
         raise error("neutral code", "'0' stands for the neutral face on its own; drop it")
     try:

@@ -369,7 +369,7 @@ def _guarded_loader():
             if self.check_event(yaml.AliasEvent):
                 event = self.peek_event()
                 raise yaml.composer.ComposerError(None, None, "YAML aliases (*name) are not allowed in "
-                                                  "timeline files; write the value out", event.start_mark)
+                                                  "facsim input files; write the value out", event.start_mark)
             self._depth += 1
             self._values += 1
             if self._values > self._most_values:     # checked while reading: parsing is the slow part
