@@ -21,7 +21,7 @@ Examples
 >>> limit("max_tracks")
 10000
 >>> short("x" * 1000, 20)
-"'xxxxxxxx … xxxxxxxx'"
+"'xxxxxxx … xxxxxxx'"
 """
 from __future__ import annotations
 
