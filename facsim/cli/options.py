@@ -52,7 +52,7 @@ def fps(text: str) -> float:
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected frames per second, got {text!r}") from None
     try:
-        return check_fps(value, "frames per second")
+        return check_fps(value, "the frame rate")
     except ValueError as exc:
         raise argparse.ArgumentTypeError(str(exc)) from None
 

@@ -96,7 +96,7 @@ def _frame_rate(times: np.ndarray, path) -> float:
     rate = 1.0 / step if step > 0 else math.inf
     if not MIN_FPS <= rate <= limit("max_fps"):    # odd timestamps: say so rather than divide by ~0
         raise ExchangeError(f"timestamps {step:g} s apart (median) make {rate:g} frames per second; expected "
-                            f"{MIN_FPS:g} to {limit('max_fps'):,} (give the frame rate with fps=)", file=path)
+                            f"{MIN_FPS:g} to {limit('max_fps'):,} (give the frame rate: --fps)", file=path)
     near = min(COMMON_FPS, key=lambda r: abs(r - rate))
     return float(near) if abs(near - rate) <= 0.01 * rate else round(rate, 3)
 
