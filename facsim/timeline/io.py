@@ -149,14 +149,17 @@ def _schema_problem(error) -> tuple[tuple, str]:
 
 
 def _depth_problem(data: Any) -> str | None:
-    """Why ``data`` is nested too deeply or has too many tracks, else None (iterative: no recursion)."""
+    """Why ``data`` is nested too deeply, too big or has too many tracks, else None (iterative: no recursion)."""
     tracks = data.get("tracks") if isinstance(data, Mapping) else None
     if isinstance(tracks, list) and len(tracks) > limit("max_tracks"):
         return f"{len(tracks):,} tracks is too many {override_hint('max_tracks')}"
-    most = limit("max_depth")
+    most, most_values, seen = limit("max_depth"), limit("max_values"), 0
     stack = [(data, 1)]
     while stack:
         value, depth = stack.pop()
+        seen += 1
+        if seen > most_values:       # JSON has no reader-level count (YAML does): the schema check would crawl
+            return f"more than {most_values:,} values in one timeline {override_hint('max_values')}"
         if depth > most:
             return f"lists and mappings nested more than {most} deep {override_hint('max_depth')}"
         if isinstance(value, Mapping):
