@@ -145,6 +145,8 @@ def _schema_problem(error) -> tuple[tuple, str]:
         return location, f"must be {sign} {value:g}, got {short(instance)}"
     if kind in ("minItems", "minLength"):
         return location, "must not be empty"
+    if kind == "maxLength":
+        return location, f"{len(instance):,} characters is too long; at most {value:,}"
     return location, short(error.message, 200)
 
 
