@@ -22,6 +22,8 @@ import tempfile
 import time
 from pathlib import Path
 
+import numpy as np
+
 from facsim.exchange import ExchangeError, load_any_timeline
 from facsim.facs.notation import NotationError, format_expression, parse
 from facsim.timeline.model import TimelineError
@@ -172,8 +174,10 @@ def file_case(path: Path, text: str | bytes, loader, frames: bool):
             raise
         if frames:    # a timeline that loads must also sample (a few frames at its start and end)
             times = frame_times(timeline)
-            activation_curves(timeline, times[:3])
-            activation_curves(timeline, times[-3:])
+            for curves in (activation_curves(timeline, times[:3]), activation_curves(timeline, times[-3:])):
+                for key, values in curves.items():   # accepted must mean read correctly: no NaN levels
+                    if not np.all(np.isfinite(values) & (values >= 0) & (values <= 1)):
+                        raise AssertionError(f"levels of {key} out of 0..1 or NaN: {values}")
     return run
 
 

@@ -44,6 +44,14 @@ def no_hang():
         signal.signal(signal.SIGALRM, previous)
 
 
+def all_finite(curves) -> None:
+    """An accepted input must not be misread into NaN or infinite levels."""
+    import numpy as np
+
+    for key, values in curves.items():
+        assert np.all(np.isfinite(values)) and np.all((values >= 0) & (values <= 1)), (key, values)
+
+
 def one_bounded_line(error: Exception) -> None:
     text = str(error)
     assert "\n" not in text and len(text) <= MAX_MESSAGE + 200, text[:300]
@@ -132,8 +140,8 @@ def _load(tmp_path, suffix: str, text: str):
             one_bounded_line(exc)
             return None
         times = frame_times(timeline)
-        activation_curves(timeline, times[:2])
-        activation_curves(timeline, times[-2:])
+        all_finite(activation_curves(timeline, times[:2]))
+        all_finite(activation_curves(timeline, times[-2:]))
     return timeline
 
 
@@ -242,7 +250,7 @@ def _import(tmp_path, suffix: str, text: str):
         except ExchangeError as exc:
             one_bounded_line(exc)
             return
-        activation_curves(timeline, frame_times(timeline)[:2])
+        all_finite(activation_curves(timeline, frame_times(timeline)[:2]))
 
 
 @given(text=openface_csv())

@@ -262,6 +262,10 @@ def read_arkit_csv(path, *, fps: float | None = None):
         frames.append(frame)
         weights[k] = [csv_number(cells, i, header, line, path) for i in shape_at]
         angles[k] = [0.0 if i is None else csv_number(cells, i, header, line, path) for i in angle_at]
+        if np.any(np.abs(angles[k]) > 1.0 + 1e-6):   # -1..1 is -180..180 degrees; more would overflow into NaN
+            column = next(n for n, v in zip(angle_names(), angles[k]) if abs(v) > 1.0 + 1e-6)
+            raise ExchangeError(f"column {column}: {angles[k][angle_names().index(column)]:g} is outside -1..1 "
+                                "(Live Link Face angles are degrees / 180)", file=path, line=line)
     fps = float(fps) if fps else (_fps_from_frames(seconds, frames) or arkit_table()["live_link_face"]["default_fps"])
     index = np.array(seconds, float) * fps + np.array(frames)
     snapped = np.round(index)

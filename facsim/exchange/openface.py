@@ -149,6 +149,11 @@ def read_openface_csv(path, *, intensities: str = "hapfacs", face_id: int | None
             raise ExchangeError(f"no rows with face_id {face_id}", file=path)
         numbers, data = numbers[keep], [row for row, k in zip(data, keep) if k]
         column = {name: numbers[:, k] for k, name in enumerate(optional)}
+    for name in (*_POSE, *_GAZE):     # radians; beyond a full turn is no head pose or gaze (and overflows)
+        if optional[name] is not None and np.any(np.abs(column[name]) > 2 * math.pi):
+            row = int(np.flatnonzero(np.abs(column[name]) > 2 * math.pi)[0])
+            raise ExchangeError(f"column {name}: {column[name][row]:g} radians is more than a full turn",
+                                file=path, line=data[row][0])
     stamps = column["timestamp"]
     backwards = np.flatnonzero(np.diff(stamps) <= 0)
     if backwards.size:
