@@ -109,7 +109,8 @@ def check_file_size(path, problem=ValueError) -> None:
     """Raise ``problem(message)`` if the file at ``path`` is bigger than the input limit."""
     size = os.path.getsize(path)
     if size > limit("max_input_bytes"):
-        raise problem(f"file is {size:,} bytes, too big for an input file {override_hint('max_input_bytes')}")
+        raise problem(f"file is {size:,} bytes, too big for an input file {override_hint('max_input_bytes')}; "
+                      "long recordings are smaller as .facs")
 
 
 __all__ = ["LIMITS", "MAX_MESSAGE", "MIN_FPS", "check_file_size", "check_fps", "check_frames", "clip", "limit",

@@ -117,7 +117,7 @@ def parse_intensity(value: float | str, *, name: str = "intensity") -> float:
         except ValueError:
             number = None
     elif isinstance(value, (int, float)) and not isinstance(value, bool):
-        number = float(value)
+        number = float(value) if abs(value) < 1e300 else (math.inf if value > 0 else -math.inf)   # 10**400
     if number is not None:
         number += 0.0          # -0.0 -> 0.0, so '12@-0' reads and formats as 12@0
     if number is None or math.isnan(number):

@@ -161,7 +161,8 @@ def _depth_problem(data: Any) -> str | None:
         value, depth = stack.pop()
         seen += 1
         if seen > most_values:       # JSON has no reader-level count (YAML does): the schema check would crawl
-            return f"more than {most_values:,} values in one timeline {override_hint('max_values')}"
+            return (f"more than {most_values:,} values in one timeline {override_hint('max_values')}; "
+                    "long recordings are smaller and faster as .facs")
         if depth > most:
             return f"lists and mappings nested more than {most} deep {override_hint('max_depth')}"
         if isinstance(value, Mapping):
@@ -380,7 +381,8 @@ def _guarded_loader():
             if self._values > self._most_values:     # checked while reading: parsing is the slow part
                 raise yaml.composer.ComposerError(
                     None, None, f"more than {limit('max_values'):,} values in one file "
-                    f"{override_hint('max_values')}", self.peek_event().start_mark)
+                    f"{override_hint('max_values')}; long recordings are smaller and faster as .facs",
+                    self.peek_event().start_mark)
             try:
                 if self._depth > self._most_depth:
                     raise yaml.composer.ComposerError(

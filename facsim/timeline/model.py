@@ -108,7 +108,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from facsim.limits import check_fps, check_frames, limit, override_hint
+from facsim.limits import check_fps, check_frames, limit, override_hint, short
 from facsim.facs.catalogue import INTENSITY_TABLES, LETTERS, UnknownActionUnitError, info, intensity_of
 from facsim.timeline.easing import get_easing
 from facsim.facs.activations import Activations, activations
@@ -195,8 +195,8 @@ class TimelineError(ValueError):
 def seconds(value: Any, name: str) -> float:
     """A finite time or duration >= 0, else a TimelineError at ``name``."""
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise TimelineError(f"expected a number of seconds, got {value!r}", location=(name,))
-    value = float(value)
+        raise TimelineError(f"expected a number of seconds, got {short(value)}", location=(name,))
+    value = _float(value)
     if not math.isfinite(value):
         raise TimelineError(f"expected a finite number of seconds, got {value}", location=(name,))
     if value < 0:
@@ -214,10 +214,18 @@ def _set_interval(item) -> None:
     object.__setattr__(item, "end", end)
 
 
+def _float(value) -> float:
+    """``float(value)``, infinite for integers too big for a float (JSON and YAML allow 10**400)."""
+    try:
+        return float(value)
+    except OverflowError:
+        return math.inf if value > 0 else -math.inf
+
+
 def positive(value: Any, name: str, unit: str = "") -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
-            or not math.isfinite(float(value)) or float(value) <= 0:
-        raise TimelineError(f"must be a number > 0{unit}, got {value!r}", location=(name,))
+            or not math.isfinite(_float(value)) or _float(value) <= 0:
+        raise TimelineError(f"must be a number > 0{unit}, got {short(value)}", location=(name,))
     return float(value)
 
 
@@ -232,7 +240,7 @@ def parse_level(value: Any, name: str, table: str | None = None) -> float:
     except ValueError as exc:
         problem = "intensity out of range" if "between 0 and 1" in str(exc) else "not an intensity"
         letters = " or a letter A-E" if table is not None else ""
-        raise TimelineError(f"{problem}: {value!r}; use a fraction 0..1, a percentage '0%'..'100%'{letters}",
+        raise TimelineError(f"{problem}: {short(value)}; use a fraction 0..1, a percentage '0%'..'100%'{letters}",
                             location=(name,)) from None
 
 
