@@ -8,7 +8,7 @@ variable, named in the error a user sees when they reach it::
     FACSIM_MAX_INPUT_BYTES   size of an input file (timeline, CSV, .facs)   default 16 MiB
     FACSIM_MAX_DEPTH         nesting of lists/mappings in a timeline file    default 32
     FACSIM_MAX_TRACKS        tracks in one timeline                          default 10,000
-    FACSIM_MAX_VALUES        values (numbers, strings, lists...) in one file default 100,000
+    FACSIM_MAX_VALUES        values (numbers, strings, lists...) in one file default 500,000
     FACSIM_MAX_FRAMES        frames in one video (duration x fps)            default 1,000,000 (9.3 h at 30 fps)
     FACSIM_MAX_FPS           frame rate                                      default 1,000
     FACSIM_MAX_NOTATION      characters of one FACS string                   default 10,000
@@ -34,7 +34,7 @@ LIMITS = {
     "max_input_bytes": ("FACSIM_MAX_INPUT_BYTES", 16 * 1024 * 1024),
     "max_depth": ("FACSIM_MAX_DEPTH", 32),
     "max_tracks": ("FACSIM_MAX_TRACKS", 10_000),
-    "max_values": ("FACSIM_MAX_VALUES", 100_000),
+    "max_values": ("FACSIM_MAX_VALUES", 500_000),
     "max_frames": ("FACSIM_MAX_FRAMES", 1_000_000),
     "max_fps": ("FACSIM_MAX_FPS", 1000),
     "max_notation": ("FACSIM_MAX_NOTATION", 10_000),

@@ -370,6 +370,7 @@ def _guarded_loader():
             super().__init__(stream)
             self._depth, self._values = 0, 0
             self._most_depth, self._most_values = limit("max_depth"), limit("max_values")
+            self._most_tracks = limit("max_tracks")
 
         def compose_node(self, parent, index):
             if self.check_event(yaml.AliasEvent):
@@ -382,6 +383,13 @@ def _guarded_loader():
                 raise yaml.composer.ComposerError(
                     None, None, f"more than {limit('max_values'):,} values in one file "
                     f"{override_hint('max_values')}; long recordings are smaller and faster as .facs",
+                    self.peek_event().start_mark)
+            # Items of a top-level list (the tracks), counted as they are read: a million of them
+            # would take minutes to parse before the track limit could be checked.
+            if self._depth == 3 and isinstance(parent, yaml.SequenceNode) and index >= self._most_tracks:
+                self._depth -= 1
+                raise yaml.composer.ComposerError(
+                    None, None, f"more than {self._most_tracks:,} tracks {override_hint('max_tracks')}",
                     self.peek_event().start_mark)
             try:
                 if self._depth > self._most_depth:
