@@ -61,7 +61,8 @@ COMMON_FPS = (24, 25, 30, 48, 50, 60, 100, 120)
 RIDGE = 0.01
 #: Recovered levels below this are set to 0 (least-squares crumbs, not actions).
 LEVEL_FLOOR = 0.005
-_TIMECODE = re.compile(r"^\s*(\d+):(\d{1,2}):(\d{1,2})[:;.](\d+(?:\.\d*)?)\s*$")
+# ASCII digits, bounded lengths: '٠١' is no frame number, and 400 nines would be an infinite one.
+_TIMECODE = re.compile(r"^\s*([0-9]{1,4}):([0-9]{1,2}):([0-9]{1,2})[:;.]([0-9]{1,4}(?:\.[0-9]{0,9})?)\s*$", re.ASCII)
 
 
 @lru_cache(maxsize=1)

@@ -48,7 +48,7 @@ from facsim.exchange import ExchangeError, csv_number, read_csv_rows, require_co
 
 #: Frame rates the measured one is snapped to (within 1 %).
 COMMON_FPS = (15, 24, 25, 30, 48, 50, 60, 90, 100, 120)
-_AU_COLUMN = re.compile(r"^AU(\d+)_r$", re.IGNORECASE)
+_AU_COLUMN = re.compile(r"^AU(\d{1,4})_r$", re.IGNORECASE | re.ASCII)
 _POSE = ("pose_Rx", "pose_Ry", "pose_Rz")
 _GAZE = ("gaze_angle_x", "gaze_angle_y")
 

@@ -469,6 +469,8 @@ def read_data_file(path: Path, kind: str, error) -> tuple[str, Any]:
     except RecursionError:
         raise error(f"malformed JSON: lists and mappings nested too deeply {override_hint('max_depth')}",
                     file=path) from None
+    except ValueError as exc:    # e.g. an integer of more than 4,300 digits
+        raise error(f"malformed JSON: {exc}", file=path) from None
 
 
 def load_timeline(path: str | os.PathLike) -> Timeline:
