@@ -273,3 +273,19 @@ def test_openface_timestamps_too_close_are_an_exchange_error(tmp_path):
     path.write_text(OPENFACE_HEADER + "\n1,0,0,1,1,0,0,0,1,1\n2,0,1e-320,1,1,0,0,0,1,1\n")
     with pytest.raises(ExchangeError, match="frames per second"):
         load_any_timeline(path)
+
+
+# ---------------------------------------------------------------- blinks ---
+
+@given(st.integers(0, 2**32), st.floats(0.0, 3000.0))
+def test_blinks_up_to_a_time_are_a_prefix_of_all_blinks(seed, until):
+    """Sampling early frames draws blinks only up to them, and they are the same blinks as the whole video's."""
+    import numpy as np
+
+    from facsim.timeline.model import Blinks, Timeline
+    from facsim.timeline.sampling import blink_times
+
+    timeline = Timeline(duration=3000.0, blinks=Blinks(seed=seed))
+    every = blink_times(timeline)
+    early = blink_times(timeline, until)
+    assert np.array_equal(early, every[every < until])
