@@ -110,6 +110,12 @@ BAD = [
     "import openface ok.csv -o t.yaml --min-confidence 2",
     "import arkit-csv ok.csv -o t.yaml",
     "import notation bad.facs -o t.yaml",
+    # camera processor
+    "analyse ok.csv --threads 0",
+    "analyse ok.csv --face -1",
+    "analyse ok.csv --face \u0664",
+    "retarget ok.csv -o x.mp4 --size 0",
+    "validate --size 1e9",
     # the command line itself
     "frobnicate",
     "",

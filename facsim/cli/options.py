@@ -43,6 +43,32 @@ def number(low: float | None = None, high: float | None = None, *, unit: str = "
     return parse
 
 
+def integer(low: int, high: int | None = None):
+    """An argparse type: an ASCII integer in ``[low, high]``.
+
+    Examples
+    --------
+    >>> integer(1, 64)("4")
+    4
+    >>> integer(1, 64)("0")
+    Traceback (most recent call last):
+    ...
+    argparse.ArgumentTypeError: must be an integer from 1 to 64, got '0'
+    """
+    def parse(text: str) -> int:
+        span = f"from {low} to {high}" if high is not None else f">= {low}"
+        try:
+            if not text.strip().lstrip("+-").isascii():   # int() would read '٤' as 4
+                raise ValueError(text)
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"must be an integer {span}, got {text!r}") from None
+        if value < low or (high is not None and value > high):
+            raise argparse.ArgumentTypeError(f"must be an integer {span}, got {text!r}")
+        return value
+    return parse
+
+
 def fps(text: str) -> float:
     """An argparse type for frame rates: finite, within :func:`facsim.limits.check_fps`'s range."""
     from facsim.limits import check_fps
