@@ -3,8 +3,20 @@ from __future__ import annotations
 
 import functools
 
+import os
+
 import numpy as np
 import pytest
+
+try:   # property-based tests: modest example counts, derandomized so CI runs the same examples every time
+    from hypothesis import HealthCheck, settings
+
+    settings.register_profile("ci", derandomize=True, max_examples=60, deadline=None, print_blob=True,
+                              suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+    settings.register_profile("fuzz", max_examples=2000, deadline=None)
+    settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
+except ImportError:  # the tests that need it skip themselves (pytest.importorskip)
+    pass
 
 
 @pytest.fixture(scope="session")

@@ -3,8 +3,9 @@
 One module per command group; each has ``add_commands(sub)`` and sets a
 ``handler`` on its subparsers. Adding a group is one module and one name in
 :data:`COMMAND_GROUPS`. Every user error ends in one line on stderr and exit
-status 2; nothing is written unless the whole output could be made (files are
-written atomically). Set ``FACSIM_DEBUG=1`` to see tracebacks.
+status 2; an unexpected internal error ends in one "please report" line and
+exit status 1; nothing is written unless the whole output could be made (files
+are written atomically). ``--debug`` (or ``FACSIM_DEBUG=1``) shows tracebacks.
 """
 from __future__ import annotations
 
@@ -15,6 +16,7 @@ import sys
 from importlib import import_module
 
 EXIT_USAGE = 2
+EXIT_INTERNAL = 1
 
 #: Command groups, in the order ``facsim --help`` lists them (modules in facsim/cli/).
 COMMAND_GROUPS = ("render", "dynamics", "exchange", "info", "speech", "batch", "studio", "analysis")
@@ -36,6 +38,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     parser = _Parser(prog="facsim", description="FACS notation to faces: stills, videos and exports.")
     parser.add_argument("--version", action="version", version=f"facsim {__version__}")
+    parser.add_argument("--debug", action="store_true", help="show the traceback of an error (or set FACSIM_DEBUG=1)")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND", parser_class=_Parser)
     for group in COMMAND_GROUPS:
         import_module(f"facsim.cli.{group}").add_commands(sub)
@@ -59,10 +62,14 @@ def main(argv=None) -> int:
         print(f"facsim: interrupted ({name}); nothing was left half-written", file=sys.stderr)
         return 128 + (stopped[-1] if stopped else signal.SIGINT)
     except Exception as exc:  # one clear line, never a traceback (unless asked for)
-        if os.environ.get("FACSIM_DEBUG"):
+        if getattr(args, "debug", False) or os.environ.get("FACSIM_DEBUG"):
             raise
-        print(f"facsim: error: {_message(exc)}", file=sys.stderr)
-        return EXIT_USAGE if _is_user_error(exc) else 1
+        if _is_user_error(exc):
+            print(f"facsim: error: {_message(exc)}", file=sys.stderr)
+            return EXIT_USAGE
+        print(f"facsim: internal error ({type(exc).__name__}: {_message(exc, 160)}); please report "
+              "this bug with the output of the same command run as `facsim --debug ...`", file=sys.stderr)
+        return EXIT_INTERNAL
     return 0
 
 
@@ -84,12 +91,19 @@ def _stop_on_signals() -> list:
     return received
 
 
-def _message(exc: BaseException) -> str:
+def _message(exc: BaseException, width: int = 400) -> str:
+    from facsim.limits import clip
+
     text = str(exc).strip() or type(exc).__name__
     if isinstance(exc, KeyError) and text.startswith(("'", '"')):
         text = text[1:-1]
-    return " ".join(text.split())
+    return clip(text, width)
 
 
 def _is_user_error(exc: BaseException) -> bool:
-    return isinstance(exc, (CliError, ValueError, KeyError, FileNotFoundError, IsADirectoryError, PermissionError))
+    """Errors in what the user gave (values, files, permissions), as opposed to bugs in facsim.
+
+    ``MemoryError`` and ``RecursionError`` are facsim's fault: the input limits
+    (:mod:`facsim.limits`) should have refused the input first.
+    """
+    return isinstance(exc, (CliError, ValueError, KeyError, OSError))

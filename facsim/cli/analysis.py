@@ -8,17 +8,19 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from facsim.cli.options import integer
+
 
 def add_commands(sub, add_view_options=None) -> None:
     p = sub.add_parser("analyse", aliases=["analyze"], help="images or video of a real face -> FACS (camera processor)")
     p.add_argument("input", help="an image, a folder of images, or a video")
     p.add_argument("-o", "--output", help="write .csv (OpenFace 2.0 layout), .yaml/.json (timeline) or .facs")
-    p.add_argument("--face", type=int, default=0, help="which face when there are several: 0 = largest (default)")
+    p.add_argument("--face", type=integer(0, 99), default=0, help="which face when there are several: 0 = largest (default)")
     p.add_argument("--neutral", help="an image of the same person at rest (their baseline)")
     p.add_argument("--no-smooth", action="store_true", help="no temporal smoothing of video landmarks")
     p.add_argument("--no-baseline", action="store_true",
                    help="video without --neutral: do not take its least active frames as the person's rest")
-    p.add_argument("--threads", type=int, default=1, help="interpreter threads per model (default 1)")
+    p.add_argument("--threads", type=integer(1, 256), default=1, help="interpreter threads per model (default 1)")
     p.add_argument("--explain", action="store_true", help="also list the AUs landmarks cannot show, and why")
     p.set_defaults(handler=cmd_analyse)
 
@@ -27,8 +29,8 @@ def add_commands(sub, add_view_options=None) -> None:
     p.add_argument("-o", "--output", required=True, help="the character video (.mp4, .webm, .gif)")
     p.add_argument("--character", "-c", default="ava", help="preset name or random:SEED")
     p.add_argument("--engine", choices=("registers", "muscle"), default="registers")
-    p.add_argument("--size", type=int, default=384, help="output frame size in pixels (square, default 384)")
-    p.add_argument("--face", type=int, default=0, help="which face when there are several")
+    p.add_argument("--size", type=integer(16, 8192), default=384, help="output frame size in pixels (square, default 384)")
+    p.add_argument("--face", type=integer(0, 99), default=0, help="which face when there are several")
     p.add_argument("--neutral", help="an image of the performer at rest")
     p.add_argument("--no-baseline", action="store_true",
                    help="without --neutral: do not take the video's least active frames as the performer's rest")
@@ -40,7 +42,7 @@ def add_commands(sub, add_view_options=None) -> None:
                    help="comma-separated presets, or all (default: ava, kwame, mei, george; --quick: ava)")
     p.add_argument("--quick", action="store_true", help="a small set: front view, one character, fewer cases")
     p.add_argument("-o", "--output", default="validation", help="report folder (default ./validation)")
-    p.add_argument("--size", type=int, default=320, help="render size in pixels (default 320)")
+    p.add_argument("--size", type=integer(16, 8192), default=320, help="render size in pixels (default 320)")
     p.set_defaults(handler=cmd_validate)
 
 

@@ -1,14 +1,14 @@
 """The CLI's time-based commands: ``facsim animate``, ``facsim emotion``, ``facsim plot``."""
 from __future__ import annotations
 
-from facsim.cli.options import add_view_options, character_of, render_options
+from facsim.cli.options import add_view_options, character_of, fps, number, output, render_options
 
 
 def add_commands(sub) -> None:
     p = sub.add_parser("animate", help="render a timeline (YAML/JSON) to MP4, WebM, GIF or PNG frames")
     p.add_argument("timeline", help="timeline file (see examples/ and `facsim schema`)")
     p.add_argument("-o", "--output", required=True, help="out.mp4, out.webm, out.gif, or a folder for PNG frames")
-    p.add_argument("--fps", type=float, help="frames per second (default: the timeline's)")
+    p.add_argument("--fps", type=fps, help="frames per second (default: the timeline's)")
     p.add_argument("--audio", help="an audio file to mux into the MP4/WebM")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     add_view_options(p)
@@ -19,22 +19,22 @@ def add_commands(sub) -> None:
     p.add_argument("-o", "--output", required=True)
     p.add_argument("--intensity", default="100%", help="peak intensity, e.g. 50%% (HapFACS used 50 and 100)")
     p.add_argument("--table", help="emotion preset table (hapfacs or emfacs)")
-    p.add_argument("--onset", type=float, default=1.0, help="seconds (default 1)")
-    p.add_argument("--apex", type=float, default=1.0, help="seconds (default 1)")
-    p.add_argument("--offset", type=float, default=1.0, help="seconds (default 1)")
+    p.add_argument("--onset", type=number(0, 3600, unit="seconds"), default=1.0, help="seconds (default 1)")
+    p.add_argument("--apex", type=number(0, 3600, unit="seconds"), default=1.0, help="seconds (default 1)")
+    p.add_argument("--offset", type=number(0, 3600, unit="seconds"), default=1.0, help="seconds (default 1)")
     p.add_argument("--easing", default="linear", help="linear, ease-in, ease-out, smoothstep, sigmoid")
-    p.add_argument("--fps", type=float, default=30.0)
+    p.add_argument("--fps", type=fps, default=30.0)
     p.add_argument("--blinks", action="store_true", help="add seeded spontaneous blinks")
     p.add_argument("--seed", type=int, default=0, help="seed for --blinks")
     p.add_argument("--audio", help="an audio file to mux into the MP4/WebM")
-    p.add_argument("--save-timeline", help="also write the timeline used (YAML or JSON)")
+    p.add_argument("--save-timeline", type=output(".yaml", ".yml", ".json"), help="also write the timeline used (YAML or JSON)")
     p.add_argument("--quiet", action="store_true")
     add_view_options(p)
     p.set_defaults(handler=cmd_emotion, antialias="fxaa")
 
     p = sub.add_parser("plot", help="plot a timeline's AU intensities over time (PNG or SVG)")
     p.add_argument("timeline")
-    p.add_argument("-o", "--output", required=True, help="plot.png or plot.svg")
+    p.add_argument("-o", "--output", required=True, type=output(".png", ".svg"), help="plot.png or plot.svg")
     p.set_defaults(handler=cmd_plot)
 
     p = sub.add_parser("schema", help="print the timeline JSON Schema")

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 
+from facsim.cli.options import fps, number, output
 from facsim.engines import ENGINES
 
 CHARACTER_HELP = "preset name (see `facsim characters`) or random:SEED"
@@ -26,6 +27,8 @@ def _au_list(text: str):
     if text.strip().lower() == "all":
         return "all"
     try:
+        if not text.isascii():     # int() would read '١٢' as 12
+            raise ValueError(text)
         codes = [int(part) for part in text.replace("+", ",").split(",") if part.strip()]
     except ValueError:
         raise argparse.ArgumentTypeError(f"--aus takes 'all' or AU codes like 1,2,12, got {text!r}") from None
@@ -34,14 +37,7 @@ def _au_list(text: str):
     return codes
 
 
-def _positive(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        value = -1.0
-    if not value > 0:
-        raise argparse.ArgumentTypeError(f"must be a number > 0, got {text!r}")
-    return value
+_TIMELINE_OUT = output(".yaml", ".yml", ".json", ".facs")
 
 
 def add_commands(sub) -> None:
@@ -51,29 +47,30 @@ def add_commands(sub) -> None:
     formats = export.add_subparsers(dest="format", required=True, metavar="FORMAT")
 
     p = formats.add_parser("glb", help="glTF 2.0 binary: head mesh, AU morph targets, head/eye joints, animation")
-    p.add_argument("-o", "--output", required=True, help="the .glb file to write")
+    p.add_argument("-o", "--output", required=True, type=output(".glb"), help="the .glb file to write")
     p.add_argument("--character", "-c", help=CHARACTER_HELP + " (default: the timeline's, else ava)")
     p.add_argument("--timeline", help="add this timeline (any readable file) as an animation")
     p.add_argument("--aus", type=_au_list, default="all", help="morph targets for 'all' AUs (default) or e.g. 1,2,12")
     p.add_argument("--interpolation", choices=("linear", "step"), default="linear", help="animation keys")
-    p.add_argument("--fps", type=_positive, help="animation frame rate (default: the timeline's)")
+    p.add_argument("--fps", type=fps, help="animation frame rate (default: the timeline's)")
     p.add_argument("--no-normals", action="store_true", help="leave out normals and their morph deltas (smaller)")
     p.set_defaults(handler=cmd_export_glb)
 
     p = formats.add_parser("arkit-csv", help="ARKit-52 blendshape weights per frame, Live Link Face CSV layout")
     p.add_argument("timeline", help="timeline file (YAML, JSON, .facs, CSV)")
-    p.add_argument("-o", "--output", required=True, help="the .csv file to write")
-    p.add_argument("--fps", type=_positive, help="frames per second (default: the timeline's)")
+    p.add_argument("-o", "--output", required=True, type=output(".csv"), help="the .csv file to write")
+    p.add_argument("--fps", type=fps, help="frames per second (default: the timeline's)")
     p.set_defaults(handler=cmd_export_arkit)
 
     p = formats.add_parser("notation", help="the timeline as compact, lossless .facs notation text")
     p.add_argument("timeline", help="timeline file (YAML, JSON, .facs, CSV)")
-    p.add_argument("-o", "--output", required=True, help="the .facs file to write ('-' prints it)")
+    p.add_argument("-o", "--output", required=True, type=output(".facs", allow_stdout=True),
+                   help="the .facs file to write ('-' prints it)")
     p.set_defaults(handler=cmd_export_notation)
 
     p = formats.add_parser("mesh", help="one deformed frame as OBJ or PLY (with the muscle engine's wrinkle)")
     p.add_argument("expression", help='FACS string, e.g. "6+12", "R12A+L14", "neutral"')
-    p.add_argument("-o", "--output", required=True, help="face.obj or face.ply")
+    p.add_argument("-o", "--output", required=True, type=output(".obj", ".ply"), help="face.obj or face.ply")
     p.add_argument("--character", "-c", default="ava", help=CHARACTER_HELP)
     p.add_argument("--engine", choices=("auto", *ENGINES), default="auto",
                    help="auto (default): the muscle engine, whose skin compression the file carries as wrinkle")
@@ -86,23 +83,26 @@ def add_commands(sub) -> None:
 
     p = formats.add_parser("openface", help="an OpenFace 2.0 FeatureExtraction CSV (a recorded performance)")
     p.add_argument("input", help="the OpenFace .csv")
-    p.add_argument("-o", "--output", required=True, help="timeline to write: .yaml, .json or .facs")
-    p.add_argument("--fps", type=_positive, help="timeline frame rate (default: measured from the timestamps)")
+    p.add_argument("-o", "--output", required=True, type=_TIMELINE_OUT,
+                   help="timeline to write: .yaml, .json or .facs")
+    p.add_argument("--fps", type=fps, help="timeline frame rate (default: measured from the timestamps)")
     p.add_argument("--intensities", choices=("hapfacs", "facshuman"), default="hapfacs",
                    help="what OpenFace intensities 1-5 (A-E) mean")
     p.add_argument("--face-id", type=int, help="which face of a multi-face file (default: the lowest id)")
-    p.add_argument("--min-confidence", type=float, help="also hold frames less confident than this")
+    p.add_argument("--min-confidence", type=number(0, 1), help="also hold frames less confident than this")
     p.set_defaults(handler=cmd_import_openface)
 
     p = formats.add_parser("arkit-csv", help="a Live Link Face (ARKit-52 blendshape) CSV")
     p.add_argument("input", help="the Live Link Face .csv")
-    p.add_argument("-o", "--output", required=True, help="timeline to write: .yaml, .json or .facs")
-    p.add_argument("--fps", type=_positive, help="the take's frame rate (default: from its Timecodes, else 60)")
+    p.add_argument("-o", "--output", required=True, type=_TIMELINE_OUT,
+                   help="timeline to write: .yaml, .json or .facs")
+    p.add_argument("--fps", type=fps, help="the take's frame rate (default: from its Timecodes, else 60)")
     p.set_defaults(handler=cmd_import_arkit)
 
     p = formats.add_parser("notation", help="a .facs notation file")
     p.add_argument("input", help="the .facs file")
-    p.add_argument("-o", "--output", required=True, help="timeline to write: .yaml, .json or .facs")
+    p.add_argument("-o", "--output", required=True, type=_TIMELINE_OUT,
+                   help="timeline to write: .yaml, .json or .facs")
     p.set_defaults(handler=cmd_import_notation)
 
 

@@ -74,7 +74,10 @@ class ExchangeError(ValueError):
             where = f"line {line}" + ("" if column is None else f", column {column}")
         else:
             where = ""
-        super().__init__(f"{where}: {problem}" if where else problem)
+        from facsim.limits import clip
+
+        # One bounded line: a hostile file must not make a megabyte-long message.
+        super().__init__(clip(f"{where}: {problem}" if where else str(problem)))
 
     def in_file(self, file) -> "ExchangeError":
         """The same error, naming the file it came from."""
@@ -92,6 +95,25 @@ def write_file(path, data: bytes | str) -> Path:
         raise FileNotFoundError(f"cannot write {path}: folder {path.parent} does not exist")
     payload = data.encode("utf-8") if isinstance(data, str) else bytes(data)
     return atomic_write(path, lambda tmp: tmp.write_bytes(payload))
+
+
+def samples_timeline(path, times, curves, **settings):
+    """:func:`~facsim.timeline.builders.timeline_from_samples`, its TimelineError (a frame rate out of range,
+    too many frames) turned into an :class:`ExchangeError` naming ``path``: importers raise one error type."""
+    from facsim.timeline.builders import timeline_from_samples
+    from facsim.timeline.model import TimelineError
+
+    try:
+        return timeline_from_samples(times, curves, **settings)
+    except TimelineError as exc:
+        raise ExchangeError(str(exc), file=path) from None
+
+
+def check_input_size(path) -> None:
+    """An :class:`ExchangeError` if the file at ``path`` is over the input size limit (:mod:`facsim.limits`)."""
+    from facsim.limits import check_file_size
+
+    check_file_size(path, lambda problem: ExchangeError(problem, file=path))
 
 
 def _csv_kind(path: Path) -> str:
@@ -150,6 +172,7 @@ def read_csv_rows(path) -> tuple[list[str], list[tuple[int, list[str]]]]:
     import io
 
     path = Path(path)
+    check_input_size(path)
     try:
         text = path.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError as exc:
@@ -191,7 +214,7 @@ def require_columns(header: list[str], required, path, what: str) -> dict[str, i
 
 
 __all__ = [
-    "ExchangeError", "TIMELINE_SUFFIXES", "csv_number",
+    "ExchangeError", "TIMELINE_SUFFIXES", "check_input_size", "csv_number", "samples_timeline",
     "load_any_timeline", "read_csv_rows", "require_columns", "save_any_timeline",
     "write_file", *sorted(_LAZY),
 ]

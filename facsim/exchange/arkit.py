@@ -50,8 +50,8 @@ from pathlib import Path
 import numpy as np
 
 from facsim.engines.rigid import eye_levels, eye_motion, head_levels, head_motion, rigid_table
-from facsim.exchange import ExchangeError, csv_number, read_csv_rows, require_columns, write_file
-from facsim.timeline.builders import timeline_from_samples
+from facsim.exchange import (ExchangeError, csv_number, read_csv_rows, require_columns, samples_timeline,
+                             write_file)
 
 REGISTER_PREFIX = "faceunits/"
 #: Frame rates a Live Link Face take's frame numbers are snapped up to.
@@ -61,7 +61,8 @@ COMMON_FPS = (24, 25, 30, 48, 50, 60, 100, 120)
 RIDGE = 0.01
 #: Recovered levels below this are set to 0 (least-squares crumbs, not actions).
 LEVEL_FLOOR = 0.005
-_TIMECODE = re.compile(r"^\s*(\d+):(\d{1,2}):(\d{1,2})[:;.](\d+(?:\.\d*)?)\s*$")
+# ASCII digits, bounded lengths: '٠١' is no frame number, and 400 nines would be an infinite one.
+_TIMECODE = re.compile(r"^\s*([0-9]{1,4}):([0-9]{1,2}):([0-9]{1,2})[:;.]([0-9]{1,4}(?:\.[0-9]{0,9})?)\s*$", re.ASCII)
 
 
 @lru_cache(maxsize=1)
@@ -262,6 +263,10 @@ def read_arkit_csv(path, *, fps: float | None = None):
         frames.append(frame)
         weights[k] = [csv_number(cells, i, header, line, path) for i in shape_at]
         angles[k] = [0.0 if i is None else csv_number(cells, i, header, line, path) for i in angle_at]
+        if np.any(np.abs(angles[k]) > 1.0 + 1e-6):   # -1..1 is -180..180 degrees; more would overflow into NaN
+            column = next(n for n, v in zip(angle_names(), angles[k]) if abs(v) > 1.0 + 1e-6)
+            raise ExchangeError(f"column {column}: {angles[k][angle_names().index(column)]:g} is outside -1..1 "
+                                "(Live Link Face angles are degrees / 180)", file=path, line=line)
     fps = float(fps) if fps else (_fps_from_frames(seconds, frames) or arkit_table()["live_link_face"]["default_fps"])
     index = np.array(seconds, float) * fps + np.array(frames)
     snapped = np.round(index)
@@ -272,7 +277,7 @@ def read_arkit_csv(path, *, fps: float | None = None):
         raise ExchangeError(f"Timecode {data[bad[0] + 1][1][lookup['timecode']].strip()!r} does not come after "
                             "the previous row's", file=path, line=data[bad[0] + 1][0])
     curves = _curves(np.clip(weights, 0.0, 1.0), angles)
-    return timeline_from_samples(times, curves, fps=fps, description=f"ARKit blendshapes from {path.name}")
+    return samples_timeline(path, times, curves, fps=fps, description=f"ARKit blendshapes from {path.name}")
 
 
 def _curves(weights: np.ndarray, angles: np.ndarray) -> dict:

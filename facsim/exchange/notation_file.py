@@ -72,10 +72,11 @@ _BLINK_ATTR = {"rate": "rate_per_minute"}
 _SIDE_SUFFIX = {"both": "", "left": "L", "right": "R", "unilateral": "U"}
 _SUFFIX_SIDE = {v: k for k, v in _SIDE_SUFFIX.items()}
 
-_NUMBER = re.compile(r"(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][-+]?\d+)?")
+# ASCII digits only (\d alone would read '١٢' as 12); codes of at most 4 digits (int() of 5,000 digits raises).
+_NUMBER = re.compile(r"(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][-+]?\d+)?", re.ASCII)
 _WORD = re.compile(r"[A-Za-z][A-Za-z0-9_-]*")
 _BARE = re.compile(r"[^\s\"#]+")
-_AU = re.compile(r"AU(\d+)([LRU]?)(?=\s|$)")
+_AU = re.compile(r"AU(\d{1,4})([LRU]?)(?=\s|$)", re.ASCII)
 _KEY = re.compile(r"([a-z_]+):(?=\s|$)")
 _SPEECH = re.compile(r"(say|audio)[ \t]+")
 
@@ -510,7 +511,10 @@ def loads_notation(text: str, *, folder=None):
 
 def read_notation(path):
     """Read a ``.facs`` file (see :func:`loads_notation`); errors name the file."""
+    from facsim.exchange import check_input_size
+
     path = Path(path)
+    check_input_size(path)
     try:
         return loads_notation(path.read_text(encoding="utf-8"), folder=path.parent)
     except NotationFileError as exc:

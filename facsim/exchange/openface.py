@@ -36,18 +36,19 @@ Each AU becomes a track of linear segments from frame to frame
 """
 from __future__ import annotations
 
+import math
+
 import re
 from pathlib import Path
 
 import numpy as np
 
 from facsim.engines.rigid import eye_levels, head_levels
-from facsim.exchange import ExchangeError, csv_number, read_csv_rows, require_columns
-from facsim.timeline.builders import timeline_from_samples
+from facsim.exchange import ExchangeError, csv_number, read_csv_rows, require_columns, samples_timeline
 
 #: Frame rates the measured one is snapped to (within 1 %).
 COMMON_FPS = (15, 24, 25, 30, 48, 50, 60, 90, 100, 120)
-_AU_COLUMN = re.compile(r"^AU(\d+)_r$", re.IGNORECASE)
+_AU_COLUMN = re.compile(r"^AU(\d{1,4})_r$", re.IGNORECASE | re.ASCII)
 _POSE = ("pose_Rx", "pose_Ry", "pose_Rz")
 _GAZE = ("gaze_angle_x", "gaze_angle_y")
 
@@ -86,10 +87,16 @@ def eye_rotvec_degrees(gaze: np.ndarray, head_degrees: np.ndarray) -> np.ndarray
     return np.stack([pitch, yaw, np.zeros(len(gaze))], axis=1)
 
 
-def _frame_rate(times: np.ndarray) -> float:
+def _frame_rate(times: np.ndarray, path) -> float:
     if len(times) < 2:
         return 30.0
-    rate = 1.0 / float(np.median(np.diff(times)))
+    from facsim.limits import MIN_FPS, limit
+
+    step = float(np.median(np.diff(times)))
+    rate = 1.0 / step if step > 0 else math.inf
+    if not MIN_FPS <= rate <= limit("max_fps"):    # odd timestamps: say so rather than divide by ~0
+        raise ExchangeError(f"timestamps {step:g} s apart (median) make {rate:g} frames per second; expected "
+                            f"{MIN_FPS:g} to {limit('max_fps'):,} (give the frame rate: --fps)", file=path)
     near = min(COMMON_FPS, key=lambda r: abs(r - rate))
     return float(near) if abs(near - rate) <= 0.01 * rate else round(rate, 3)
 
@@ -142,6 +149,11 @@ def read_openface_csv(path, *, intensities: str = "hapfacs", face_id: int | None
             raise ExchangeError(f"no rows with face_id {face_id}", file=path)
         numbers, data = numbers[keep], [row for row, k in zip(data, keep) if k]
         column = {name: numbers[:, k] for k, name in enumerate(optional)}
+    for name in (*_POSE, *_GAZE):     # radians; beyond a full turn is no head pose or gaze (and overflows)
+        if optional[name] is not None and np.any(np.abs(column[name]) > 2 * math.pi):
+            row = int(np.flatnonzero(np.abs(column[name]) > 2 * math.pi)[0])
+            raise ExchangeError(f"column {name}: {column[name][row]:g} radians is more than a full turn",
+                                file=path, line=data[row][0])
     stamps = column["timestamp"]
     backwards = np.flatnonzero(np.diff(stamps) <= 0)
     if backwards.size:
@@ -155,7 +167,7 @@ def read_openface_csv(path, *, intensities: str = "hapfacs", face_id: int | None
     gaze = _hold_bad_frames(np.stack([column[n] for n in _GAZE], 1), good)
 
     times = stamps - stamps[0]
-    rate = float(fps) if fps else _frame_rate(times)
+    rate = float(fps) if fps else _frame_rate(times, path)
     index = np.round(times * rate)
     if np.all(np.abs(times * rate - index) <= 0.25) and np.all(np.diff(index) > 0):
         times = index / rate
@@ -170,7 +182,7 @@ def read_openface_csv(path, *, intensities: str = "hapfacs", face_id: int | None
         for code in (61, 62, 63, 64):
             curves[(code, "both")] = np.array([lv[code] for lv in levels])
     curves = {key: v for key, v in curves.items() if np.any(v > 0)}
-    return timeline_from_samples(times, curves, fps=rate, intensities=intensities,
+    return samples_timeline(path, times, curves, fps=rate, intensities=intensities,
                                  description=f"OpenFace performance {path.name}")
 
 

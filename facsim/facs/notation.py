@@ -45,8 +45,13 @@ _PREFIX_SIDE = {"L": "left", "R": "right", "U": "unilateral"}
 #: these overlap. A ``U`` unit could be on either side, so it clashes with any.
 _COVERS = {"left": {"left"}, "right": {"right"}, "both": {"left", "right"}, "unilateral": {"left", "right"}}
 _NEUTRAL = ("", "0", "neutral")
-_TOKEN = re.compile(r"(?P<side>[LRU])?(?P<au>AU)?(?P<code>\d+)(?:(?P<letter>[A-Z])|@(?P<amount>.*))?",
-                    re.IGNORECASE)
+# ASCII digits only: \d would read Arabic-Indic or fullwidth digits as codes ("١٢" as AU12).
+_TOKEN = re.compile(r"(?P<side>[LRU])?(?P<au>AU)?(?P<code>[0-9]+)(?:(?P<letter>[A-Z])|@(?P<amount>.*))?",
+                    re.IGNORECASE | re.ASCII)
+#: What an ``@`` amount may look like: a plain decimal fraction or percentage (no exponents, inf or nan).
+_AMOUNT = re.compile(r"[-+]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)%?", re.ASCII)
+#: Longest code written with digits (FACS codes have at most 2; leading zeros allowed).
+_MAX_CODE_DIGITS = 4
 
 
 class NotationError(ValueError):
@@ -63,9 +68,12 @@ class NotationError(ValueError):
     """
 
     def __init__(self, problem: str, *, text: str, position: int, token: str, hint: str = ""):
+        from facsim.limits import clip, short
+
         self.text, self.position, self.token = text, position, token
-        message = f"{problem} {token!r} at position {position} in {text!r}"
-        super().__init__(f"{message}: {hint}" if hint else message)
+        # The string and token are shown shortened: a 1 MB string must not make a 1 MB message.
+        message = f"{problem} {short(token, 40)} at position {position} in {short(text, 60)}"
+        super().__init__(clip(f"{message}: {hint}" if hint else message))
 
     def __reduce__(self):  # keyword-only __init__: tell pickle how to rebuild (worker processes)
         return _rebuild_notation_error, (str(self), self.text, self.position, self.token)
@@ -109,7 +117,9 @@ def parse_intensity(value: float | str, *, name: str = "intensity") -> float:
         except ValueError:
             number = None
     elif isinstance(value, (int, float)) and not isinstance(value, bool):
-        number = float(value)
+        number = float(value) if abs(value) < 1e300 else (math.inf if value > 0 else -math.inf)   # 10**400
+    if number is not None:
+        number += 0.0          # -0.0 -> 0.0, so '12@-0' reads and formats as 12@0
     if number is None or math.isnan(number):
         raise ValueError(f"{name} must be a number in [0, 1] or a percentage like '70%', got {value!r}")
     if not 0.0 <= number <= 1.0:
@@ -279,7 +289,9 @@ def _parse_token(token: str, position: int, text: str, table: dict) -> ActionUni
     match = _TOKEN.fullmatch(token)
     if match is None:
         raise error("malformed action unit", "write e.g. '12', 'AU12', 'L12C' or '12@0.7'")
-    code = int(match["code"])
+    if len(match["code"].lstrip("0")) > _MAX_CODE_DIGITS:
+        raise error("unknown action unit", "FACS codes have at most two digits")
+    code = int(match["code"].lstrip("0") or "0")
     if code == 0:
         raise error("neutral code", "'0' stands for the neutral face on its own; drop it")
     try:
@@ -297,6 +309,9 @@ def _parse_token(token: str, position: int, text: str, table: dict) -> ActionUni
                         f"FACS intensities are {', '.join(LETTERS)}")
         return ActionUnit(code, table[letter], side, letter)
     if match["amount"] is not None:
+        if not _AMOUNT.fullmatch(match["amount"].strip()):
+            raise error("bad intensity in", "write the amount as a fraction '0.7' or a percentage '70%' "
+                                            "(ASCII digits)")
         try:
             return ActionUnit(code, parse_intensity(match["amount"]), side)
         except ValueError as exc:
@@ -338,6 +353,11 @@ def parse(text: str, *, intensities: str = "hapfacs") -> Expression:
                          f"choose one of {', '.join(map(repr, INTENSITY_TABLES))}")
     if not isinstance(text, str):
         raise TypeError(f"FACS notation must be a str, got {type(text).__name__}")
+    from facsim.limits import limit, override_hint
+
+    if len(text) > limit("max_notation"):
+        raise NotationError(f"notation of {len(text):,} characters is too long {override_hint('max_notation')};",
+                            text=text, position=0, token=text[:10])
     if text.strip().lower() in _NEUTRAL:
         return Expression()
     table = dict(INTENSITY_TABLES[intensities])

@@ -51,6 +51,14 @@ def stimulus_timeline(expression_or_emotion, onset: float = 1.0, apex: float = 1
     if isinstance(expression_or_emotion, str) and expression_or_emotion.strip().lower() in emotion_names():
         track = Track(emotion=expression_or_emotion, table=table, timing=envelope)
     else:
+        if isinstance(expression_or_emotion, str) and _looks_like_a_name(expression_or_emotion):
+            import difflib
+
+            name = expression_or_emotion.strip()
+            close = difflib.get_close_matches(name.lower(), emotion_names(), n=1)
+            hint = f"did you mean {close[0]!r}? " if close else ""
+            raise TimelineError(f"unknown emotion {name[:40]!r}; {hint}choose one of {', '.join(emotion_names())} "
+                                "or give FACS notation such as '1+2+5B+26'")
         if table is not None:
             raise TimelineError(TABLE_ONLY_FOR_EMOTION, location=("table",))
         text = expression_or_emotion
@@ -58,6 +66,12 @@ def stimulus_timeline(expression_or_emotion, onset: float = 1.0, apex: float = 1
             text = expression_text(expression_or_emotion, intensities)
         track = Track(facs=text, timing=envelope)
     return Timeline((track,), duration=envelope.end, fps=fps, intensities=intensities, **settings)
+
+
+def _looks_like_a_name(text: str) -> bool:
+    """A word, not FACS notation: letters only (every FACS unit has a digit), and not 'neutral'."""
+    word = text.strip()
+    return bool(word) and word.lower() != "neutral" and all(ch.isalpha() or ch in " -_" for ch in word)
 
 
 def timeline_from_samples(times, curves: Mapping[tuple[int, str], np.ndarray], *, fps: float,

@@ -33,6 +33,7 @@ from pathlib import Path
 from typing import Any, Mapping, Sequence
 
 from facsim.atomic import atomic_write
+from facsim.limits import check_file_size, limit, override_hint, short
 from facsim.timeline.model import ENVELOPE_KEYS, SIDE_ONLY_FOR_AU, TABLE_ONLY_FOR_EMOTION, DEFAULT_FPS, DEFAULT_INTENSITIES, Blinks, Envelope, Hold, Segment, Timeline, TimelineError, Timing, Track, intensities_table, parse_level, source_problem
 
 SCHEMA_FILE = "timeline.schema.json"
@@ -124,7 +125,7 @@ def _schema_problem(error) -> tuple[tuple, str]:
         return location, _source_problem_in(instance)
     if kind == "additionalProperties":
         allowed = list(schema.get("properties", {}))
-        extra = sorted(k for k in instance if k not in allowed)[0]
+        extra = sorted((k for k in instance if k not in allowed), key=str)[0]   # keys may mix types
         close = difflib.get_close_matches(str(extra), allowed, n=1)
         hint = f"; did you mean {close[0]!r}?" if close else f"; known fields are {', '.join(allowed)}"
         return location, f"unknown field {extra!r}{hint}"
@@ -133,18 +134,42 @@ def _schema_problem(error) -> tuple[tuple, str]:
         return location, f"missing field {missing[0]!r}"
     if kind == "type":
         expected = " or ".join(_TYPE_NAMES.get(t, t) for t in ([value] if isinstance(value, str) else value))
-        return location, f"expected {expected}, got {instance!r}"
+        return location, f"expected {expected}, got {short(instance)}"
     if kind == "enum":
-        return location, f"unknown {name} {instance!r}; choose one of {', '.join(map(str, value))}"
+        return location, f"unknown {name} {short(instance)}; choose one of {', '.join(map(str, value))}"
     if kind == "minimum" and name in ("start", "end", "onset", "apex", "offset"):
         return location, (f"negative time {instance:g} s; times are seconds from the start of the video "
                           "and must be >= 0")
     if kind in ("minimum", "exclusiveMinimum", "maximum", "exclusiveMaximum"):
         sign = {"minimum": ">=", "exclusiveMinimum": ">", "maximum": "<=", "exclusiveMaximum": "<"}[kind]
-        return location, f"must be {sign} {value:g}, got {instance!r}"
+        return location, f"must be {sign} {value:g}, got {short(instance)}"
     if kind in ("minItems", "minLength"):
         return location, "must not be empty"
-    return location, error.message
+    if kind == "maxLength":
+        return location, f"{len(instance):,} characters is too long; at most {value:,}"
+    return location, short(error.message, 200)
+
+
+def _depth_problem(data: Any) -> str | None:
+    """Why ``data`` is nested too deeply, too big or has too many tracks, else None (iterative: no recursion)."""
+    tracks = data.get("tracks") if isinstance(data, Mapping) else None
+    if isinstance(tracks, list) and len(tracks) > limit("max_tracks"):
+        return f"{len(tracks):,} tracks is too many {override_hint('max_tracks')}"
+    most, most_values, seen = limit("max_depth"), limit("max_values"), 0
+    stack = [(data, 1)]
+    while stack:
+        value, depth = stack.pop()
+        seen += 1
+        if seen > most_values:       # JSON has no reader-level count (YAML does): the schema check would crawl
+            return (f"more than {most_values:,} values in one timeline {override_hint('max_values')}; "
+                    "long recordings are smaller and faster as .facs")
+        if depth > most:
+            return f"lists and mappings nested more than {most} deep {override_hint('max_depth')}"
+        if isinstance(value, Mapping):
+            stack.extend((v, depth + 1) for v in value.values())
+        elif isinstance(value, (list, tuple)):
+            stack.extend((v, depth + 1) for v in value)
+    return None
 
 
 def _location_key(location: tuple) -> tuple:
@@ -223,6 +248,9 @@ def timeline_from_dict(data: Mapping, *, folder=None) -> Timeline:
     if not isinstance(data, Mapping):
         what = "nothing (the file is empty)" if data is None else type(data).__name__
         raise TimelineError(f"expected a mapping with 'tracks' at the top level, got {what}")
+    problem = _depth_problem(data)         # before the schema check, which would take minutes or recurse
+    if problem:
+        raise TimelineError(problem)
     _check_schema(data)
     table = data.get("intensities", DEFAULT_INTENSITIES)
     intensities_table(table)
@@ -328,13 +356,60 @@ def _format_of(path: Path) -> str:
                             file=path) from None
 
 
+@lru_cache(maxsize=1)
+def _guarded_loader():
+    """yaml.SafeLoader that refuses aliases and nesting deeper than the depth limit.
+
+    Aliases are how a few hundred bytes expand to gigabytes ("billion laughs");
+    deep nesting is how they reach Python's recursion limit. Timeline files need neither.
+    """
+    import yaml
+
+    class GuardedLoader(yaml.SafeLoader):
+        def __init__(self, stream):
+            super().__init__(stream)
+            self._depth, self._values = 0, 0
+            self._most_depth, self._most_values = limit("max_depth"), limit("max_values")
+            self._most_tracks = limit("max_tracks")
+
+        def compose_node(self, parent, index):
+            if self.check_event(yaml.AliasEvent):
+                event = self.peek_event()
+                raise yaml.composer.ComposerError(None, None, "YAML aliases (*name) are not allowed in "
+                                                  "facsim input files; write the value out", event.start_mark)
+            self._depth += 1
+            self._values += 1
+            if self._values > self._most_values:     # checked while reading: parsing is the slow part
+                raise yaml.composer.ComposerError(
+                    None, None, f"more than {limit('max_values'):,} values in one file "
+                    f"{override_hint('max_values')}; long recordings are smaller and faster as .facs",
+                    self.peek_event().start_mark)
+            # Items of a top-level list (the tracks), counted as they are read: a million of them
+            # would take minutes to parse before the track limit could be checked.
+            if self._depth == 3 and isinstance(parent, yaml.SequenceNode) and index >= self._most_tracks:
+                self._depth -= 1
+                raise yaml.composer.ComposerError(
+                    None, None, f"more than {self._most_tracks:,} tracks {override_hint('max_tracks')}",
+                    self.peek_event().start_mark)
+            try:
+                if self._depth > self._most_depth:
+                    raise yaml.composer.ComposerError(
+                        None, None, f"lists and mappings nested more than {limit('max_depth')} deep "
+                        f"{override_hint('max_depth')}", self.peek_event().start_mark)
+                return super().compose_node(parent, index)
+            finally:
+                self._depth -= 1
+
+    return GuardedLoader
+
+
 def _yaml_line(text: str, location: Sequence[str | int]) -> int | None:
     """1-based line of the YAML node at ``location`` (or its nearest parent)."""
     import yaml
 
     try:
-        node = yaml.compose(text, Loader=yaml.SafeLoader)
-    except yaml.YAMLError:
+        node = yaml.compose(text, Loader=_guarded_loader())
+    except Exception:      # noqa: BLE001 - the line is only a courtesy; the error it annotates stands
         return None
     line = None
     for key in location:
@@ -342,7 +417,7 @@ def _yaml_line(text: str, location: Sequence[str | int]) -> int | None:
             break
         line = node.start_mark.line + 1
         if isinstance(node, yaml.MappingNode):
-            node = next((v for k, v in node.value if k.value == key), None)
+            node = next((v for k, v in node.value if k.value == str(key)), None)
         elif isinstance(node, yaml.SequenceNode) and isinstance(key, int) and key < len(node.value):
             node = node.value[key]
         else:
@@ -350,6 +425,52 @@ def _yaml_line(text: str, location: Sequence[str | int]) -> int | None:
     if node is not None:
         line = node.start_mark.line + 1
     return line
+
+
+def read_data_file(path: Path, kind: str, error) -> tuple[str, Any]:
+    """The text of a YAML or JSON file from an untrusted source, and its data, within the input limits.
+
+    Parameters
+    ----------
+    path : Path
+    kind : {"yaml", "json"}
+    error : callable
+        ``error(problem, file=..., line=...)`` makes the exception to raise
+        (:class:`TimelineError`, a spec error...).
+
+    Returns
+    -------
+    text : str
+    data : object
+        Plain dicts, lists, strings and numbers.
+    """
+    import yaml
+
+    if path.is_dir():
+        raise error("is a folder, not a file", file=path)
+    check_file_size(path, lambda problem: error(problem, file=path))
+    try:
+        text = path.read_bytes().decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise error(f"not UTF-8 text ({exc.reason} at byte {exc.start})", file=path) from None
+    if kind == "yaml":
+        try:
+            return text, yaml.load(text, Loader=_guarded_loader())
+        except yaml.MarkedYAMLError as exc:
+            mark = exc.problem_mark
+            raise error(f"malformed YAML: {exc.problem or exc}", file=path,
+                        line=None if mark is None else mark.line + 1) from None
+        except Exception as exc:  # noqa: BLE001 - tags such as '!!int x' fail with ValueError, dates too
+            raise error(f"malformed YAML: {exc}", file=path) from None
+    try:
+        return text, json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise error(f"malformed JSON: {exc.msg} (column {exc.colno})", file=path, line=exc.lineno) from None
+    except RecursionError:
+        raise error(f"malformed JSON: lists and mappings nested too deeply {override_hint('max_depth')}",
+                    file=path) from None
+    except ValueError as exc:    # e.g. an integer of more than 4,300 digits
+        raise error(f"malformed JSON: {exc}", file=path) from None
 
 
 def load_timeline(path: str | os.PathLike) -> Timeline:
@@ -367,21 +488,7 @@ def load_timeline(path: str | os.PathLike) -> Timeline:
 
     path = Path(path)
     kind = _format_of(path)
-    text = path.read_text(encoding="utf-8")
-    if kind == "yaml":
-        try:
-            data = yaml.safe_load(text)
-        except yaml.YAMLError as exc:
-            mark = getattr(exc, "problem_mark", None)
-            problem = " ".join(str(getattr(exc, "problem", None) or exc).split())
-            raise TimelineError(f"malformed YAML: {problem}", file=path,
-                                line=None if mark is None else mark.line + 1) from None
-    else:
-        try:
-            data = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise TimelineError(f"malformed JSON: {exc.msg} (column {exc.colno})", file=path,
-                                line=exc.lineno) from None
+    text, data = read_data_file(path, kind, TimelineError)
     try:
         return timeline_from_dict(data, folder=path.parent)
     except TimelineError as exc:
@@ -406,4 +513,4 @@ def save_timeline(timeline: Timeline, path: str | os.PathLike) -> Path:
     return atomic_write(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
 
 
-__all__ = ["load_timeline", "save_timeline", "timeline_from_dict", "timeline_schema", "timeline_to_dict"]
+__all__ = ["load_timeline", "read_data_file", "save_timeline", "timeline_from_dict", "timeline_schema", "timeline_to_dict"]

@@ -108,6 +108,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from facsim.limits import check_fps, check_frames, limit, override_hint, short
 from facsim.facs.catalogue import INTENSITY_TABLES, LETTERS, UnknownActionUnitError, info, intensity_of
 from facsim.timeline.easing import get_easing
 from facsim.facs.activations import Activations, activations
@@ -169,7 +170,10 @@ class TimelineError(ValueError):
         if where and line is not None:
             where += f":{line}"
         parts = [p for p in (where, self.path) if p]
-        super().__init__(": ".join([*parts, problem]))
+        from facsim.limits import clip
+
+        # One line, bounded: a hostile file must not make a megabyte-long message.
+        super().__init__(clip(": ".join([*parts, str(problem)])))
 
     @property
     def path(self) -> str:
@@ -191,8 +195,8 @@ class TimelineError(ValueError):
 def seconds(value: Any, name: str) -> float:
     """A finite time or duration >= 0, else a TimelineError at ``name``."""
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise TimelineError(f"expected a number of seconds, got {value!r}", location=(name,))
-    value = float(value)
+        raise TimelineError(f"expected a number of seconds, got {short(value)}", location=(name,))
+    value = _float(value)
     if not math.isfinite(value):
         raise TimelineError(f"expected a finite number of seconds, got {value}", location=(name,))
     if value < 0:
@@ -210,10 +214,18 @@ def _set_interval(item) -> None:
     object.__setattr__(item, "end", end)
 
 
+def _float(value) -> float:
+    """``float(value)``, infinite for integers too big for a float (JSON and YAML allow 10**400)."""
+    try:
+        return float(value)
+    except OverflowError:
+        return math.inf if value > 0 else -math.inf
+
+
 def positive(value: Any, name: str, unit: str = "") -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
-            or not math.isfinite(float(value)) or float(value) <= 0:
-        raise TimelineError(f"must be a number > 0{unit}, got {value!r}", location=(name,))
+            or not math.isfinite(_float(value)) or _float(value) <= 0:
+        raise TimelineError(f"must be a number > 0{unit}, got {short(value)}", location=(name,))
     return float(value)
 
 
@@ -228,7 +240,7 @@ def parse_level(value: Any, name: str, table: str | None = None) -> float:
     except ValueError as exc:
         problem = "intensity out of range" if "between 0 and 1" in str(exc) else "not an intensity"
         letters = " or a letter A-E" if table is not None else ""
-        raise TimelineError(f"{problem}: {value!r}; use a fraction 0..1, a percentage '0%'..'100%'{letters}",
+        raise TimelineError(f"{problem}: {short(value)}; use a fraction 0..1, a percentage '0%'..'100%'{letters}",
                             location=(name,)) from None
 
 
@@ -614,7 +626,14 @@ class Timeline:
             if not isinstance(track, (Track, SoundTrack)):
                 raise TimelineError(f"expected a Track, got {type(track).__name__}", location=("tracks", i))
         object.__setattr__(self, "tracks", tracks)
+        if len(tracks) > limit("max_tracks"):
+            raise TimelineError(f"{len(tracks):,} tracks is too many {override_hint('max_tracks')}",
+                                location=("tracks",))
         object.__setattr__(self, "fps", positive(self.fps, "fps"))
+        try:
+            check_fps(self.fps)
+        except ValueError as exc:
+            raise TimelineError(str(exc).removeprefix("fps "), location=("fps",)) from None
         if self.duration is None:
             if not tracks:
                 raise TimelineError("a timeline without tracks needs a duration", location=("duration",))
@@ -632,6 +651,12 @@ class Timeline:
         if self.blinks is not None and not isinstance(self.blinks, Blinks):
             raise TimelineError(f"expected Blinks, got {self.blinks!r}", location=("blinks",))
         intensities_table(self.intensities)
+        ends = [track.end for track in tracks if isinstance(track, Track)]   # speech: known once synthesised
+        length = self.duration if self.duration is not None else max(ends, default=0.0)
+        try:
+            check_frames(length * self.fps, f"{length:g} s at {self.fps:g} fps")
+        except ValueError as exc:
+            raise TimelineError(str(exc), location=("duration",) if self.duration is not None else ()) from None
         for i, track in enumerate(tracks):     # letters must read in this table too
             if isinstance(track, SoundTrack):
                 continue

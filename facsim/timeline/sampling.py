@@ -22,7 +22,8 @@ from typing import Mapping
 import numpy as np
 
 from facsim.facs.activations import Activations
-from facsim.timeline.model import (BLINK_AU, BLINK_CLOSE_FRACTION, DECIMALS, SIDE_SUFFIX, Segment, Timeline, Track,
+from facsim.limits import check_fps, check_frames
+from facsim.timeline.model import (TimelineError, BLINK_AU, BLINK_CLOSE_FRACTION, DECIMALS, SIDE_SUFFIX, Segment, Timeline, Track,
                                    positive, track_activations)
 
 
@@ -36,6 +37,11 @@ def frame_count(timeline: Timeline, fps: float | None = None) -> int:
     90
     """
     fps = timeline.fps if fps is None else positive(fps, "fps")
+    try:
+        check_fps(fps)
+        check_frames(timeline.length * fps, f"{timeline.length:g} s at {fps:g} fps")
+    except ValueError as exc:
+        raise TimelineError(str(exc)) from None
     return int(math.floor(round(timeline.length * fps, 6) + 0.5))
 
 
@@ -68,8 +74,13 @@ def frame_times(timeline: Timeline, fps: float | None = None) -> np.ndarray:
     return np.arange(frame_count(timeline, fps)) / fps
 
 
-def blink_times(timeline: Timeline) -> np.ndarray:
+def blink_times(timeline: Timeline, until: float | None = None) -> np.ndarray:
     """Start times of the spontaneous blinks (seconds; empty without ``blinks``).
+
+    ``until`` (default: the timeline's length) stops the draws early: sampling
+    a few frames costs blinks up to the last of them, not the whole video. The
+    draws are a prefix of the same random stream, so the blinks before
+    ``until`` are the same whatever it is.
 
     Examples
     --------
@@ -85,17 +96,23 @@ def blink_times(timeline: Timeline) -> np.ndarray:
         return np.zeros(0)
     rng = np.random.default_rng(blinks.seed)
     mean_extra = 60.0 / blinks.rate_per_minute - blinks.min_interval
-    times, t, end = [], 0.0, timeline.length
-    while True:
-        t += blinks.min_interval + rng.exponential(mean_extra)
-        if t >= end:
-            return np.array(times)
-        times.append(t)
+    end = timeline.length if until is None else min(float(until), timeline.length)
+    # Drawn in batches (the same stream as one draw at a time), summed left to right like a running total.
+    chunks, t = [], 0.0
+    batch = 64
+    while t < end:
+        gaps = blinks.min_interval + rng.exponential(mean_extra, size=batch)
+        starts = np.cumsum(np.concatenate(([t], gaps)))[1:]
+        chunks.append(starts)
+        t = float(starts[-1])
+        batch = min(batch * 2, 1 << 16)
+    times = np.concatenate(chunks) if chunks else np.zeros(0)
+    return times[times < end]
 
 
-def blink_track(timeline: Timeline) -> Track | None:
-    """The blinks as one AU45 track of sectors (``None`` if there are none)."""
-    starts = blink_times(timeline)
+def blink_track(timeline: Timeline, until: float | None = None) -> Track | None:
+    """The blinks starting before ``until`` as one AU45 track of sectors (``None`` if there are none)."""
+    starts = blink_times(timeline, until)
     if starts.size == 0:
         return None
     blinks = timeline.blinks
@@ -107,8 +124,8 @@ def blink_track(timeline: Timeline) -> Track | None:
     return Track(au=BLINK_AU, timing=tuple(segments))
 
 
-def _all_tracks(timeline: Timeline) -> tuple[Track, ...]:
-    blinks = blink_track(timeline)
+def _all_tracks(timeline: Timeline, until: float | None = None) -> tuple[Track, ...]:
+    blinks = blink_track(timeline, until)
     return timeline.tracks if blinks is None else (*timeline.tracks, blinks)
 
 
@@ -134,7 +151,9 @@ def activation_curves(timeline: Timeline, times) -> dict[tuple[int, str], np.nda
         raise ValueError(f"times must be a 1-D array of seconds, got shape {times.shape}")
     totals: dict[tuple[int, str], np.ndarray] = {}
     speech = []
-    for track in _all_tracks(timeline):
+    # Blinks only up to the last time asked for: cost follows the frames sampled, not the duration.
+    until = float(np.nextafter(times.max(), np.inf)) if times.size else 0.0
+    for track in _all_tracks(timeline, until):
         if not isinstance(track, Track):   # speech: AU curves from its phones, combined below
             speech.append(track)
             continue
