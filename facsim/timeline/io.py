@@ -484,8 +484,6 @@ def load_timeline(path: str | os.PathLike) -> Timeline:
     FileNotFoundError
         If there is no such file.
     """
-    import yaml
-
     path = Path(path)
     kind = _format_of(path)
     text, data = read_data_file(path, kind, TimelineError)
