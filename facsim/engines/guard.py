@@ -1,0 +1,189 @@
+"""Keep a deformed face physical: skin off the eyeballs, no skin turned inside out.
+
+Both engines end with this step, after their own deformation and before the
+rigid head motion (51–58):
+
+1. **Eyeball contact.** Skin that lies outside an eyeball at rest may not
+   enter it: summed targets (registers) or a cheek pushed up by the orbital
+   ring (muscles, AU 6) can otherwise move the lower lid or the skin under it
+   into the eye, which then shows through the skin. Such points are moved out
+   along the eyeball's radius to the surface plus a clearance (never further
+   out than they rest).
+2. **Untangling.** A skin triangle whose area along its rest normal falls
+   below a small share of its rest area has folded (or is about to fold)
+   through its neighbours — two targets that each move the lid crease, or
+   one that moves the lid margin further than the lid's skin can follow. The
+   displacement of its corners (and, if that is not enough, of a widening ring
+   around them) is relaxed toward the average of their neighbours' — a
+   membrane that refuses to fold — while every other vertex keeps its
+   displacement. A constant displacement is a rigid shift of the rest
+   surface, which is fold-free, so the relaxation always ends.
+
+The two can undo each other a little (relaxing a lid may move it into the eye,
+pushing it out may fold a triangle), so they alternate a few times.
+
+Examples
+--------
+>>> guard = SkinGuard(head, rest, eye_centres, eye_radius)   # doctest: +SKIP
+>>> positions = guard(positions)                              # doctest: +SKIP
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+#: Least share of its rest area a skin triangle keeps along its rest normal.
+MIN_AREA_SHARE = 0.05
+#: Skin within this height (dm) over an eyeball at rest keeps its rest height over it when an
+#: expression moves it there (the lid slides over the eye keeping its thickness); skin further
+#: out is kept at least this high. 3 mm: a lid's thickness at its margin and a little more.
+LID_HEIGHT = 0.03
+#: Rounds of (eye contact, untangling); relaxation passes per round; rings grown per stuck round.
+ROUNDS = 4
+#: Rounds of the untangling step.
+UNTANGLE_ROUNDS = 24
+#: Furthest (dm) the untangling moves any vertex: 1.5 mm.
+MAX_CORRECTION = 0.03
+#: Rest triangles smaller than this (twice the area, dm²) have no reliable orientation.
+DEGENERATE_AREA2 = 1e-10
+
+
+class SkinGuard:
+    """The final physical step of an engine, for one character.
+
+    Parameters
+    ----------
+    head : HeadModel
+        Gives the skin triangles (geometry vertices ``0 … skin_vertex_count-1``).
+    rest : (N_geo, 3) array
+        The character's neutral geometry.
+    eye_centres : sequence of (3,) arrays
+        The eyeball centres (at rest: the step runs before rigid head motion).
+    eye_radius : float
+    """
+
+    def __init__(self, head, rest, eye_centres, eye_radius: float):
+        rest = np.asarray(rest, float)
+        self.skin = int(head.skin_vertex_count)
+        tris = np.asarray(head.triangles)
+        tris = tris[(tris < self.skin).all(axis=1)]
+        cross = np.cross(rest[tris[:, 1]] - rest[tris[:, 0]], rest[tris[:, 2]] - rest[tris[:, 0]])
+        area2 = np.linalg.norm(cross, axis=1)
+        sound = area2 > DEGENERATE_AREA2
+        self.triangles = tris[sound]
+        self.rest_area2 = area2[sound]
+        self.rest_normal = cross[sound] / area2[sound, None]
+        self.rest = rest[: self.skin]
+        edges = np.concatenate([self.triangles[:, [0, 1]], self.triangles[:, [1, 2]], self.triangles[:, [2, 0]]])
+        n = self.skin
+        adj = sp.coo_matrix((np.ones(2 * len(edges)), (np.r_[edges[:, 0], edges[:, 1]], np.r_[edges[:, 1], edges[:, 0]])),
+                            shape=(n, n)).tocsr()
+        adj.data[:] = 1.0  # duplicate edges (shared by two triangles) count once
+        self.adjacency = adj
+        self.patch, self.patch_weight = _patches(self.triangles, adj)
+        self.eyes = []
+        for centre in eye_centres:
+            centre = np.asarray(centre, float)
+            dist = np.linalg.norm(self.rest - centre, axis=1)
+            outside = np.flatnonzero(dist >= eye_radius)
+            floor = np.minimum(dist[outside], eye_radius + LID_HEIGHT)
+            self.eyes.append((centre, outside, floor))
+
+    def __call__(self, positions: np.ndarray) -> np.ndarray:
+        """A copy of ``positions`` (N_geo, 3) with the skin kept physical."""
+        out = np.array(positions, dtype=np.float32, copy=True)
+        skin = out[: self.skin].astype(float)
+        for _ in range(ROUNDS):
+            moved = self.off_eyes(skin)
+            folded = self.untangle(skin)
+            if not moved and not folded:
+                break
+        out[: self.skin] = skin
+        return out
+
+    # -- the two steps (in place on skin positions (N_skin, 3), float64)
+
+    def off_eyes(self, skin: np.ndarray) -> int:
+        """Move skin out of the eyeballs; returns how many points moved."""
+        count = 0
+        for centre, outside, floor in self.eyes:
+            offset = skin[outside] - centre
+            dist = np.linalg.norm(offset, axis=1)
+            inside = dist < floor - 1e-9
+            if inside.any():
+                ids = outside[inside]
+                skin[ids] = centre + offset[inside] * (floor[inside] / np.maximum(dist[inside], 1e-12))[:, None]
+                count += int(inside.sum())
+        return count
+
+    def folded(self, skin: np.ndarray) -> np.ndarray:
+        """Indices of skin triangles below :data:`MIN_AREA_SHARE` of their rest area along the rest normal."""
+        t = self.triangles
+        cross = np.cross(skin[t[:, 1]] - skin[t[:, 0]], skin[t[:, 2]] - skin[t[:, 0]])
+        share = (cross * self.rest_normal).sum(axis=1) / self.rest_area2
+        return np.flatnonzero(share < MIN_AREA_SHARE)
+
+    def untangle(self, skin: np.ndarray) -> int:
+        """Unfold folded triangles (in place); returns how many were folded at first.
+
+        The corners of each folded triangle are drawn toward their rest shape,
+        turned and moved as the ring of skin around them now lies (the best
+        rigid fit of the rest patch, Kabsch): a rigid copy of the rest surface
+        is not folded, and the fit keeps what the patch does as a whole (a
+        closing lid still closes). Only the corners move, and none further
+        than :data:`MAX_CORRECTION` in all.
+        """
+        bad = self.folded(skin)
+        first = len(bad)
+        start = skin.copy()
+        for _ in range(UNTANGLE_ROUNDS):
+            if not len(bad):
+                break
+            patch, weight = self.patch[bad], self.patch_weight[bad]           # (B, P)
+            fit = _rigid_fits(self.rest[patch], skin[patch], weight)           # (B, P, 3)
+            corners = self.triangles[bad]                                      # (B, 3)
+            total = np.zeros_like(skin)
+            count = np.zeros(self.skin)
+            np.add.at(total, corners.ravel(), fit[:, :3].reshape(-1, 3))
+            np.add.at(count, corners.ravel(), 1.0)
+            moved = count > 0
+            skin[moved] += 0.5 * (total[moved] / count[moved, None] - skin[moved])
+            # A fold that needs more than MAX_CORRECTION to undo is the target's own shape (a lid
+            # margin rolling under as the eye closes): leave it rather than reshape the lid.
+            shift = skin - start
+            length = np.linalg.norm(shift, axis=1)
+            far = length > MAX_CORRECTION
+            skin[far] = start[far] + shift[far] * (MAX_CORRECTION / length[far])[:, None]
+            self.off_eyes(skin)
+            bad = self.folded(skin)
+        return first
+
+
+def _patches(triangles: np.ndarray, adjacency) -> tuple[np.ndarray, np.ndarray]:
+    """Per triangle: its corners first, then their neighbours, padded (T, P); and 1/0 weights."""
+    indptr, indices = adjacency.indptr, adjacency.indices
+    rows = []
+    for tri in triangles:
+        ring = np.concatenate([indices[indptr[v]:indptr[v + 1]] for v in tri])
+        rows.append(np.r_[tri, np.setdiff1d(ring, tri)])
+    width = max(len(r) for r in rows)
+    patch = np.zeros((len(rows), width), np.int64)
+    weight = np.zeros((len(rows), width))
+    for k, r in enumerate(rows):
+        patch[k, :len(r)] = r
+        patch[k, len(r):] = r[0]
+        weight[k, :len(r)] = 1.0
+    return patch, weight
+
+
+def _rigid_fits(rest: np.ndarray, now: np.ndarray, weight: np.ndarray) -> np.ndarray:
+    """Each patch's rest points (B, P, 3) turned and moved to fit ``now`` best (weighted; proper
+    rotations, no mirroring)."""
+    w = weight[..., None] / weight.sum(axis=1)[:, None, None]
+    a = (w * rest).sum(axis=1, keepdims=True)
+    b = (w * now).sum(axis=1, keepdims=True)
+    cov = np.einsum("bpi,bpj->bij", w * (rest - a), now - b)
+    u, _, vt = np.linalg.svd(cov)
+    d = np.sign(np.linalg.det(u @ vt))
+    u[:, :, 2] *= d[:, None]
+    return np.einsum("bpi,bij->bpj", rest - a, u @ vt) + b
