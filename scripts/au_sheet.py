@@ -61,7 +61,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     exprs, labels = list(args.expressions), list(args.expressions)
     if args.emotions:
-        from facsim.emotions import emotion_names
+        from facsim.facs.emotions import emotion_names
 
         names = [n for n in emotion_names() if n != "neutral"]
         exprs += [facsim.emotion(n) for n in names]

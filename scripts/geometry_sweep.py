@@ -31,7 +31,7 @@ from facsim.engines.checks import GeometryCheck
 
 def expressions(codes) -> list[tuple[str, facsim.Activations]]:
     """(label, activations) for singles and pairs at E plus every emotion preset of every table."""
-    from facsim.emotions import emotion, emotion_names, preset_tables
+    from facsim.facs.emotions import emotion, emotion_names, preset_tables
 
     def unit(code):  # 46 (wink) is one-sided by definition; score it on the left
         return f"L{code}E" if code == 46 else f"{code}E"
@@ -48,14 +48,9 @@ def expressions(codes) -> list[tuple[str, facsim.Activations]]:
 
 
 def simulated_codes(engine_name: str) -> list[int]:
-    import importlib
+    from facsim.engines import simulated_codes as codes
 
-    name = {"registers": "registers", "muscle": "muscle"}[engine_name]
-    try:
-        module = importlib.import_module(f"facsim.engines.{name}")
-    except ImportError:  # before the package layout of issue 11
-        module = importlib.import_module(f"facsim.{name}")
-    return sorted(module.simulated_codes())
+    return sorted(codes(engine_name))
 
 
 def sweep(engine_name: str, character: str, *, batch: int = 16, verbose: bool = False) -> dict:

@@ -1,8 +1,8 @@
 """Is a deformed face still physical? Checks over every skin vertex, for any engine.
 
 Two things a real face never does: skin turned inside out (a triangle whose
-normal now points against its rest normal: the surface folded through
-itself), and skin inside an eyeball (a point outside the eyeball at rest that
+normal now points against its rest normal, turned with the head: the
+surface folded through itself), and skin inside an eyeball (a point outside the eyeball at rest that
 an expression moved into it: the eye would show through the lid). Both are
 checked on every skin vertex and triangle, not only on an engine's contact
 points, so they catch what a solver's constraints miss.
@@ -22,6 +22,8 @@ import numpy as np
 
 #: Rest triangles smaller than this (twice the area, dm²) have no reliable orientation.
 DEGENERATE_AREA2 = 1e-10
+#: Skin this far (dm) above the eyes' centres is scalp, moved only by the head (51–58).
+SCALP_ABOVE_EYES = 0.9
 #: Depth (dm) below the eyeball surface that counts as inside: 0.01 mm, well under rounding of a render.
 EYE_TOLERANCE = 1e-4
 
@@ -45,9 +47,8 @@ class GeometryCheck:
     """Checks positions (N_geo, 3) of a head against its neutral ``rest`` positions.
 
     The eyeballs are found in the checked positions themselves (the centre of
-    each generated eyeball's vertices), so rigid head motion and eye rotations
-    need no special case. Triangle orientation is compared with the rest normal,
-    which rigid head turns (at most ~45°) never reverse.
+    each generated eyeball's vertices), and the head's rotation from the scalp,
+    so rigid head motion and eye rotations need no special case.
     """
 
     def __init__(self, head, rest: np.ndarray):
@@ -60,6 +61,10 @@ class GeometryCheck:
         self.rest_normal = _normals(rest, self.triangles)
         self.skin = skin
         self.eyes = [np.asarray(head.eye_vertices[s]) for s in ("left", "right")]
+        # The scalp well above the eyes: no AU moves it, so it shows the head's own rotation.
+        top = max(rest[ids].mean(axis=0)[1] for ids in self.eyes) + SCALP_ABOVE_EYES
+        self.scalp = np.flatnonzero(rest[:skin, 1] > top)
+        self.rest = rest
         self.radius = []
         self.outside = []
         for ids in self.eyes:
@@ -70,7 +75,8 @@ class GeometryCheck:
 
     def __call__(self, positions: np.ndarray) -> GeometryReport:
         p = np.asarray(positions, float)
-        flipped = np.flatnonzero((_normals(p, self.triangles) * self.rest_normal).sum(1) <= 0)
+        turn = head_rotation(self.rest[self.scalp], p[self.scalp])
+        flipped = np.flatnonzero((_normals(p, self.triangles) * (self.rest_normal @ turn.T)).sum(1) <= 0)
         inside, depth = [], 0.0
         for ids, radius, outside in zip(self.eyes, self.radius, self.outside):
             centre = p[ids].mean(axis=0)
@@ -81,6 +87,14 @@ class GeometryCheck:
                 depth = max(depth, float(-gap[bad].min()))
         inside = np.concatenate(inside)
         return GeometryReport(len(flipped), len(inside), depth, flipped, inside)
+
+
+def head_rotation(rest: np.ndarray, now: np.ndarray) -> np.ndarray:
+    """The rotation (3, 3) that best turns points ``rest`` (K, 3) onto ``now`` (Kabsch; no mirroring)."""
+    a, b = rest - rest.mean(axis=0), now - now.mean(axis=0)
+    u, _, vt = np.linalg.svd(a.T @ b)
+    d = np.sign(np.linalg.det(u @ vt))
+    return (u @ np.diag([1.0, 1.0, d]) @ vt).T
 
 
 def _normals(p: np.ndarray, tris: np.ndarray) -> np.ndarray:

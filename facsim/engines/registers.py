@@ -16,13 +16,14 @@ Examples
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cached_property, lru_cache
 from typing import Iterable
 
 import numpy as np
 
 from facsim._data import load_yaml
 from facsim.engines.base import Deformation
+from facsim.engines.guard import SkinGuard
 from facsim.engines.rigid import RigidMotion, rigid_codes, rigid_table
 from facsim.facs.activations import Activations
 from facsim.head.surface import smoothstep
@@ -93,9 +94,37 @@ def register_weights(act: Activations) -> dict[Column, float]:
     for (code, side), level in act:
         if table.get(code, {}).get("direction") and side == "right" and act[code, "left"] == level:
             continue  # a direction code given without a side (e.g. 30) moves to the left only
+        scale = combination_scales(act, code, side)
         for reg in table.get(code, {}).get("registers", []):
-            contributions.setdefault(Column(reg["target"], side), []).append((level, float(reg["max"])))
+            vmax = float(reg["max"]) * scale.get(reg["target"], 1.0)
+            contributions.setdefault(Column(reg["target"], side), []).append((level, vmax))
     return {col: combine_registers(pairs) for col, pairs in contributions.items()}
+
+
+def combination_scales(act: Activations, code: int, side: str) -> dict[str, float]:
+    """Target → factor on AU ``code``'s maxima on ``side`` from the table's ``combinations``.
+
+    A rule applies when every AU it names acts on that side; its factor then
+    scales by the weaker of them (at half intensity, half the change), so the
+    face moves smoothly as an AU fades in.
+
+    >>> combination_scales(Activations({(1, "left"): 1.0, (4, "left"): 1.0}), 4, "left")["faceunits/browDown{Side}"]
+    0.35
+    >>> combination_scales(Activations({(4, "left"): 1.0}), 4, "left")
+    {}
+    """
+    out: dict[str, float] = {}
+    for rule in register_table().get("combinations") or []:
+        scale = rule["scale"]
+        if scale["au"] != code:
+            continue
+        weakest = min(act[c, side] for c in rule["when"])
+        if weakest <= 0.0:
+            continue
+        factor = 1.0 - weakest * (1.0 - float(scale["by"]))
+        for target in scale["targets"]:
+            out[target] = out.get(target, 1.0) * factor
+    return out
 
 
 class RegisterEngine:
@@ -154,8 +183,14 @@ class RegisterEngine:
         morphed[self.head.base_index] = base
         positions = self.head.positions(morphed, neutral_base=self.base_positions,
                                         eye_rotations=self.rigid.eye_rotations(act))
-        self.head.keep_skin_off_eyes(positions, self.neutral, self.base_positions)
+        positions = self.guard(positions)
         return Deformation(self.rigid.move_head(positions, act))
+
+    @cached_property
+    def guard(self) -> SkinGuard:
+        """The physical last step: skin off the eyeballs, no skin turned inside out."""
+        centres = [self.head.eye_pivot(self.base_positions, side)[0] for side in ("left", "right")]
+        return SkinGuard(self.head, self.neutral, centres, self.head.eye_pivot(self.base_positions, "left")[1])
 
     def reset(self) -> None:
         """Nothing to do: the register engine keeps no state between frames."""

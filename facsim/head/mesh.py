@@ -131,8 +131,6 @@ NECK_JOINT = "joint-neck"
 #: hm08's lash strips are long opaque cards; drawn at this fraction of their
 #: length (toward their roots on the lid) they read as lashes, not eyeliner.
 LASH_LENGTH = 0.45
-#: Least distance (dm) kept between moved skin and the eyeball surface.
-EYE_CLEARANCE = 0.004
 
 
 @dataclass(frozen=True, eq=False)  # identity-hashed: caches key on the model
@@ -223,23 +221,6 @@ class HeadModel:
         out[self.lashes] = roots + LASH_LENGTH * (out[self.lashes] - roots)
         out[self.cap_vertex] = out[self.neck_loop].mean(axis=0)
         return out
-
-    def keep_skin_off_eyes(self, positions: np.ndarray, neutral: np.ndarray, neutral_base: np.ndarray) -> None:
-        """Push skin that an expression moved into an eyeball back onto its surface (in place).
-
-        Summed targets can draw the lids or the skin below them inward through the
-        eyeball, which then shows through the skin. Skin outside the eye at neutral
-        is kept at least ``EYE_CLEARANCE`` off it (or as far as it was, if closer).
-        """
-        skin = slice(0, self.skin_vertex_count)
-        for side in EYE_SIDES:
-            centre, radius = self.eye_pivot(neutral_base, side)
-            rest = np.linalg.norm(neutral[skin] - centre, axis=1)
-            offset = positions[skin] - centre
-            distance = np.linalg.norm(offset, axis=1)
-            floor = np.minimum(rest, radius + EYE_CLEARANCE)
-            inside = (distance < floor) & (rest >= radius)
-            positions[skin][inside] = centre + offset[inside] * (floor[inside] / distance[inside])[:, None]
 
     def joint(self, base_positions: np.ndarray, name: str) -> np.ndarray:
         """Centre of MakeHuman joint cube ``name`` (e.g. "joint-mouth") after morphing."""

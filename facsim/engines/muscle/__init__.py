@@ -23,6 +23,7 @@ from scipy.spatial import cKDTree
 
 from facsim.engines.base import Deformation
 from facsim.engines.rigid import RigidMotion
+from facsim.engines.guard import SkinGuard
 from facsim.facs.activations import Activations
 from facsim.engines.muscle import solver
 from facsim.engines.muscle.muscles import au_table, build_muscles, build_tongue, drive, jaw_pose, pressure_patches
@@ -132,6 +133,8 @@ class MuscleEngine:
         self.parts = _Parts(head, data, neutral, self.model.net)
         self.rigid = RigidMotion(head, base_positions)
         self.state = solver.rest_state(self.model)
+        # The solver keeps its contact points off the eyes; this last step checks every skin point.
+        self.guard = SkinGuard(head, self.neutral, list(self.model.net.eye_centre), self.model.net.eye_radius)
 
     # -- the Engine protocol
     def deform(self, act: Activations) -> Deformation:
@@ -210,8 +213,9 @@ class MuscleEngine:
         rot, shift = jaw_transform(state.jaw[index:index + 1], net.hinge, model.jaw_spec["yaw_per_lateral"])
         control = state.drive.tongue[index:index + 1]
         r, t = solver.tongue_frame(model.tongue, control, rot, shift, net.hinge)
-        out = self.parts.place(state.points(index)[: net.count], rot[0], shift[0], net.hinge, (r[0], t[0]),
-                               model.tongue, self.rigid.eye_rotations(act))
+        skin = self.guard(state.points(index)[: net.count])
+        out = self.parts.place(skin, rot[0], shift[0], net.hinge, (r[0], t[0]), model.tongue,
+                               self.rigid.eye_rotations(act))
         return self.rigid.move_head(out.astype(np.float32), act).astype(np.float32)
 
 

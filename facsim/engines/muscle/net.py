@@ -607,11 +607,18 @@ def build_net(head, base_positions, *, anat: Anatomy | None = None, spec: dict |
     contact_k = constants["contact"] * area / np.maximum(depth, 1e-3)
     contact_k[~has_bone] = 0.0
 
-    # Lids and the sac rest on the eyeballs: they keep their rest gap or the clearance.
+    # Lids and the sac rest on the eyeballs: they keep their rest gap or the clearance. So does
+    # every other skin point near an eye that lies outside it at rest: the cheek that the orbital
+    # ring (AU 6) pushes up under the lower lid would otherwise pass into the eyeball.
     eye_centre = np.stack([np.asarray(head.eye_pivot(base_positions, s)[0], float) for s in SIDES])
     eye_radius = float(head.eye_pivot(base_positions, "left")[1])
-    eye_ids = np.flatnonzero(anat.eye_side >= 0)
-    eye_index = anat.eye_side[eye_ids].astype(np.int64)
+    side = anat.eye_side.astype(np.int64)
+    dist = np.linalg.norm(rest[:, None, :] - eye_centre[None], axis=2)       # (N, 2)
+    nearest = np.argmin(dist, axis=1)
+    near = (dist.min(axis=1) < constants["eye_contact_reach"] * eye_radius) & (dist.min(axis=1) >= eye_radius)
+    near &= anat.kind != MOUTH
+    eye_ids = np.flatnonzero((side >= 0) | near)
+    eye_index = np.where(side[eye_ids] >= 0, side[eye_ids], nearest[eye_ids])
     gap = np.linalg.norm(rest[eye_ids] - eye_centre[eye_index], axis=1)
     eye_floor = np.minimum(gap, eye_radius + constants["lid_clearance"] * scale)
 

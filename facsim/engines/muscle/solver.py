@@ -268,7 +268,9 @@ def build_model(net: TensionNet, layer: MuscleLayer, spec: dict, tongue: TongueM
     lid_muscle = np.flatnonzero(eye_of[parent] >= 0)
     eye_ids = np.r_[net.eye_ids, ns + lid_muscle]
     eye_index = np.r_[net.eye_index, eye_of[parent[lid_muscle]]]
-    eye_floor = np.r_[net.eye_floor, floor_of[parent[lid_muscle]]]
+    # (A muscle point under the skin may lie deeper than its skin point: never above its rest.)
+    muscle_gap = np.linalg.norm(layer.node_rest[lid_muscle] - net.eye_centre[eye_of[parent[lid_muscle]]], axis=1)
+    eye_floor = np.r_[net.eye_floor, np.minimum(floor_of[parent[lid_muscle]], muscle_gap)]
 
     def ends(ref):
         return np.where(ref >= 0, ref, -1), np.where(ref < 0, -1 - ref, -1)
