@@ -58,7 +58,7 @@ def sweep(engine_name: str, character: str, *, batch: int = 16, verbose: bool = 
     engine = face.engine
     check = GeometryCheck(face.head, engine.neutral)
     exprs = expressions(simulated_codes(engine_name))
-    flipped, inside, depth, worst = 0, 0, 0.0, []
+    flipped, unturned, inside, depth, worst = 0, 0, 0, 0.0, []
     start = time.perf_counter()
     for first in range(0, len(exprs), batch):
         part = exprs[first:first + batch]
@@ -69,6 +69,7 @@ def sweep(engine_name: str, character: str, *, batch: int = 16, verbose: bool = 
         for (label, _), p in zip(part, positions):
             report = check(p)
             flipped += report.flipped > 0
+            unturned += report.flipped_unturned > 0
             inside += report.inside > 0
             depth = max(depth, report.depth)
             if report.flipped or report.inside:
@@ -76,7 +77,7 @@ def sweep(engine_name: str, character: str, *, batch: int = 16, verbose: bool = 
         if verbose:
             print(f"  {engine_name}: {first + len(part)}/{len(exprs)}", file=sys.stderr, flush=True)
     return {"engine": engine_name, "character": character, "expressions": len(exprs),
-            "flipped": int(flipped), "inside": int(inside), "depth_mm": 100.0 * depth,
+            "flipped": int(flipped), "flipped_unturned": int(unturned), "inside": int(inside), "depth_mm": 100.0 * depth,
             "seconds": time.perf_counter() - start, "worst": sorted(worst, key=lambda w: w[0], reverse=True)}
 
 
@@ -91,7 +92,7 @@ def main(argv=None) -> int:
     for name in engines:
         r = sweep(name, args.character, verbose=args.verbose)
         print(f"{r['engine']:9s} {r['character']}: {r['expressions']} expressions; "
-              f"{r['flipped']} invert a skin triangle; {r['inside']} put skin inside an eyeball "
+              f"{r['flipped']} invert a skin triangle ({r['flipped_unturned']} against unturned rest normals); {r['inside']} put skin inside an eyeball "
               f"(deepest {r['depth_mm']:.3f} mm); {r['seconds']:.0f} s")
         for _, label, rep in r["worst"][: args.list]:
             print(f"    {label}: {rep.flipped} triangles inverted, {rep.inside} skin points inside an eyeball "

@@ -32,7 +32,8 @@ EYE_TOLERANCE = 1e-4
 class GeometryReport:
     """What :class:`GeometryCheck` found in one set of positions."""
 
-    flipped: int            # skin triangles turned inside out
+    flipped: int            # skin triangles turned inside out (against the rest normal turned with the head)
+    flipped_unturned: int   # ... against the rest normal itself (the same, except under head motion 51-58)
     inside: int             # skin vertices inside an eyeball
     depth: float            # how deep the deepest of them is (dm; 0 if none)
     flipped_triangles: np.ndarray  # indices into GeometryCheck.triangles
@@ -76,7 +77,9 @@ class GeometryCheck:
     def __call__(self, positions: np.ndarray) -> GeometryReport:
         p = np.asarray(positions, float)
         turn = head_rotation(self.rest[self.scalp], p[self.scalp])
-        flipped = np.flatnonzero((_normals(p, self.triangles) * (self.rest_normal @ turn.T)).sum(1) <= 0)
+        normal = _normals(p, self.triangles)
+        flipped = np.flatnonzero((normal * (self.rest_normal @ turn.T)).sum(1) <= 0)
+        unturned = int(((normal * self.rest_normal).sum(1) <= 0).sum())
         inside, depth = [], 0.0
         for ids, radius, outside in zip(self.eyes, self.radius, self.outside):
             centre = p[ids].mean(axis=0)
@@ -86,7 +89,7 @@ class GeometryCheck:
             if bad.any():
                 depth = max(depth, float(-gap[bad].min()))
         inside = np.concatenate(inside)
-        return GeometryReport(len(flipped), len(inside), depth, flipped, inside)
+        return GeometryReport(len(flipped), unturned, len(inside), depth, flipped, inside)
 
 
 def head_rotation(rest: np.ndarray, now: np.ndarray) -> np.ndarray:

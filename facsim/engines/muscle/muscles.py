@@ -412,8 +412,10 @@ def drive(layer: MuscleLayer, activations_list) -> Drive:
             entry = table.get(code)
             if not entry:
                 continue
+            scale = _combination_scales(act, code, side)
             for name, value in (entry.get("muscles") or {}).items():
                 magnitude, target = _muscle_entry(value, side)
+                magnitude *= scale.get(name, 1.0)
                 k = layer.index(name, target)
                 share = 0.5 if layer.side[k] == "both" else 1.0  # midline muscles: mean of the sides
                 muscle[bi, k] += share * magnitude * level
@@ -428,6 +430,24 @@ def drive(layer: MuscleLayer, activations_list) -> Drive:
             tongue[bi, 2] = max(tongue[bi, 2], tongue_spec.get("lift", 0.0) * level)
     return Drive(np.clip(muscle, -1, 1), np.clip(pressure, -1, 1), np.clip(lip_pressure, -1, 1),
                  np.clip(tongue, -1, 1))
+
+
+def _combination_scales(act, code: int, side: str) -> dict[str, float]:
+    """Muscle → factor on AU ``code``'s magnitudes on ``side`` (``combinations`` in muscle_aus.yaml).
+
+    A rule applies when every AU it names acts on that side, in proportion to the weakest.
+    """
+    out: dict[str, float] = {}
+    for rule in au_table().get("combinations") or []:
+        scale = rule["scale"]
+        if scale["au"] != code:
+            continue
+        weakest = min(act[c, side] for c in rule["when"])
+        if weakest > 0.0:
+            factor = 1.0 - weakest * (1.0 - float(scale["by"]))
+            for name in scale["muscles"]:
+                out[name] = out.get(name, 1.0) * factor
+    return out
 
 
 def _muscle_entry(value, side: str) -> tuple[float, str]:
