@@ -75,7 +75,8 @@ def sweep(engine_name: str, character: str, *, batch: int = 16, verbose: bool = 
             if report.flipped or report.inside:
                 worst.append((report.flipped + 100 * report.inside, label, report))
         if verbose:
-            print(f"  {engine_name}: {first + len(part)}/{len(exprs)}", file=sys.stderr, flush=True)
+            print(f"  {engine_name}: {first + len(part)}/{len(exprs)} done; so far {flipped} invert, "
+                  f"{inside} inside an eyeball", file=sys.stderr, flush=True)
     return {"engine": engine_name, "character": character, "expressions": len(exprs),
             "flipped": int(flipped), "flipped_unturned": int(unturned), "inside": int(inside), "depth_mm": 100.0 * depth,
             "seconds": time.perf_counter() - start, "worst": sorted(worst, key=lambda w: w[0], reverse=True)}

@@ -1,7 +1,9 @@
 """Every pair of simulated AUs at intensity E solves to a valid face.
 
 Valid: finite, no skin triangle turned inside out, no flesh inside the skull
-(the model's own bone surface), no lid through an eyeball. Solving 1,500 pairs
+(the model's own bone surface), no lid through an eyeball — checked on the
+solver's contact points and again on EVERY skin vertex and triangle of the
+final face (:class:`facsim.engines.checks.GeometryCheck`). Solving 1,500 pairs
 one by one would take many minutes, so the pairs are covered by blocks of
 ``BLOCK`` codes performed together: a covering design in which every pair of
 codes appears in at least one block (checked below). A block is a harder test
@@ -74,6 +76,9 @@ def test_every_pair_of_aus_at_e_solves_to_a_valid_face(face_of, head, codes, par
     def normals(p):
         return np.cross(p[skin_tris[:, 1]] - p[skin_tris[:, 0]], p[skin_tris[:, 2]] - p[skin_tris[:, 0]])
 
+    from facsim.engines.checks import GeometryCheck
+
+    check = GeometryCheck(head, engine.neutral)  # every skin vertex and triangle, after the engine's last step
     rest_n = normals(rest)
     sound = np.linalg.norm(rest_n, axis=1) > 1e-10  # degenerate rest triangles have no orientation
     blocks = covering_blocks(codes, BLOCK)[part::PARTS]
@@ -86,6 +91,11 @@ def test_every_pair_of_aus_at_e_solves_to_a_valid_face(face_of, head, codes, par
         if not np.isfinite(p).all():
             problems.append((block, "not finite"))
             continue
+        report = check(p)
+        if report.inside:
+            problems.append((block, f"{report.inside} skin points {report.depth * 100:.2f} mm inside an eyeball"))
+        if report.flipped:
+            problems.append((block, f"{report.flipped} skin triangles of the final face turned inside out"))
         # Compare the skin before the rigid head motion (51-58 turn every normal alike).
         skin = state.points(b)[: head.skin_vertex_count]
         flipped = ((normals(skin) * rest_n).sum(1) <= 0) & sound

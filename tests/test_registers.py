@@ -148,9 +148,11 @@ def test_emotions_differ_from_neutral_where_their_aus_act(face_of):
         assert np.abs(img - neutral).sum(-1).max() > 100, name
 
 
-#: AUs that close the lids: hm08's eyeBlink target rolls the lid corners under themselves, a fold
-#: the skin guard cannot undo within the MAX_CORRECTION it may move skin (the sweep lists them).
-LID_CLOSURE = {43, 45, 46}
+#: AUs whose targets fold skin the guard cannot fully undo within the MAX_CORRECTION it may move
+#: it (scripts/geometry_sweep.py lists them): eyeBlink (43, 45, 46, and 64's lid) rolls the lid
+#: corners under themselves; mouthClose (8) is an ARKit corrective meant only with jawOpen. Their
+#: folds must stay at the lids and lips.
+FOLDING_TARGETS = {8, 43, 45, 46, 64}
 #: The all-pairs sweep is shared out over this many tests, so ``pytest -n`` runs them side by side.
 PAIR_PARTS = 3
 
@@ -173,12 +175,18 @@ def geometry_check(engine, head):
 
 
 @pytest.mark.parametrize("part", range(PAIR_PARTS))
-def test_every_au_and_pair_at_e_stays_physical(engine, head, geometry_check, part):
+def test_every_au_and_pair_at_e_stays_physical(engine, head, marks, geometry_check, part):
     """Every single AU and pair of AUs at E, checked on EVERY skin vertex and triangle: finite,
-    no skin inside an eyeball, no skin triangle turned inside out (outside the closing lids)."""
-    from facsim.engines.muscle.net import LID, anatomy
-
-    lid = anatomy(head).kind == LID
+    no skin inside an eyeball, no skin triangle turned inside out (but the known folds of
+    FOLDING_TARGETS, at the lids and lips)."""
+    centres = [head.eye_pivot(engine.base_positions, side)[0] for side in ("left", "right")]
+    radius = head.eye_pivot(engine.base_positions, "left")[1]
+    lips = engine.neutral[[marks[k] for k in ("upper_lip", "lower_lip", "lip_corner_left", "lip_corner_right")]]
+    rest = engine.neutral[geometry_check.triangles].mean(axis=1)
+    near_eye = np.min([np.linalg.norm(rest - c, axis=1) for c in centres], axis=0) < 2 * radius
+    near_lips = np.min(np.linalg.norm(rest[:, None] - lips[None], axis=2), axis=1) < 0.15
+    # Head translations (57, 58) shear the neck below an open jaw (27); the guard acts before them.
+    under_chin = rest[:, 1] < head.joint(engine.base_positions, "joint-jaw")[1]
     problems = []
     for text in _pairs()[part::PAIR_PARTS]:
         act = activations(parse(text))
@@ -190,22 +198,45 @@ def test_every_au_and_pair_at_e_stays_physical(engine, head, geometry_check, par
         if report.inside:
             problems.append(f"{text}: {report.inside} skin points {report.depth * 100:.2f} mm inside an eyeball")
         if report.flipped:
-            corners = geometry_check.triangles[report.flipped_triangles]
-            if not act.codes & LID_CLOSURE or not lid[corners].any(axis=1).all():
+            where = report.flipped_triangles
+            known = (near_eye | near_lips) if act.codes & FOLDING_TARGETS else np.zeros_like(near_eye)
+            if act.codes & {57, 58}:
+                known = known | under_chin
+            if not known[where].all():
                 problems.append(f"{text}: {report.flipped} skin triangles turned inside out")
     assert not problems, "\n".join(problems)
 
 
-def test_skin_guard_unfolds_a_fold_and_lifts_skin_off_the_eye(engine, head, geometry_check):
+def test_skin_guard_unfolds_a_fold_and_lifts_skin_off_the_eye(engine, head, marks, geometry_check):
     """The guard itself: a lid point pushed into the eyeball and a folded triangle are repaired."""
     p = engine.neutral.copy()
     centre, radius = head.eye_pivot(engine.base_positions, "left")
     lid = np.argmin(np.linalg.norm(p[: head.skin_vertex_count] - (centre + [0, 0, radius]), axis=1))
     p[lid] = centre + 0.5 * (p[lid] - centre)          # halfway to the eye's centre
-    tri = geometry_check.triangles[np.argmax(p[geometry_check.triangles].mean(axis=1)[:, 1])]  # top of the head
-    a, b, c = tri
-    p[a] = p[b] + p[c] - p[a]                           # mirror one corner across the opposite edge
+    centroid = p[geometry_check.triangles].mean(axis=1)
+    a, b, c = geometry_check.triangles[np.argmin(np.linalg.norm(centroid - p[marks["cheek_left"]], axis=1))]
+    edge = (p[c] - p[b]) / np.linalg.norm(p[c] - p[b])
+    foot = p[b] + np.dot(p[a] - p[b], edge) * edge
+    p[a] = p[a] + 1.3 * (foot - p[a])                  # push one corner just across the opposite edge
     before = geometry_check(p)
     assert before.inside >= 1 and before.flipped >= 1
     after = geometry_check(engine.guard(p))
     assert after.ok, after
+
+
+@pytest.mark.parametrize("name", ["sadness", "fear"])
+def test_sad_and_fearful_inner_brows_are_raised(engine, marks, name):
+    """Issue 13: in 1+4 the inner brows rise and are drawn together (a combination rule)."""
+    from facsim.facs.emotions import emotion
+
+    delta = engine(activations(emotion(name))) - engine.neutral
+    assert delta[marks["inner_brow_left"], 1] > 0.03
+    both = _moved(engine, "1+4")[marks["inner_brow_left"]]
+    assert both[1] > 0.03 and both[0] < -0.005
+
+
+def test_pressed_lips_keep_their_corners(engine, marks):
+    """Issue 13: 24 presses the lips together without the smile mouthPress alone gives."""
+    delta = _moved(engine, "24")
+    assert abs(delta[marks["lip_corner_left"], 1]) < 0.015
+    assert delta[marks["upper_lip"], 1] < -0.02 and delta[marks["lower_lip"], 1] > 0.02

@@ -40,8 +40,11 @@ MIN_AREA_SHARE = 0.05
 LID_HEIGHT = 0.03
 #: Rounds of (eye contact, untangling); relaxation passes per round; rings grown per stuck round.
 ROUNDS = 4
-#: Rounds of the untangling step.
-UNTANGLE_ROUNDS = 24
+#: Rounds of the untangling step; the patch fitted around a folded triangle widens by a ring
+#: every WIDEN_EVERY rounds it stays folded, up to MAX_RINGS.
+UNTANGLE_ROUNDS = 32
+WIDEN_EVERY = 8
+MAX_RINGS = 4
 #: Furthest (dm) the untangling moves any vertex: 1.5 mm.
 MAX_CORRECTION = 0.03
 #: Rest triangles smaller than this (twice the area, dm²) have no reliable orientation.
@@ -80,7 +83,8 @@ class SkinGuard:
                             shape=(n, n)).tocsr()
         adj.data[:] = 1.0  # duplicate edges (shared by two triangles) count once
         self.adjacency = adj
-        self.patch, self.patch_weight = _patches(self.triangles, adj)
+        self._adjacency = adj
+        self._patch_cache = {}
         self.eyes = []
         for centre in eye_centres:
             centre = np.asarray(centre, float)
@@ -123,6 +127,21 @@ class SkinGuard:
         share = (cross * self.rest_normal).sum(axis=1) / self.rest_area2
         return np.flatnonzero(share < MIN_AREA_SHARE)
 
+    def _patches(self, bad: np.ndarray, rings: int) -> tuple[np.ndarray, np.ndarray]:
+        """Patches of ``rings`` rings around triangles ``bad`` (built on first use, then kept)."""
+        rings = min(rings, MAX_RINGS)
+        missing = [t for t in bad if (t, rings) not in self._patch_cache]
+        if missing:
+            patch, weight = _patches(self.triangles[missing], self._adjacency, rings)
+            for k, t in enumerate(missing):
+                n = int(weight[k].sum())
+                self._patch_cache[t, rings] = patch[k, :n]
+        rows = [self._patch_cache[t, rings] for t in bad]
+        width = max(len(r) for r in rows)
+        patch = np.array([np.r_[r, np.full(width - len(r), r[0])] for r in rows])
+        weight = (np.arange(width)[None, :] < np.array([len(r) for r in rows])[:, None]).astype(float)
+        return patch, weight
+
     def untangle(self, skin: np.ndarray) -> int:
         """Unfold folded triangles (in place); returns how many were folded at first.
 
@@ -136,10 +155,10 @@ class SkinGuard:
         bad = self.folded(skin)
         first = len(bad)
         start = skin.copy()
-        for _ in range(UNTANGLE_ROUNDS):
+        for it in range(UNTANGLE_ROUNDS):
             if not len(bad):
                 break
-            patch, weight = self.patch[bad], self.patch_weight[bad]           # (B, P)
+            patch, weight = self._patches(bad, 1 + it // WIDEN_EVERY)           # (B, P)
             fit = _rigid_fits(self.rest[patch], skin[patch], weight)           # (B, P, 3)
             corners = self.triangles[bad]                                      # (B, 3)
             total = np.zeros_like(skin)
@@ -159,12 +178,14 @@ class SkinGuard:
         return first
 
 
-def _patches(triangles: np.ndarray, adjacency) -> tuple[np.ndarray, np.ndarray]:
-    """Per triangle: its corners first, then their neighbours, padded (T, P); and 1/0 weights."""
+def _patches(triangles: np.ndarray, adjacency, rings: int) -> tuple[np.ndarray, np.ndarray]:
+    """Per triangle: its corners first, then ``rings`` rings of neighbours, padded (T, P); and 1/0 weights."""
     indptr, indices = adjacency.indptr, adjacency.indices
     rows = []
     for tri in triangles:
-        ring = np.concatenate([indices[indptr[v]:indptr[v + 1]] for v in tri])
+        ring = np.asarray(tri)
+        for _ in range(rings):
+            ring = np.union1d(ring, np.concatenate([indices[indptr[v]:indptr[v + 1]] for v in ring]))
         rows.append(np.r_[tri, np.setdiff1d(ring, tri)])
     width = max(len(r) for r in rows)
     patch = np.zeros((len(rows), width), np.int64)

@@ -109,7 +109,7 @@ def combination_scales(act: Activations, code: int, side: str) -> dict[str, floa
     face moves smoothly as an AU fades in.
 
     >>> combination_scales(Activations({(1, "left"): 1.0, (4, "left"): 1.0}), 4, "left")["faceunits/browDown{Side}"]
-    0.35
+    0.2
     >>> combination_scales(Activations({(4, "left"): 1.0}), 4, "left")
     {}
     """
