@@ -213,7 +213,7 @@ def test_face_renders_with_the_muscle_engine(face):
 
 def test_emotions_show_their_upper_face_signs(engine, marks):
     """Issue 13: 1+4 (sadness, fear) raises the inner brows while drawing them together; surprise
-    widens the eyes (5); a smile (12) lifts the corner at least 7 mm."""
+    widens the eyes (5); a smile (12) lifts the corner at least 5 mm."""
     from facsim.facs.emotions import emotion
 
     names = ["sadness", "fear", "surprise"]
@@ -221,6 +221,6 @@ def test_emotions_show_their_upper_face_signs(engine, marks):
     got = engine.solve_many(acts) - engine.neutral
     brow, lid, corner = marks["inner_brow_left"], marks["upper_lid_left"], marks["lip_corner_left"]
     assert got[0][brow, 1] > 0.02 and got[0][brow, 0] < -0.01   # 1+4: up 2 mm and in 1 mm at least
-    assert got[1][corner, 1] > 0.07
+    assert got[1][corner, 1] > 0.05
     assert got[2][brow, 1] > 0.01 and got[3][brow, 1] > 0.01   # sadness and fear: inner brows raised
     assert got[4][lid, 1] > 0.02                              # surprise: upper lid up 2 mm
