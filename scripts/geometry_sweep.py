@@ -62,10 +62,10 @@ def sweep(engine_name: str, character: str, *, batch: int = 16, verbose: bool = 
     start = time.perf_counter()
     for first in range(0, len(exprs), batch):
         part = exprs[first:first + batch]
-        if hasattr(engine, "solve_many"):
-            positions = engine.solve_many([a for _, a in part])
+        if hasattr(engine, "deform_many"):  # the muscle engine solves a batch at once
+            positions = [d.positions for d in engine.deform_many([a for _, a in part])]
         else:
-            positions = [engine(a) for _, a in part]
+            positions = [engine.deform(a).positions for _, a in part]
         for (label, _), p in zip(part, positions):
             report = check(p)
             flipped += report.flipped > 0
