@@ -41,11 +41,22 @@ def test_blinks_are_plotted(tmp_path):
     assert "AU45 Blink" in out.read_text()
 
 
-def test_overwrites_existing_file(tmp_path):
+def test_replaces_an_earlier_plot_but_not_a_file_of_another_kind(tmp_path):
+    from facsim.atomic import OutputError, overwriting
+
     path = tmp_path / "p.png"
-    path.write_bytes(b"old")
     plot_timeline(stimulus_timeline("12"), path)
-    assert path.read_bytes().startswith(b"\x89PNG")
+    first = path.read_bytes()
+    plot_timeline(stimulus_timeline("1+2"), path)          # a PNG replaces a PNG
+    assert path.read_bytes().startswith(b"\x89PNG") and path.read_bytes() != first
+    other = tmp_path / "q.png"
+    other.write_bytes(b"not a picture")
+    with pytest.raises(OutputError, match="overwrite"):
+        plot_timeline(stimulus_timeline("12"), other)
+    assert other.read_bytes() == b"not a picture"
+    with overwriting(True):
+        plot_timeline(stimulus_timeline("12"), other)
+    assert other.read_bytes().startswith(b"\x89PNG")
 
 
 def test_unsupported_suffix(tmp_path):
