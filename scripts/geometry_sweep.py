@@ -23,7 +23,6 @@ import itertools
 import sys
 import time
 
-import numpy as np
 
 import facsim
 from facsim.engines.checks import GeometryCheck
