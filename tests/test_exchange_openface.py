@@ -4,6 +4,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from facsim.engines.rigid import rigid_table
+
 from facsim.exchange import ExchangeError, load_any_timeline, read_openface_csv
 from facsim.exchange.openface import intensity_levels
 from facsim.timeline.sampling import activation_curves, frame_count, frame_times
@@ -71,7 +73,8 @@ def test_pose_and_gaze_signs(tmp_path):
     curves = activation_curves(tl, frame_times(tl))
     assert curves[54, "left"][0] == pytest.approx(0.5)          # pitched down in the image: head down
     assert curves[56, "left"][1] == pytest.approx(0.5)          # Rz < 0 (counter-clockwise): toward the right shoulder
-    assert curves[63, "left"][2] == pytest.approx(0.5)          # gaze up
+    up = rigid_table()["eye_rotations"][63]["left"]              # degrees at intensity 1 (negative: about -x)
+    assert curves[63, "left"][2] == pytest.approx(min(1.0, 12.5 / abs(up)))   # gaze up
     assert curves[62, "left"][3] == pytest.approx(0.5)          # gaze to the image's left: their right
 
 

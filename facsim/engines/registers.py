@@ -108,7 +108,7 @@ def combination_scales(act: Activations, code: int, side: str) -> dict[str, floa
     scales by the weaker of them (at half intensity, half the change), so the
     face moves smoothly as an AU fades in.
 
-    >>> combination_scales(Activations({(1, "left"): 1.0, (4, "left"): 1.0}), 4, "left")["faceunits/browDown{Side}"]
+    >>> round(combination_scales(Activations({(1, "left"): 1.0, (4, "left"): 1.0}), 4, "left")["faceunits/browDown{Side}"], 6)
     0.2
     >>> combination_scales(Activations({(4, "left"): 1.0}), 4, "left")
     {}
