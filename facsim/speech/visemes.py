@@ -6,7 +6,7 @@ Examples
 >>> table.viseme_of("b").name, table.viseme_of("b").aus[24]
 ('PP', 0.7)
 >>> sorted(table.viseme_of("uw").aus)
-[18, 26]
+[18, 22, 26]
 """
 from __future__ import annotations
 
