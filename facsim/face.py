@@ -173,22 +173,14 @@ class Face:
         """
         import hashlib
 
-        from facsim.atomic import atomic_write
-        from facsim.head.assets import cache_dir
+        from facsim.head.assets import cache_dir, cached_array
         from facsim.render.occlusion import bake_occlusion
 
         shape = self.character.with_(name="", description="", colors={}, hair="", brows="", lashes="")
         key = hashlib.sha256(repr((OCCLUSION_VERSION, shape))
                              .encode()).hexdigest()[:16]
-        path = cache_dir() / "occlusion" / f"{key}.npy"
-        try:
-            return np.load(path)
-        except (OSError, ValueError):
-            pass
-        occlusion = bake_occlusion(self.head.topology, self.neutral)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        atomic_write(path, lambda tmp: tmp.write_bytes(_npy_bytes(occlusion)))
-        return occlusion
+        return cached_array(cache_dir() / "occlusion" / f"{key}.npy",
+                            lambda: bake_occlusion(self.head.topology, self.neutral))
 
     def activations(self, expression=None) -> Activations:
         """Activations from a FACS string (read with this face's ``intensities``), an Expression or Activations."""
@@ -281,11 +273,3 @@ def _options(options: RenderOptions | None, values: dict) -> RenderOptions:
     if options is None:
         return RenderOptions(**values)
     return options.replace(**values) if values else options
-
-
-def _npy_bytes(array: np.ndarray) -> bytes:
-    import io
-
-    buf = io.BytesIO()
-    np.save(buf, array)
-    return buf.getvalue()

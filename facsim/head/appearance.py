@@ -15,8 +15,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from facsim.head.assets import cache_dir
-from facsim.atomic import atomic_write
+from facsim.head.assets import cache_dir, cached_array
 from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Mapping
@@ -198,21 +197,8 @@ def detail_texture(head) -> np.ndarray:
     """(rows, cols, 4) uint8 skin detail: redness, beard area, oiliness, age lines (see
     :class:`Appearance`), placed by anatomy on the base mesh.
     It depends on the base mesh only, so it is computed once and cached on disk."""
-    path = cache_dir() / f"skin-detail-v{DETAIL_VERSION}.npy"
-    try:
-        detail = np.load(path)
-        if detail.shape == (*DETAIL_SIZE, 4) and detail.dtype == np.uint8:
-            return detail
-    except (OSError, ValueError):
-        pass  # missing or damaged: (re)build below
-    detail = _build_detail(head)
-    path.parent.mkdir(parents=True, exist_ok=True)
-
-    def write(tmp):
-        with open(tmp, "wb") as f:
-            np.save(f, detail)
-    atomic_write(path, write)
-    return detail
+    return cached_array(cache_dir() / f"skin-detail-v{DETAIL_VERSION}.npy", lambda: _build_detail(head),
+                        valid=lambda a: a.shape == (*DETAIL_SIZE, 4) and a.dtype == np.uint8)
 
 
 def _build_detail(head) -> np.ndarray:
@@ -372,12 +358,10 @@ def _resize(image: np.ndarray, size: tuple[int, int]) -> np.ndarray:
 
 def position_map(head) -> np.ndarray:
     """Base-mesh 3-D position at each texel of the paint box (NaN off the mesh); cached on disk."""
-    path = cache_dir() / _POSITION_MAP_FILE
-    if path.exists():
-        try:
-            return np.load(path)
-        except (OSError, ValueError):
-            pass  # rebuild a damaged file below
+    return cached_array(cache_dir() / _POSITION_MAP_FILE, lambda: _build_position_map(head))
+
+
+def _build_position_map(head) -> np.ndarray:
     from scipy.interpolate import LinearNDInterpolator
 
     topo = head.topology
@@ -388,10 +372,4 @@ def position_map(head) -> np.ndarray:
     v, u = np.meshgrid((np.arange(rows) + 0.5) / rows, (np.arange(cols) + 0.5) / cols, indexing="ij")
     result = LinearNDInterpolator(uv, xyz)(np.stack([u.ravel(), v.ravel()], 1)).reshape(rows, cols, 3)
     result = np.nan_to_num(result, nan=-100.0).astype(np.float32)  # far away: no paint
-    path.parent.mkdir(parents=True, exist_ok=True)
-
-    def write(tmp):
-        with open(tmp, "wb") as f:
-            np.save(f, result)
-    atomic_write(path, write)
     return result

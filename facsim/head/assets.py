@@ -26,6 +26,7 @@ import zipfile
 from dataclasses import dataclass
 from functools import cached_property, lru_cache
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
@@ -130,6 +131,29 @@ def load_face_data(*, wheel: str | os.PathLike | None = None, progress: bool = T
 @lru_cache(maxsize=2)
 def _read_cache(path: str, _mtime: int) -> FaceData:
     return FaceData(read_cache_arrays(path, "face data cache", FORMAT_VERSION))
+
+
+def cached_array(path: Path, build: Callable[[], np.ndarray], *,
+                 valid: Callable[[np.ndarray], bool] = lambda array: True) -> np.ndarray:
+    """The array saved at ``path``, or ``build()`` saved there atomically.
+
+    A missing, damaged or (by ``valid``) outdated file is rebuilt; the cache is
+    facsim's own, so it is replaced without asking.
+    """
+    try:
+        array = np.load(path, allow_pickle=False)
+        if valid(array):
+            return array
+    except (OSError, ValueError):
+        pass  # missing or damaged: (re)build below
+    array = build()
+    path.parent.mkdir(parents=True, exist_ok=True)
+
+    def write(tmp):
+        with open(tmp, "wb") as f:
+            np.save(f, array)
+    atomic_write(path, write, overwrite=True)
+    return array
 
 
 def read_cache_arrays(path: str, what: str, version: int) -> dict[str, np.ndarray]:
