@@ -51,6 +51,14 @@ async def json_body(request: Request):
         raise RequestError(f"request body is not valid JSON: {exc}", status=400) from None
 
 
+async def json_object(request: Request, example: str) -> dict:
+    """The request's JSON object (see :func:`json_body`); anything else is a 400 showing ``example``."""
+    body = await json_body(request)
+    if not isinstance(body, dict):
+        raise RequestError(example, status=400)
+    return body
+
+
 def create_app(*, workdir, token: str | None = None, allowed_hosts: set[str] | None = None,
                max_pending: int = 8, max_body: int = MAX_BODY, max_upload: int = checks.MAX_UPLOAD,
                render_timeout: float = 300.0) -> FastAPI:
@@ -191,26 +199,20 @@ def create_app(*, workdir, token: str | None = None, allowed_hosts: set[str] | N
 
     @app.post("/api/parse")
     async def parse(request: Request):
-        body = await json_body(request)
-        if not isinstance(body, dict):
-            raise RequestError("send {\"expression\": \"1+2+5B+26\"}", status=400)
+        body = await json_object(request, "send {\"expression\": \"1+2+5B+26\"}")
         table = checks.intensities_table(body.get("intensities"))
         text = checks.expression_text(body.get("expression"), table)
         return {"expression": text, "units": checks.expression_units(text, table)}
 
     @app.post("/api/expression")
     async def expression(request: Request):
-        body = await json_body(request)
-        if not isinstance(body, dict):
-            raise RequestError("send {\"levels\": {\"12\": {\"left\": 0.55, \"right\": 0.55}}}", status=400)
+        body = await json_object(request, "send {\"levels\": {\"12\": {\"left\": 0.55, \"right\": 0.55}}}")
         table = checks.intensities_table(body.get("intensities"))
         return {"expression": checks.expression_from_levels(body.get("levels", {}), table)}
 
     @app.post("/api/emotion")
     async def emotion(request: Request):
-        body = await json_body(request)
-        if not isinstance(body, dict):
-            raise RequestError("send {\"name\": \"surprise\"}", status=400)
+        body = await json_object(request, "send {\"name\": \"surprise\"}")
         table = checks.intensities_table(body.get("intensities"))
         preset_table = body.get("table", "hapfacs")
         try:
@@ -316,16 +318,12 @@ def create_app(*, workdir, token: str | None = None, allowed_hosts: set[str] | N
 
     @app.post("/api/timeline/load")
     async def timeline_load(request: Request):
-        body = await json_body(request)
-        if not isinstance(body, dict):
-            raise RequestError("send {\"name\": \"clip.yaml\", \"text\": ...}", status=400)
+        body = await json_object(request, "send {\"name\": \"clip.yaml\", \"text\": ...}")
         return {"timeline": checks.timeline_from_text(body.get("name"), body.get("text"))}
 
     @app.post("/api/timeline/save")
     async def timeline_save(request: Request):
-        body = await json_body(request)
-        if not isinstance(body, dict):
-            raise RequestError("send {\"timeline\": {...}, \"format\": \"yaml\"}", status=400)
+        body = await json_object(request, "send {\"timeline\": {...}, \"format\": \"yaml\"}")
         fmt = body.get("format", "yaml")
         text = checks.timeline_text(body.get("timeline"), fmt)
         return Response(text, media_type="application/yaml" if fmt == "yaml" else "application/json",
@@ -334,9 +332,7 @@ def create_app(*, workdir, token: str | None = None, allowed_hosts: set[str] | N
     @app.post("/api/timeline/stimulus")
     async def timeline_stimulus(request: Request):
         """A HapFACS stimulus (1 s onset, 1 s apex, 1 s offset by default) as a timeline document."""
-        body = await json_body(request)
-        if not isinstance(body, dict):
-            raise RequestError("send {\"expression\": \"1+2+5B+26\"} or {\"emotion\": \"surprise\"}", status=400)
+        body = await json_object(request, "send {\"expression\": \"1+2+5B+26\"} or {\"emotion\": \"surprise\"}")
         table = checks.intensities_table(body.get("intensities"))
         name = body.get("emotion") or checks.expression_text(body.get("expression", "neutral"), table)
         timing = [checks.number(body.get(k, 1.0), k, 0.0, 60.0) for k in ("onset", "apex", "offset")]
@@ -352,9 +348,7 @@ def create_app(*, workdir, token: str | None = None, allowed_hosts: set[str] | N
     @app.post("/api/jobs", status_code=202)
     async def start_job(request: Request):
         """Start an export: png, video (mp4/webm/gif), glb, arkit-csv or facs. Returns the job."""
-        body = await json_body(request)
-        if not isinstance(body, dict):
-            raise RequestError("send {\"kind\": \"video\", \"timeline\": {...}, ...}", status=400)
+        body = await json_object(request, "send {\"kind\": \"video\", \"timeline\": {...}, ...}")
         kind = checks.choice(body.get("kind"), ("png", "video", "glb", "arkit-csv", "facs"), "kind")
         if kind == "png":
             spec = render_spec(body)
