@@ -1,11 +1,14 @@
-"""Shuffle the before and after sets together into numbered contact sheets (6 a sheet)."""
+"""Shuffle sets together into numbered contact sheets (6 a sheet).
+
+Usage: ``make_sheets.py ROOT [SET ...]`` (default sets: before after), each a folder of ROOT from render_set.py.
+"""
 import json, random, sys
 from pathlib import Path
 from PIL import Image, ImageDraw, ImageFont
 
 root = Path(sys.argv[1])  # holds before/ and after/ from render_set.py
 items = []
-for phase in ("before", "after"):
+for phase in sys.argv[2:] or ("before", "after"):
     for it in json.loads((root / phase / "key.json").read_text()):
         items.append({**it, "phase": phase, "path": str(root / phase / it["file"])})
 random.Random(2026).shuffle(items)

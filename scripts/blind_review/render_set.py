@@ -1,22 +1,38 @@
-"""Render the blind-review set: 6 presets x 6 basic emotions x {100 %, 50 %} + neutral per preset (78 images)."""
-import json, sys
+"""Render the blind-review set: 6 presets x 6 basic emotions x {100 %, 50 %} + neutral per preset (78 images).
+
+Example: ``python scripts/blind_review/render_set.py /work/blind/after --engine muscle --size 320``
+"""
+import argparse
+import json
 from pathlib import Path
+
 import facsim
 from facsim.facs.emotions import emotion
 
-out = Path(sys.argv[1]); out.mkdir(parents=True, exist_ok=True)
-presets = ["ava", "liam", "amara", "kwame", "mei", "george"]
-emotions = ["happiness", "sadness", "surprise", "anger", "fear", "disgust"]
-items = []
-for c in presets:
-    face = facsim.Face(c)
-    for e in emotions:
-        for level in (1.0, 0.5):
-            name = f"{c}_{e}_{int(level*100)}"
-            face.save(out / f"{name}.png", emotion(e, intensity=level), size=320)
-            items.append({"file": f"{name}.png", "character": c, "emotion": e, "intensity": level})
-    face.save(out / f"{c}_neutral_0.png", None, size=320)
-    items.append({"file": f"{c}_neutral_0.png", "character": c, "emotion": "neutral", "intensity": 0})
-    face.close()
-(out / "key.json").write_text(json.dumps(items, indent=1))
-print(len(items))
+PRESETS = ["ava", "liam", "amara", "kwame", "mei", "george"]
+EMOTIONS = ["happiness", "sadness", "surprise", "anger", "fear", "disgust"]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("out", type=Path)
+    parser.add_argument("--engine", default="registers", choices=["registers", "muscle"])
+    parser.add_argument("--size", type=int, default=320)
+    args = parser.parse_args()
+    args.out.mkdir(parents=True, exist_ok=True)
+    items = []
+    for character in PRESETS:
+        face = facsim.Face(character, engine=args.engine)
+        for name, level in [(e, lv) for e in EMOTIONS for lv in (1.0, 0.5)] + [("neutral", 0)]:
+            file = f"{character}_{name}_{int(level * 100)}.png"
+            expression = None if name == "neutral" else emotion(name, intensity=level)
+            face.save(args.out / file, expression, size=args.size)
+            items.append({"file": file, "character": character, "emotion": name, "intensity": level,
+                          "engine": args.engine})
+        face.close()
+    (args.out / "key.json").write_text(json.dumps(items, indent=1))
+    print(len(items))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,10 +1,14 @@
+"""Score a blind review: recognition, believability and the confusion table per set.
+
+Usage: ``score.py ROOT`` (ROOT holds private_key.json and answers.csv).
+"""
 import csv, json, sys
 from collections import Counter, defaultdict
 root = sys.argv[1]
 key = {k["id"]: k for k in json.load(open(f"{root}/private_key.json"))}
 rows = list(csv.DictReader(open(f"{root}/answers.csv")))
 E = ["happiness", "sadness", "surprise", "anger", "fear", "disgust", "neutral"]
-for phase in ("before", "after"):
+for phase in sorted({k["phase"] for k in key.values()}):
     conf = defaultdict(Counter); bel = []; hits = Counter(); tot = Counter()
     for r in rows:
         k = key[int(r["id"])]
