@@ -74,6 +74,9 @@ def test_summary_counts_hits_misses_and_faces_not_found():
     assert s["overall"] == {1.0: pytest.approx(1 / 3), 0.5: 1.0}     # contempt has no FER label: not counted
     assert s["no_face"] == 1 and s["confusion"][("anger", 1.0)] == {"no face": 1}
     assert s["confusion"][("contempt", 1.0)] == {"disgust": 1}
+    grid = [_row("happiness", 1.0, "happy"), _row("happiness", 1.0, "happy")]
+    grid[0]["reading"]["grid_labels"] = ["happy", "neutral", "neutral", "neutral"]
+    assert score.summarise(grid)["overall_grid"] == {1.0: pytest.approx((0.25 + 1.0) / 2)}
     text = score.format_report("registers", s, ["happiness", "anger", "fear", "contempt"], [1.0, 0.5])
     assert "emotions at 100%: 33.3% recognised" in text and "neutral: 100.0% read as neutral" in text
 

@@ -56,6 +56,10 @@ PADDING_PX = 40
 #: the cascade mid-forehead to the chin's top); shift (dx, dy) in box sides, measured on scikit-image's
 #: astronaut photo: cascade box (175, 70)-(268, 163), BlazeFace (179, 81)-(272, 174), same size.
 HAAR_SHIFT = (-0.04, -0.12)
+#: Crop variants (centre shift in box sides, box scale) for a crop-robust figure: a single crop's verdicts
+#: move by several points when the box moves by a few pixels; the mean over these is steadier.
+CROP_GRID = tuple((shift, scale) for shift in ((0.0, 0.0), HAAR_SHIFT, (0.0, -0.2))
+                  for scale in (0.9, 1.0, 1.15, 1.3))
 
 
 class RaterError(RuntimeError):
@@ -97,6 +101,7 @@ class Reading:
 
     scores: dict
     box: tuple
+    grid_labels: tuple = ()
 
     @property
     def label(self) -> str:
@@ -145,12 +150,15 @@ def resize_bilinear(gray: np.ndarray, size: int) -> np.ndarray:
     return top * (1 - fy[:, None]) + bottom * fy[:, None]
 
 
-def haar_like_box(box) -> tuple[int, int, int, int]:
-    """A BlazeFace box → the square box OpenCV's frontal-face cascade would give, as (x, y, w, h) ints."""
+def haar_like_box(box, *, shift=HAAR_SHIFT, scale: float = 1.0) -> tuple[int, int, int, int]:
+    """A BlazeFace box → the square box OpenCV's frontal-face cascade would give, as (x, y, w, h) ints.
+
+    ``shift`` (in box sides) and ``scale`` move and grow it (the crop grid).
+    """
     x0, y0, x1, y1 = (float(v) for v in box)
-    side = max(x1 - x0, y1 - y0)
-    cx = (x0 + x1) / 2 + HAAR_SHIFT[0] * side
-    cy = (y0 + y1) / 2 + HAAR_SHIFT[1] * side
+    side = max(x1 - x0, y1 - y0) * scale
+    cx = (x0 + x1) / 2 + shift[0] * side
+    cy = (y0 + y1) / 2 + shift[1] * side
     s = int(round(side))
     return int(round(cx - side / 2)), int(round(cy - side / 2)), s, s
 
@@ -214,16 +222,26 @@ class EmotionRater:
         self._interp.invoke()
         return np.array(self._interp.get_tensor(self._output)[0], np.float64)
 
-    def rate(self, image) -> Reading | None:
-        """The reading of the largest face in ``image`` ((H, W, 3|4) uint8), or None when no face is found."""
+    def rate(self, image, *, grid: bool = False) -> Reading | None:
+        """The reading of the largest face in ``image`` ((H, W, 3|4) uint8), or None when no face is found.
+
+        ``grid`` also classifies the :data:`CROP_GRID` variants (their labels go to ``grid_labels``).
+        """
         rgb = to_rgb(image)
         faces = self._detector.detect(rgb)
         if not faces:
             return None
+        gray = luma(rgb)
         x, y, w, h = haar_like_box(faces[0].box)
-        probs = self.classify(face_tensor(luma(rgb), (x, y, w, h)))
+        probs = self.classify(face_tensor(gray, (x, y, w, h)))
         box = (x - OFFSET_PX, y - OFFSET_PX, x + w + OFFSET_PX, y + h + OFFSET_PX)
-        return Reading(dict(zip(LABELS, (float(p) for p in probs))), box)
+        grid_labels = ()
+        if grid:
+            grid_labels = tuple(
+                LABELS[int(np.argmax(self.classify(face_tensor(gray, haar_like_box(faces[0].box, shift=shift,
+                                                                                  scale=scale)))))]
+                for shift, scale in CROP_GRID)
+        return Reading(dict(zip(LABELS, (float(p) for p in probs))), box, grid_labels)
 
 
 def main() -> None:

@@ -7,7 +7,9 @@ For each engine: every character × emotion × intensity (default the six basic
 emotions at 100 % and 50 %) plus each character's neutral face is rendered
 front-on with facsim's own API, rated by the FER2013 model (:mod:`rater`), and
 summarised: recognition per emotion and intensity, the confusion table, the
-mean probability of the intended label. ``--out DIR`` keeps the renders and
+mean probability of the intended label, and recognition averaged over a grid of
+12 crops (a single crop's verdicts move by several points when the box moves by
+a few pixels; the grid figure is the steadier one to compare changes with). ``--out DIR`` keeps the renders and
 writes ``results.json`` (every reading). Same inputs → same figures.
 """
 from __future__ import annotations
@@ -19,7 +21,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from rater import FER_LABEL, LABELS, EmotionRater, RaterError  # noqa: E402
+from rater import CROP_GRID, FER_LABEL, LABELS, EmotionRater, RaterError  # noqa: E402
 
 BASIC = ("happiness", "sadness", "surprise", "anger", "fear", "disgust")
 BLIND_REVIEW_PRESETS = ("ava", "liam", "amara", "kwame", "mei", "george")
@@ -63,10 +65,11 @@ def render_and_rate(engine: str, items, rater: EmotionRater, *, size: int, out: 
                 from facsim.media.images import write_png
 
                 write_png(out / f"{engine}_{character}_{item['emotion']}_{round(item['intensity'] * 100)}.png", image)
-            reading = rater.rate(image)
+            reading = rater.rate(image, grid=True)
             rows.append({**item, "engine": engine,
                          "reading": None if reading is None else {"label": reading.label, "scores": reading.scores,
-                                                                  "box": list(reading.box)}})
+                                                                  "box": list(reading.box),
+                                                                  "grid_labels": list(reading.grid_labels)}})
             if log:
                 log(f"\r{engine}: {n}/{len(items)} rated")
     finally:
@@ -81,6 +84,8 @@ def render_and_rate(engine: str, items, rater: EmotionRater, *, size: int, out: 
 
 def summarise(rows) -> dict:
     """Recognition per (emotion, intensity), per intensity overall, confusion counts, mean target probability.
+
+    ``overall_grid`` and each cell's ``grid``: the share of crop-grid variants that name the target.
 
     An emotion without a FER2013 label (contempt, embarrassment, pride) appears in the confusion table only.
     A stimulus where no face was found counts as not recognised.
@@ -97,19 +102,25 @@ def summarise(rows) -> dict:
             continue
         hit = said == target
         prob = reading["scores"][target] if reading else 0.0
-        cell = cells.setdefault(key, {"n": 0, "hits": 0, "prob": 0.0})
+        grid = reading.get("grid_labels") if reading else None
+        grid_hit = sum(label == target for label in grid) / len(grid) if grid else float(hit)
+        cell = cells.setdefault(key, {"n": 0, "hits": 0, "prob": 0.0, "grid": 0.0})
         cell["n"] += 1
         cell["hits"] += hit
         cell["prob"] += prob
+        cell["grid"] += grid_hit
         if row["emotion"] != "neutral":
-            tally = overall.setdefault(row["intensity"], [0, 0])
+            tally = overall.setdefault(row["intensity"], [0, 0, 0.0])
             tally[0] += hit
             tally[1] += 1
+            tally[2] += grid_hit
     for cell in cells.values():
         cell["rate"] = cell["hits"] / cell["n"]
         cell["prob"] /= cell["n"]
+        cell["grid"] /= cell["n"]
     return {"cells": cells, "confusion": confusion,
-            "overall": {level: hits / n for level, (hits, n) in overall.items()},
+            "overall": {level: hits / n for level, (hits, n, _) in overall.items()},
+            "overall_grid": {level: grid / n for level, (_, n, grid) in overall.items()},
             "no_face": sum(1 for r in rows if r["reading"] is None), "n": len(rows)}
 
 
@@ -119,13 +130,15 @@ def format_report(engine: str, summary: dict, emotions, intensities) -> str:
         if level in summary["overall"]:
             goal = GOALS.get(level)
             lines.append(f"emotions at {level:.0%}: {summary['overall'][level]:.1%} recognised"
-                         + (f" (goal {goal:.0%})" if goal else ""))
+                         + (f" (goal {goal:.0%})" if goal else "")
+                         + f"; over {len(CROP_GRID)} crops {summary['overall_grid'][level]:.1%}")
     neutral = summary["cells"].get(("neutral", 0.0))
     if neutral:
-        lines.append(f"neutral: {neutral['rate']:.1%} read as neutral")
+        lines.append(f"neutral: {neutral['rate']:.1%} read as neutral; over {len(CROP_GRID)} crops "
+                     f"{neutral['grid']:.1%}")
     lines.append("")
     header = f"{'emotion':<14}" + "".join(f"{f'{lv:.0%}':>16}" for lv in intensities)
-    lines.append(header + "   (recognised / mean p(target))")
+    lines.append(header + "   (hits/n, rate, mean p(target) — one crop, as the panel)")
     for name in [*emotions, "neutral"]:
         # neutral has one cell (intensity 0), shown in the first column
         levels = intensities[:1] if name == "neutral" else intensities
