@@ -73,6 +73,8 @@ def test_summary_counts_hits_misses_and_faces_not_found():
     assert s["cells"][("happiness", 1.0)]["rate"] == 0.5
     assert s["overall"] == {1.0: pytest.approx(1 / 3), 0.5: 1.0}     # contempt has no FER label: not counted
     assert s["no_face"] == 1 and s["confusion"][("anger", 1.0)] == {"no face": 1}
+    failed = score.summarise([{**_row("fear", 1.0, None), "error": "positions contain NaN"}])
+    assert failed["failed"] == 1 and failed["no_face"] == 0 and failed["overall"] == {1.0: 0.0}
     assert s["confusion"][("contempt", 1.0)] == {"disgust": 1}
     grid = [_row("happiness", 1.0, "happy"), _row("happiness", 1.0, "happy")]
     grid[0]["reading"]["grid_labels"] = ["happy", "neutral", "neutral", "neutral"]

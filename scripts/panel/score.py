@@ -62,7 +62,14 @@ def render_and_rate(engine: str, items, panel: Panel, *, size: int, out: Path | 
                     old.close()
                 faces = {character: facsim.Face(character, engine=engine)}
             expression = None if item["emotion"] == "neutral" else emotion(item["emotion"], intensity=item["intensity"])
-            image = faces[character].render(expression, size=size)
+            try:
+                image = faces[character].render(expression, size=size)
+            except ValueError as exc:   # e.g. a solver that diverged: record it, go on with the rest of the set
+                rows.extend({**item, "engine": engine, "rater": rater.name, "reading": None, "error": str(exc)}
+                            for rater in panel.raters)
+                if log:
+                    log(f"\n{engine} {character} {item['emotion']} {item['intensity']:.0%}: render failed: {exc}\n")
+                continue
             if out is not None:
                 from facsim.media.images import write_png
 
@@ -92,12 +99,12 @@ def summarise(rows) -> dict:
     ``overall_grid`` and each cell's ``grid``: the share of crop-grid variants that name the target.
 
     An emotion without a FER2013 label (contempt, embarrassment, pride) appears in the confusion table only.
-    A stimulus where no face was found counts as not recognised.
+    A stimulus where no face was found, or whose render failed (``error``), counts as not recognised.
     """
     cells, confusion, overall = {}, {}, {}
     for row in rows:
         reading = row["reading"]
-        said = reading["label"] if reading else "no face"
+        said = reading["label"] if reading else ("render failed" if row.get("error") else "no face")
         key = (row["emotion"], row["intensity"])
         confusion.setdefault(key, {}).setdefault(said, 0)
         confusion[key][said] += 1
@@ -125,11 +132,13 @@ def summarise(rows) -> dict:
     return {"cells": cells, "confusion": confusion,
             "overall": {level: hits / n for level, (hits, n, _) in overall.items()},
             "overall_grid": {level: grid / n for level, (_, n, grid) in overall.items()},
-            "no_face": sum(1 for r in rows if r["reading"] is None), "n": len(rows)}
+            "no_face": sum(1 for r in rows if r["reading"] is None and not r.get("error")),
+            "failed": sum(1 for r in rows if r.get("error")), "n": len(rows)}
 
 
 def format_report(engine: str, rater_title: str, summary: dict, emotions, intensities) -> str:
-    lines = [f"== {engine} engine, rater {rater_title}: {summary['n']} images, no face in {summary['no_face']}"]
+    lines = [f"== {engine} engine, rater {rater_title}: {summary['n']} images, no face in {summary['no_face']}"
+             + (f", RENDER FAILED for {summary['failed']}" if summary["failed"] else "")]
     for level in intensities:
         if level in summary["overall"]:
             goal = GOALS.get(level)
@@ -155,7 +164,7 @@ def format_report(engine: str, rater_title: str, summary: dict, emotions, intens
                 row += f"{'(no label)':>16}"
         lines.append(row)
     lines.append("")
-    columns = [*LABELS, "no face"]
+    columns = [*LABELS, "no face"] + (["render failed"] if summary["failed"] else [])
     lines.append("confusion (rows: stimulus; columns: the rater's label)")
     lines.append(f"{'':<20}" + "".join(f"{c[:8]:>9}" for c in columns))
     for (name, level), said in sorted(summary["confusion"].items(),
