@@ -174,6 +174,48 @@ def format_report(engine: str, rater_title: str, summary: dict, emotions, intens
     return "\n".join(lines)
 
 
+def contact_sheet(rows, out: Path, engine: str, *, tile: int = 160) -> Path:
+    """``out/sheet_ENGINE.png``: one row per character, one column per stimulus, each rater's label under it.
+
+    A label in green names the intended emotion; red does not (grey: the emotion has no label to match).
+    """
+    from PIL import Image, ImageDraw
+
+    stimuli, characters, labels = [], [], {}
+    for row in rows:
+        if row["engine"] != engine:
+            continue
+        key = (row["emotion"], row["intensity"])
+        if key not in stimuli:
+            stimuli.append(key)
+        if row["character"] not in characters:
+            characters.append(row["character"])
+        labels.setdefault((row["character"], key), []).append(row)
+    band = 14 * (1 + max((len(v) for v in labels.values()), default=1))
+    sheet = Image.new("RGB", (tile * len(stimuli), (tile + band) * len(characters)), "white")
+    draw = ImageDraw.Draw(sheet)
+    for r, character in enumerate(characters):
+        for c, (name, level) in enumerate(stimuli):
+            x, y = c * tile, r * (tile + band)
+            path = out / f"{engine}_{character}_{name}_{round(level * 100)}.png"
+            if path.exists():
+                sheet.paste(Image.open(path).convert("RGB").resize((tile, tile), Image.BILINEAR), (x, y))
+            draw.text((x + 3, y + tile + 1), f"{character} {name} {level:.0%}" if name != "neutral"
+                      else f"{character} neutral", fill=(0, 0, 0))
+            target = FER_LABEL.get(name)
+            for k, row in enumerate(labels.get((character, (name, level)), [])):
+                reading = row["reading"]
+                said = f"{reading['label']} {reading['scores'][reading['label']]:.2f}" if reading else "-"
+                colour = (120, 120, 120) if target is None else (0, 130, 0) if reading and \
+                    reading["label"] == target else (200, 0, 0)
+                draw.text((x + 3, y + tile + 15 + 14 * k), f"{row['rater']}: {said}", fill=colour)
+    path = out / f"sheet_{engine}.png"
+    from facsim.atomic import atomic_write
+
+    atomic_write(path, lambda tmp: sheet.save(tmp, format="PNG"))
+    return path
+
+
 # ------------------------------------------------------------------ photos
 
 def photo_check(panel: Panel) -> tuple[str, bool]:
@@ -295,6 +337,8 @@ def main(argv=None) -> int:
             for rater in panel.raters:
                 mine = [row for row in rows if row["rater"] == rater.name]
                 print(format_report(engine, rater.title, summarise(mine), emotions, intensities) + "\n")
+            if args.out:
+                print(f"contact sheet: {contact_sheet(rows, args.out, engine)}\n")
     if args.out:
         from facsim.atomic import atomic_write
 
