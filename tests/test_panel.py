@@ -45,7 +45,7 @@ def test_face_tensor_is_the_offset_square_crop_scaled_to_unit_range():
 
 
 def test_haar_like_box_is_square_and_moved_up():
-    x, y, w, h = rater.haar_like_box((100, 100, 200, 180))
+    _, y, w, h = rater.haar_like_box((100, 100, 200, 180))
     assert w == h == 100
     assert y < 100 - 10 + 5          # centre moved up by 12 % of the side (the box was 80 tall, squared to 100)
 

@@ -30,9 +30,14 @@ import urllib.request
 from pathlib import Path
 
 import numpy as np
+from rater import (  # the sibling module in scripts/panel
+    CROP_GRID,
+    RaterError,
+    Reading,
+    haar_like_box,
+)
 
 from facsim.atomic import atomic_write
-from rater import CROP_GRID, RaterError, Reading, haar_like_box   # the sibling module in scripts/panel
 
 VERSION = "1.7.15"
 TARBALL = f"https://registry.npmjs.org/@vladmandic/face-api/-/face-api-{VERSION}.tgz"
@@ -150,13 +155,13 @@ def separable_conv(x: np.ndarray, depthwise: np.ndarray, pointwise: np.ndarray, 
 
 def dense_block(x: np.ndarray, w: dict, name: str, *, first: bool) -> np.ndarray:
     """face-api.js ``denseBlock4``: each conv sees the sum of all earlier outputs of the block."""
-    relu = lambda v: np.maximum(v, 0)   # noqa: E731
+    relu = lambda v: np.maximum(v, 0)
     if first:
         out1 = relu(conv3x3(x, w[f"{name}/conv0/filters"], 2) + w[f"{name}/conv0/bias"])
     else:
         out1 = relu(separable_conv(x, *(w[f"{name}/conv0/{k}"] for k in ("depthwise_filter", "pointwise_filter",
                                                                           "bias")), 2))
-    conv = lambda v, i: separable_conv(v, w[f"{name}/conv{i}/depthwise_filter"],   # noqa: E731
+    conv = lambda v, i: separable_conv(v, w[f"{name}/conv{i}/depthwise_filter"],
                                        w[f"{name}/conv{i}/pointwise_filter"], w[f"{name}/conv{i}/bias"], 1)
     out2 = conv(out1, 1)
     out3 = conv(relu(out1 + out2), 2)
@@ -199,7 +204,7 @@ def resize_tfjs(rgb: np.ndarray, size: int) -> np.ndarray:
 
 def face_input(rgb: np.ndarray, box) -> np.ndarray:
     """face-api.js's face crop: the box clipped to the image, padded square (centred, black), resized to 112²."""
-    x0, y0, x1, y1 = (int(round(v)) for v in box)
+    x0, y0, x1, y1 = (int(np.round(v)) for v in box)
     h, w = rgb.shape[:2]
     x0, y0, x1, y1 = max(0, x0), max(0, y0), min(w, x1), min(h, y1)
     if x1 <= x0 or y1 <= y0:

@@ -159,8 +159,8 @@ def haar_like_box(box, *, shift=HAAR_SHIFT, scale: float = 1.0) -> tuple[int, in
     side = max(x1 - x0, y1 - y0) * scale
     cx = (x0 + x1) / 2 + shift[0] * side
     cy = (y0 + y1) / 2 + shift[1] * side
-    s = int(round(side))
-    return int(round(cx - side / 2)), int(round(cy - side / 2)), s, s
+    s = int(np.round(side))
+    return int(np.round(cx - side / 2)), int(np.round(cy - side / 2)), s, s
 
 
 def face_tensor(gray: np.ndarray, box_xywh) -> np.ndarray:
@@ -209,7 +209,7 @@ class FerRater:
         try:
             self._interp = Interpreter(model_path=str(path), num_threads=threads)
             self._interp.allocate_tensors()
-        except Exception as exc:
+        except (ValueError, RuntimeError) as exc:   # a truncated or foreign file
             raise RaterError(f"could not load {path} ({exc}); delete {model_dir()} to extract it again") from None
         self._input = self._interp.get_input_details()[0]["index"]
         self._output = self._interp.get_output_details()[0]["index"]

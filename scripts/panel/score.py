@@ -23,7 +23,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from rater import CROP_GRID, FER_LABEL, LABELS, RATERS, Panel, RaterError  # noqa: E402
+from rater import CROP_GRID, FER_LABEL, LABELS, RATERS, Panel, RaterError
 
 BASIC = ("happiness", "sadness", "surprise", "anger", "fear", "disgust")
 BLIND_REVIEW_PRESETS = ("ava", "liam", "amara", "kwame", "mei", "george")
