@@ -166,7 +166,7 @@ def format_report(engine: str, rater_title: str, summary: dict, emotions, intens
     lines.append("")
     columns = [*LABELS, "no face"] + (["render failed"] if summary["failed"] else [])
     lines.append("confusion (rows: stimulus; columns: the rater's label)")
-    lines.append(f"{'':<20}" + "".join(f"{c[:8]:>9}" for c in columns))
+    lines.append(f"{'':<20}" + "".join(f"{'failed' if c == 'render failed' else c:>9}" for c in columns))
     for (name, level), said in sorted(summary["confusion"].items(),
                                       key=lambda kv: ([*emotions, "neutral"].index(kv[0][0]), -kv[0][1])):
         label = f"{name} {level:.0%}" if name != "neutral" else "neutral"
