@@ -224,3 +224,23 @@ def test_emotions_show_their_upper_face_signs(engine, marks):
     assert got[1][corner, 1] > 0.05
     assert got[2][brow, 1] > 0.01 and got[3][brow, 1] > 0.01   # sadness and fear: inner brows raised
     assert got[4][lid, 1] > 0.02                              # surprise: upper lid up 2 mm
+
+
+def test_lash_frames_span_a_plane_where_lid_points_fall_on_a_line():
+    from facsim.engines.muscle import _frames, _spanning_triples
+
+    # Three lid points on one line (as ngozi's face shape makes them) then two off it.
+    points = np.array([[0, 0, 0], [0, 0, 1], [0, 0, 2], [1, 0, 0], [0, 1, 0]], float)
+    triples = _spanning_triples(points, np.array([[0, 1, 2, 3, 4]]))
+    assert triples.tolist() == [[0, 1, 3]]
+    assert np.isfinite(_frames(points, triples)).all()
+    # Where the nearest three span a plane, they are kept.
+    assert _spanning_triples(points, np.array([[0, 1, 3, 2, 4]])).tolist() == [[0, 1, 3]]
+
+
+def test_a_face_shape_with_lid_points_on_a_line_gets_finite_positions():
+    import facsim
+
+    # ngozi's face shape squeezes lid points onto a line; its lashes once came out NaN.
+    positions = facsim.Face("ngozi", engine="muscle").deform("12").positions
+    assert np.isfinite(positions).all()

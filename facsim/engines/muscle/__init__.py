@@ -66,8 +66,8 @@ class _Parts:
         self.neutral = neutral
         # Lashes ride the lid vertex nearest their root, turning with its local frame.
         lids = np.flatnonzero(anatomy(head).kind == LID)
-        _, near = cKDTree(neutral[lids]).query(neutral[head.lashes], k=3)
-        frame = lids[near]                                              # (L, 3) vertices spanning a frame
+        _, near = cKDTree(neutral[lids]).query(neutral[head.lashes], k=12)
+        frame = _spanning_triples(neutral, lids[near])                  # (L, 3) vertices spanning a frame
         # The right lashes take the mirror image of their left twins' frames (symmetric faces stay so).
         mirror = np.asarray(head.mirror)
         twin = {int(v): k for k, v in enumerate(head.lashes)}
@@ -97,6 +97,27 @@ class _Parts:
         out[self.lashes] = out[self.lash_frame[:, 0]] + np.einsum("lji,lj->li", frames, self.lash_offset)
         out[self.cap] = out[self.loop].mean(axis=0)
         return out
+
+
+def _spanning_triples(positions, candidates) -> np.ndarray:
+    """The nearest three of each row of ``candidates`` (L, K) that span a plane.
+
+    Some face shapes squeeze lid vertices onto a line (three with the same x and y on
+    ngozi), whose frame would be undefined; the next nearest vertex that is off the line
+    is taken instead.
+    """
+    triples = candidates[:, :3].copy()
+    for k, row in enumerate(candidates):
+        p = positions[row]
+        scale = max(float(np.linalg.norm(p - p[0], axis=1).max()), 1e-12)
+        second = next((j for j in range(1, len(row)) if np.linalg.norm(p[j] - p[0]) > 1e-3 * scale), None)
+        if second is None:
+            continue
+        third = next((j for j in range(1, len(row)) if j != second
+                      and np.linalg.norm(np.cross(p[second] - p[0], p[j] - p[0])) > 1e-3 * scale ** 2), None)
+        if third is not None:
+            triples[k] = row[[0, second, third]]
+    return triples
 
 
 def _frames(positions, triples) -> np.ndarray:
