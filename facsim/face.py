@@ -24,7 +24,7 @@ from facsim.render.options import RenderOptions
 #: shows the whole head with a little neck, the same in every frame.
 NECK_SHOWN = 0.45
 #: Bump when the occlusion bake changes, so cached bakes are redone.
-OCCLUSION_VERSION = 1
+OCCLUSION_VERSION = 2
 
 
 @lru_cache(maxsize=1)
@@ -134,25 +134,28 @@ class Face:
         """What the renderer draws of the head: hm08's lash strips give way to a lash proxy,
         and the teeth get coordinates for separate crowns and gums."""
         from facsim.head.mesh import REGIONS, RenderTopology
-        from facsim.head.proxies import teeth_coordinates
+        from facsim.head.mouth import teeth_coordinates, tongue_coordinates
 
         topo = self.head.topology
         faces = topo.faces
         if any(p.proxy.kind == "eyelashes" for p in self.proxies):
             faces = faces[topo.face_regions() != REGIONS.index("lashes")]
-        # Teeth have no skin UVs: give them (arc length from the midline, root-ward height),
-        # which the teeth shader turns into separate teeth and gums.
+        # Teeth and tongue have no skin UVs: give the teeth (arc length from the midline,
+        # root-ward height), which their shader turns into separate crowns and gums, and the
+        # tongue (across, along), for its groove, papillae and fall-off toward the throat.
         uv = np.array(topo.uv, copy=True)
-        coords = teeth_coordinates(self.head, self.data, self.base_positions)
-        on_teeth = np.flatnonzero(topo.region == REGIONS.index("teeth"))
-        uv[on_teeth] = coords[topo.render_to_geo[on_teeth]]
+        for region, coordinates in (("teeth", teeth_coordinates), ("tongue", tongue_coordinates)):
+            coords = coordinates(self.head, self.data, self.base_positions)
+            on = np.flatnonzero(topo.region == REGIONS.index(region))
+            uv[on] = coords[topo.render_to_geo[on]]
         return RenderTopology(faces=faces, render_to_geo=topo.render_to_geo, uv=uv,
                               region=topo.region, eye_coord=topo.eye_coord)
 
     @cached_property
     def shading_occlusion(self) -> np.ndarray:
         """:attr:`occlusion` with the skin under the hair shadowed by it and the mouth darkening with depth."""
-        from facsim.head.proxies import hair_shadow, mouth_depth_visibility
+        from facsim.head.mouth import mouth_depth_visibility
+        from facsim.head.proxies import hair_shadow
 
         occlusion = np.array(self.occlusion, np.float32, copy=True)
         interior, visibility = mouth_depth_visibility(self.head, self.neutral)

@@ -240,8 +240,11 @@ def apply_targets(base: np.ndarray, data, weights: Mapping[str, float]) -> np.nd
 
 
 def character_positions(character: Character, data) -> np.ndarray:
-    """Morphed base vertices (19158, 3) for ``character``."""
-    return apply_targets(data.base_vertices, data, character_weights(character, set(data.target_names)))
+    """Morphed base vertices (19158, 3) for ``character``, its mouth's parts at rest
+    (:func:`facsim.head.mouth.rest_mouth`)."""
+    from facsim.head.mouth import rest_mouth
+
+    return rest_mouth(apply_targets(data.base_vertices, data, character_weights(character, set(data.target_names))), data)
 
 
 # ------------------------------------------------------------------ presets

@@ -296,39 +296,6 @@ def hair_shadow(skin_positions: np.ndarray, hair_positions: np.ndarray, *, stren
     return (1.0 - strength * (1.0 - t * t * (3 - 2 * t))).astype(np.float32)
 
 
-def teeth_coordinates(head, data, base_positions: np.ndarray) -> np.ndarray:
-    """(N_geo, 2) for teeth vertices: arc length (dm) from the midline around the dental
-    arch (signed, +x the character's left) and height from the biting edge (0) to the gum
-    line (1); zeros elsewhere. Measured on the character's neutral base mesh."""
-    out = np.zeros((head.vertex_count, 2), np.float32)
-    geo_of_base = np.full(len(head.base_vertices), -1, np.int64)
-    geo_of_base[head.base_index] = np.arange(len(head.base_index))
-    for group, upper in (("helper-upper-teeth", True), ("helper-lower-teeth", False)):
-        base = data.group_vertices(group)
-        geo = geo_of_base[base]
-        keep = geo >= 0
-        p = np.asarray(base_positions)[base[keep]]
-        # Arc length on a circle of the arch's front radius: x for the front teeth, growing
-        # toward the back; the band's inner and outer faces get the same coordinate.
-        radius = max(float(np.abs(p[:, 0]).max()), 1e-3)
-        arc = radius * np.arcsin(np.clip(p[:, 0] / radius, -1.0, 1.0))
-        lo, hi = p[:, 1].min(), p[:, 1].max()
-        height = (p[:, 1] - lo) / (hi - lo) if upper else (hi - p[:, 1]) / (hi - lo)
-        out[geo[keep]] = np.stack([arc, height], axis=1)
-    return out
-
-
-def mouth_depth_visibility(head, neutral: np.ndarray, *, falloff: float = 0.22):
-    """Mouth-interior vertices and a visibility (1 at the lips … ~0 deep inside) that falls
-    off with depth behind the lips, so an open mouth shows a dark cavity, not a lit wall."""
-    from facsim.head.mesh import REGIONS
-
-    interior = np.flatnonzero(head.region == REGIONS.index("mouth_interior"))
-    z = np.asarray(neutral)[interior, 2]
-    depth = np.clip(z.max() - z, 0.0, None)
-    return interior, np.exp(-depth / falloff).astype(np.float32)
-
-
 # ------------------------------------------------------------------------- the cache
 
 

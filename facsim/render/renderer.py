@@ -85,7 +85,7 @@ _PASSES = {
     "skin_brows": ("REGION_SKIN", "USE_UV", "USE_WRINKLE", "USE_BROWS"),
     "mouth_interior": ("REGION_MOUTH_INTERIOR",),
     "teeth": ("REGION_TEETH", "USE_UV"),
-    "tongue": ("REGION_TONGUE",),
+    "tongue": ("REGION_TONGUE", "USE_UV"),
     "eyeball": ("REGION_EYEBALL", "USE_EYE"),
     "lashes": ("REGION_LASHES", "USE_LASH"),
 }

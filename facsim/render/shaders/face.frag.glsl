@@ -122,6 +122,12 @@ const int IRIS_FIBRES = 96;        // radial noise cells around the iris
 #if defined(REGION_TEETH) || defined(REGION_TONGUE)
 #define ONE_ALBEDO
 #endif
+#ifdef REGION_TEETH
+// Where each tooth ends along the arch (dm from the midline, per side): central and lateral
+// incisor, canine, two premolars, two molars (mean adult crown widths, upper and lower).
+const float UPPER_TEETH[8] = float[8](0.0, 0.085, 0.150, 0.225, 0.295, 0.360, 0.460, 0.560);
+const float LOWER_TEETH[8] = float[8](0.0, 0.052, 0.108, 0.176, 0.246, 0.316, 0.426, 0.530);
+#endif
 #if defined(ONE_ALBEDO) || defined(REGION_MOUTH_INTERIOR) || defined(REGION_LASHES)
 uniform vec3 u_albedo;
 #endif
@@ -229,46 +235,88 @@ void main() {
     // Inside the mouth the lips and cheeks shade everything; occlusion baked on a closed
     // mouth would black it out, so it only dims these regions down to a floor.
 #ifdef REGION_TEETH
-    // v_uv = (arc length from the midline in dm, 0 at the biting edge .. 1 at the gum line),
-    // set per tooth vertex by facsim.head.proxies.teeth_coordinates (plain UV-less bands get 0).
+    // v_uv = (arc length from the midline in dm, height from the biting edge: 0 at the edge,
+    // up the outer wall to 1 at the root row, down to -1 across the lingual slope; the lower
+    // row adds 4), set per vertex by facsim.head.mouth.teeth_coordinates.
+    float lower = step(2.0, v_uv.y);
+    float h_signed = clamp(v_uv.y - 4.0 * lower, -1.0, 1.0);
+    float h = max(h_signed, 0.0);              // up the outer (labial) wall
+    float lingual = max(-h_signed, 0.0);       // in across the inside of the arch
     float arc = abs(v_uv.x);
-    float h = clamp(v_uv.y, 0.0, 1.0);
-    // Tooth boundaries along the arch (dm): incisors, laterals, canines, premolars.
-    float b0 = 0.0, b1 = 0.0;
-    if (arc < 0.085) { b0 = 0.0; b1 = 0.085; }
-    else if (arc < 0.15) { b0 = 0.085; b1 = 0.15; }
-    else if (arc < 0.225) { b0 = 0.15; b1 = 0.225; }
-    else if (arc < 0.295) { b0 = 0.225; b1 = 0.295; }
-    else { b0 = 0.295; b1 = 0.36; }
-    float w = (arc - b0) / (b1 - b0);                     // 0..1 across this tooth
-    // Thin interproximal lines, faded to a faint mean where they would be sub-pixel (small
-    // images), so teeth never look dirty.
+    int kind = 0;
+    for (int i = 1; i < 7; ++i) {
+        if (arc >= mix(UPPER_TEETH[i], LOWER_TEETH[i], lower)) kind = i;
+    }
+    float b0 = mix(UPPER_TEETH[kind], LOWER_TEETH[kind], lower);
+    float b1 = mix(UPPER_TEETH[kind + 1], LOWER_TEETH[kind + 1], lower);
+    float w = clamp((arc - b0) / (b1 - b0), 0.0, 1.0);     // 0..1 across this tooth
+    float side = abs(2.0 * w - 1.0);                        // 0 mid-crown .. 1 at its neighbours
+    // The biting edge's outline, as the height (band units, ~1.6 cm) cut away below it:
+    // incisors square with rounded corners (laterals a little shorter), canines a cusp,
+    // premolars and molars cusps set higher (the curve of Spee). Cutting it out of the
+    // band (discard) gives each tooth its own silhouette and the dark embrasures between.
+    float notch;
+    if (kind <= 1) {
+        float corner = clamp((side - 0.45) / 0.55, 0.0, 1.0);
+        notch = 0.10 * corner * corner + (kind == 1 ? mix(0.035, 0.012, lower) : 0.0);
+    } else if (kind == 2) {
+        notch = 0.11 * pow(side, 1.6) - 0.01;
+    } else {
+        notch = 0.03 + 0.08 * pow(side, 3.0) + 0.015 * float(kind - 3);
+    }
+    if (max(h, lingual) < notch) discard;
+    // Thin interproximal shadow, strongest toward the edge where crowns part, faded to a
+    // faint mean where it would be finer than a pixel, so teeth never look dirty.
     float gap_aa = fwidth(arc);
-    float gap_depth = 0.4 * clamp(1.5 - 120.0 * gap_aa, 0.0, 1.0);
-    float gap = 1.0 - gap_depth * (1.0 - smoothstep(0.0, gap_aa + 0.0015, min(arc - b0, b1 - arc)));
-    // Scalloped gum line: higher between teeth (papillae), lower over each crown.
-    float gum_edge = 0.70 + 0.12 * (1.0 - sin(PI * clamp(w, 0.0, 1.0)));
-    float gum = smoothstep(gum_edge - 0.04, gum_edge + 0.04, h);
-    vec3 enamel = u_albedo * mix(vec3(0.86, 0.88, 0.92), vec3(1.0), smoothstep(0.02, 0.2, h));  // translucent edge
-    enamel *= 0.92 + 0.08 * sin(PI * clamp(w, 0.0, 1.0));   // each crown is rounded
-    vec3 albedo = mix(enamel * gap, vec3(0.62, 0.27, 0.28), gum);
-    float mouth_shade = mix(0.85, 1.0, occ) * mix(1.0, 0.7, smoothstep(0.15, 0.36, arc));  // back teeth in shadow
-    vec3 spec = specular_light(n, v, 90.0) * 0.18 * (1.0 - gum);
+    float gap_w = gap_aa + 0.003;
+    float gap = 1.0 - 0.45 * (1.0 - smoothstep(0.0, gap_w, min(arc - b0, b1 - arc)))
+                    * clamp(1.5 - 120.0 * gap_aa, 0.3, 1.0) * mix(1.0, 0.5, smoothstep(0.1, 0.5, h));
+    // Scalloped gum line: papillae reach down between the crowns, arcs over each.
+    float gum_edge = mix(0.62, 0.56, lower) + 0.16 * (1.0 - sin(PI * w));
+    float gum = smoothstep(gum_edge - 0.03, gum_edge + 0.03, max(h, 2.0 * lingual));  // the crowns are ~4 mm thick
+    // Ivory enamel: bluish translucent at the edge, warmer toward the neck where dentin shows,
+    // each crown rounded (brighter mid-crown), a little variation tooth to tooth.
+    float tooth_id = float(kind) + 7.0 * step(0.0, v_uv.x) + 14.0 * lower;
+    float vary = fract(sin(tooth_id * 12.9898) * 43758.5453);
+    vec3 enamel = u_albedo * (0.96 + 0.06 * vary);
+    enamel *= mix(vec3(0.80, 0.84, 0.90), vec3(1.0), smoothstep(notch, notch + 0.14, max(h, lingual)));
+    enamel *= mix(vec3(1.0), vec3(1.0, 0.94, 0.82), smoothstep(0.3, gum_edge, h));
+    enamel *= 0.84 + 0.16 * sin(PI * w);
+    vec3 gums = vec3(0.55, 0.20, 0.21) * (0.9 + 0.2 * value_noise(v_uv * vec2(60.0, 8.0), 0));
+    vec3 albedo = mix(enamel * gap, gums, gum);
+    // Light inside the mouth falls off with depth: the front teeth catch it, the back ones sit
+    // in the shadow of the cheeks (the dark buccal corridor), and the lips shade the crowns'
+    // necks. The lower row sits under the upper teeth and the upper lip: a little darker.
+    float depth_shade = mix(1.0, 0.10, smoothstep(0.12, 0.36, arc));
+    float lip_shade = mix(1.0, 0.55, smoothstep(0.35, 0.95, h)) * mix(1.0, 0.8, lower);
+    // The inside of the arch faces the tongue and throat: it only catches light scattered in.
+    float mouth_shade = depth_shade * lip_shade * mix(1.0, 0.15, smoothstep(0.05, 0.45, lingual));
+    float wet = specular_light(n, v, 120.0).r * 0.35 + specular_light(n, v, 30.0).r * 0.05;
+    vec3 spec = vec3(wet) * (1.0 - 0.6 * gum) * schlick(0.05, max(dot(n, v), 0.0)) * 3.0;
     // Enamel scatters light inside the tooth: a little of its own brightness beyond the lighting.
-    radiance = ((diffuse_light(n, vec3(0.25, 0.2, 0.15), 1.0) + 0.18) * albedo + spec) * mouth_shade;
+    radiance = ((diffuse_light(n, vec3(0.3, 0.25, 0.2), 1.0) * 0.9 + 0.16) * albedo + spec) * mouth_shade;
 #endif
 
 #ifdef REGION_TONGUE
-    float mouth_shade = mix(0.45, 1.0, occ);
-    vec3 spec = specular_light(n, v, 35.0) * 0.08;
-    radiance = (diffuse_light(n, vec3(0.3, 0.15, 0.1), 1.0) * u_albedo + spec) * mouth_shade;
+    // v_uv = (across -1..1, along 0 at the tip .. 1 at the root), facsim.head.mouth.tongue_coordinates.
+    float across = v_uv.x, along = clamp(v_uv.y, 0.0, 1.0);
+    // Median groove, papillae as fine mottling, a paler coat toward the middle.
+    float groove = 1.0 - 0.35 * exp(-across * across / 0.012) * smoothstep(0.05, 0.3, along);
+    float papillae = 0.85 + 0.3 * value_noise(v_uv * vec2(40.0, 60.0), 0);
+    vec3 albedo = u_albedo * vec3(0.85, 0.72, 0.76) * papillae * groove;
+    // The tongue lies in the mouth's shadow: lit at the tip, dark toward the throat and at its
+    // sides against the teeth.
+    float mouth_shade = mix(0.85, 0.03, smoothstep(0.0, 0.22, along)) * mix(1.0, 0.5, smoothstep(0.4, 1.0, abs(across)));
+    vec3 spec = specular_light(n, v, 40.0) * 0.12 * papillae;
+    radiance = (diffuse_light(n, vec3(0.3, 0.15, 0.1), 1.0) * 0.8 * albedo + spec) * mouth_shade;
 #endif
 
 #ifdef REGION_MOUTH_INTERIOR
-    // Mostly hidden and in the mouth's own shadow: dim, a little wet.
-    float mouth_shade = mix(0.06, 1.0, occ * occ);  // falls off with depth (Face passes it in occ)
+    // Mostly hidden and in the mouth's own shadow: dim, dark red, a little wet; falls off with
+    // depth behind the lips (Face passes facsim.head.mouth.mouth_depth_visibility in occ).
+    float mouth_shade = mix(0.015, 1.0, occ * occ);
     vec3 spec = specular_light(n, v, 30.0) * 0.04;
-    radiance = (diffuse_light(n, vec3(0.3, 0.1, 0.1), 1.0) * u_albedo * 0.55 + spec) * mouth_shade;
+    radiance = (diffuse_light(n, vec3(0.3, 0.1, 0.1), 1.0) * u_albedo * 0.45 + spec) * mouth_shade;
 #endif
 
 #ifdef REGION_LASHES

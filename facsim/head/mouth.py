@@ -1,0 +1,132 @@
+"""The inside of the mouth: the tongue's rest pose and the per-vertex coordinates the
+renderer shades teeth, tongue and oral cavity with.
+
+hm08's teeth are two crude bands (``helper-upper-teeth``/``helper-lower-teeth``, 68
+vertices each: an outer wall of three rows plus a lingual slope) and its tongue fills
+the closed mouth up to the palate. Nothing here adds per-frame work: the coordinates
+are static per vertex (the renderer uploads them once with the topology), and the
+tongue is lowered in the character's rest mesh, so both engines carry it with the jaw
+as they carry the lower teeth.
+
+Examples
+--------
+>>> from facsim import Face                                      # doctest: +SKIP
+>>> face = Face("ava")                                           # doctest: +SKIP
+>>> coords = teeth_coordinates(face.head, face.data, face.base_positions)  # doctest: +SKIP
+"""
+from __future__ import annotations
+
+import numpy as np
+
+#: Groups of hm08's mouth parts.
+UPPER_TEETH, LOWER_TEETH, TONGUE = "helper-upper-teeth", "helper-lower-teeth", "helper-tongue"
+#: Teeth coordinates put the lower row's height at this offset (upper -1..1, lower 3..5),
+#: so one shader tells the rows apart without another vertex attribute.
+LOWER_ROW_OFFSET = 4.0
+#: The tongue's dorsum rests this far (dm) below the lower incisors' biting edge. hm08's
+#: tongue fills the closed mouth up to the palate, so an open mouth showed a pink mound
+#: above the lower teeth; a relaxed tongue lies in the floor of the mouth, behind them.
+TONGUE_BELOW_TEETH = 0.012
+#: The upper teeth rest this far (dm) lower than hm08 puts them. hm08 hides the upper
+#: incisors 1 mm above the lips' meeting line, so a mouth that opened by the jaw alone
+#: (26, 27; the muscle engine's lips) showed no upper teeth; a relaxed adult shows 1–3 mm
+#: of them below the upper lip once the lips part (more in the young, less with age).
+UPPER_TEETH_DROP = 0.015
+#: Radius (dm, in plan) within which a tooth vertex's biting edge and root row are looked
+#: up: a column's rows lie within 3 mm of each other, columns 5–8 mm apart.
+COLUMN_REACH = 0.035
+#: A band vertex further than this (dm, in plan) from every root-row vertex is on the
+#: lingual slope (the band's inside, 8–13 mm in), not on the outer wall (within 3 mm).
+LINGUAL_REACH = 0.05
+
+
+def rest_mouth(base_positions: np.ndarray, data) -> np.ndarray:
+    """Base positions (19158, 3) with the mouth's parts at rest: the upper teeth lowered by
+    :data:`UPPER_TEETH_DROP` and the tongue lowered into the floor of the mouth.
+
+    The tongue is squashed toward its underside (about its lowest point) until its top
+    sits :data:`TONGUE_BELOW_TEETH` under the lower incisors' edge; its tip and sides
+    stay where they are in plan, so it still fills the lower arch. Applied to the
+    character's neutral mesh before any expression, so both engines carry the parts
+    with the skull and the jaw as they carry hm08's own.
+    """
+    out = np.array(base_positions, np.float32, copy=True)
+    out[data.group_vertices(UPPER_TEETH), 1] -= UPPER_TEETH_DROP
+    tongue = data.group_vertices(TONGUE)
+    lower = data.group_vertices(LOWER_TEETH)
+    y = out[tongue, 1]
+    bottom, top = float(y.min()), float(y.max())
+    target = float(out[lower, 1].max()) - TONGUE_BELOW_TEETH
+    if top <= target or top - bottom < 1e-6:
+        return out
+    scale = max((target - bottom) / (top - bottom), 0.4)
+    out[tongue, 1] = bottom + scale * (y - bottom)
+    return out
+
+
+def teeth_coordinates(head, data, base_positions: np.ndarray) -> np.ndarray:
+    """(N_geo, 2) per teeth vertex: (signed arc length from the midline around the dental
+    arch in dm, +x the character's left; height from the biting edge: 0 at the edge, up
+    to 1 at the root row on the outer wall, down to -1 at the inner row of the lingual
+    slope; plus :data:`LOWER_ROW_OFFSET` on the lower row); zeros elsewhere.
+
+    Measured on the character's neutral base mesh, so the shader's teeth (widths in dm)
+    stay put on the bands whatever the jaw does. The height is taken per column (the
+    band's edge row climbs toward the back), so every tooth's edge is at 0.
+    """
+    out = np.zeros((head.vertex_count, 2), np.float32)
+    for group, offset in ((UPPER_TEETH, 0.0), (LOWER_TEETH, LOWER_ROW_OFFSET)):
+        base = data.group_vertices(group)
+        geo = head.geo_of_base[base]
+        keep = geo >= 0
+        p = np.asarray(base_positions, float)[base[keep]]
+        # Arc length on a circle of the arch's front radius: x for the front teeth, growing
+        # toward the back; the band's inner and outer faces get nearly the same coordinate.
+        radius = max(float(np.abs(p[:, 0]).max()), 1e-3)
+        arc = radius * np.arcsin(np.clip(p[:, 0] / radius, -1.0, 1.0))
+        # Biting edge and root row of the vertex's column: the extreme heights among band
+        # vertices right above or below it (in plan).
+        plan_distance = np.linalg.norm(p[:, None, [0, 2]] - p[None, :, [0, 2]], axis=2)
+        near = plan_distance <= COLUMN_REACH
+        ys = np.where(near, p[None, :, 1], np.nan)
+        low, high = np.nanmin(ys, axis=1), np.nanmax(ys, axis=1)
+        span = np.maximum(high - low, 1e-4)
+        height = (p[:, 1] - low) / span if offset == 0.0 else (high - p[:, 1]) / span
+        height = np.clip(height, 0.0, 1.0)
+        # The lingual slope: far (in plan) from the root row, which tops the outer wall.
+        root = p[height > 0.85][:, [0, 2]]
+        plan = np.linalg.norm(p[:, None, [0, 2]] - root[None], axis=2).min(axis=1)
+        height = np.where(plan > LINGUAL_REACH, -1.0, height)
+        out[geo[keep]] = np.stack([arc, height + offset], axis=1)
+    return out
+
+
+def tongue_coordinates(head, data, base_positions: np.ndarray) -> np.ndarray:
+    """(N_geo, 2) per tongue vertex: (x across the tongue, -1 right … +1 left; 0 at the
+    tip … 1 at the root along its length); zeros elsewhere. The tongue's shader draws its
+    median groove and papillae in these, and darkens it toward the throat."""
+    out = np.zeros((head.vertex_count, 2), np.float32)
+    base = data.group_vertices(TONGUE)
+    geo = head.geo_of_base[base]
+    keep = geo >= 0
+    p = np.asarray(base_positions, float)[base[keep]]
+    half = max(float(np.abs(p[:, 0]).max()), 1e-3)
+    front, back = float(p[:, 2].max()), float(p[:, 2].min())
+    along = (front - p[:, 2]) / max(front - back, 1e-3)
+    out[geo[keep]] = np.stack([p[:, 0] / half, along], axis=1)
+    return out
+
+
+def mouth_depth_visibility(head, neutral: np.ndarray, *, falloff: float = 0.12):
+    """Mouth-interior vertices and a visibility (1 at the lips … ~0 deep inside) that falls
+    off with depth behind the lips, so an open mouth shows a dark cavity, not a lit wall.
+
+    ``falloff`` (dm) is the depth over which light drops to 1/e: about a centimetre, as
+    the lips, cheeks and teeth shade the cavity from every side.
+    """
+    from facsim.head.mesh import REGIONS
+
+    interior = np.flatnonzero(head.region == REGIONS.index("mouth_interior"))
+    z = np.asarray(neutral)[interior, 2]
+    depth = np.clip(z.max() - z, 0.0, None)
+    return interior, np.exp(-depth / falloff).astype(np.float32)
