@@ -264,7 +264,9 @@ void main() {
     } else {
         notch = 0.03 + 0.08 * pow(side, 3.0) + 0.015 * float(kind - 3);
     }
-    if (max(h, lingual) < notch) discard;
+    // A band without coordinates (all (0, 0): constant, so no derivative) stays whole.
+    bool shaped = fwidth(v_uv.x) + fwidth(v_uv.y) > 0.0;
+    if (shaped && max(h, lingual) < notch) discard;
     // Thin interproximal shadow, strongest toward the edge where crowns part, faded to a
     // faint mean where it would be finer than a pixel, so teeth never look dirty.
     float gap_aa = fwidth(arc);

@@ -1,0 +1,162 @@
+"""The mouth: teeth, tongue and oral cavity in their rest pose, under the jaw, and rendered."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from facsim.head.mesh import REGIONS
+from facsim.head.mouth import (
+    LOWER_ROW_OFFSET, LOWER_TEETH, TONGUE, TONGUE_BELOW_TEETH, UPPER_TEETH, rest_mouth, teeth_coordinates,
+    tongue_coordinates,
+)
+
+ENGINES = ("registers", "muscle")
+
+
+def _groups(face):
+    head, data = face.head, face.data
+    return {name: head.group_geometry(data, group)
+            for name, group in (("upper", UPPER_TEETH), ("lower", LOWER_TEETH), ("tongue", TONGUE))}
+
+
+def test_teeth_coordinates_split_rows_edges_roots_and_the_lingual_side(face_of):
+    face = face_of("ava")
+    coords = teeth_coordinates(face.head, face.data, face.base_positions)
+    parts = _groups(face)
+    upper, lower = coords[parts["upper"]], coords[parts["lower"]]
+    assert upper[:, 1].min() >= -1 and upper[:, 1].max() <= 1
+    assert lower[:, 1].min() >= LOWER_ROW_OFFSET - 1 and lower[:, 1].max() <= LOWER_ROW_OFFSET + 1
+    for rows, offset in ((upper, 0.0), (lower, LOWER_ROW_OFFSET)):
+        height = rows[:, 1] - offset
+        # hm08's bands: a biting edge, a middle and a root row on the outer wall, and a lingual row.
+        for value in (0.0, 1.0, -1.0):
+            assert np.isclose(height, value, atol=0.02).sum() == 17
+    # The arc is signed like x (the character's left is +x) and reaches the back teeth.
+    x = face.neutral[parts["upper"], 0]
+    assert np.all(np.sign(upper[np.abs(x) > 0.01, 0]) == np.sign(x[np.abs(x) > 0.01]))
+    assert np.abs(upper[:, 0]).max() > 0.36   # beyond the premolars: molars exist
+    # Every other vertex is left alone.
+    others = np.setdiff1d(np.arange(len(coords)), np.r_[parts["upper"], parts["lower"]])
+    assert not coords[others].any()
+
+
+def test_the_tongue_rests_in_the_floor_of_the_mouth(face_of):
+    face = face_of("ava")
+    data = face.data
+    from facsim.head.character import apply_targets, character_weights
+
+    raw = apply_targets(data.base_vertices, data, character_weights(face.character, set(data.target_names)))
+    np.testing.assert_allclose(rest_mouth(raw, data), face.base_positions, atol=1e-6)
+    assert raw[data.group_vertices(TONGUE), 1].max() > face.base_positions[data.group_vertices(TONGUE), 1].max() + 0.03
+    tongue = face.base_positions[data.group_vertices(TONGUE)]
+    lower = face.base_positions[data.group_vertices(LOWER_TEETH)]
+    upper = face.base_positions[data.group_vertices(UPPER_TEETH)]
+    assert tongue[:, 1].max() <= lower[:, 1].max() - TONGUE_BELOW_TEETH + 1e-5
+    assert tongue[:, 1].max() < upper[:, 1].min() + 0.06
+    # In plan it still fills the lower arch, behind the front teeth.
+    assert tongue[:, 2].max() < lower[:, 2].max()
+    assert np.abs(tongue[:, 0]).max() < np.abs(lower[:, 0]).max()
+    along = tongue_coordinates(face.head, face.data, face.base_positions)[_groups(face)["tongue"]]
+    assert along[:, 0].min() == pytest.approx(-1) and along[:, 0].max() == pytest.approx(1)
+    assert along[:, 1].min() == pytest.approx(0) and along[:, 1].max() == pytest.approx(1)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_lower_teeth_and_tongue_ride_the_jaw(face_of, engine):
+    face = face_of("ava", engine)
+    parts = _groups(face)
+    rest = face.neutral
+    drop = {}
+    for code in ("26", "27"):
+        moved = np.asarray(face.deform(code).positions)
+        np.testing.assert_allclose(moved[parts["upper"]], rest[parts["upper"]], atol=1e-4)
+        drop[code] = {name: float((rest[ids, 1] - moved[ids, 1]).mean()) for name, ids in parts.items()
+                      if name != "upper"}
+        # The tongue moves as the lower teeth do (both ride the mandible).
+        assert drop[code]["tongue"] == pytest.approx(drop[code]["lower"], rel=0.35)
+        # Rigidly: the lower row keeps its shape (distances between its vertices).
+        ids = parts["lower"][::7]
+        before = np.linalg.norm(rest[ids, None] - rest[None, ids], axis=-1)
+        after = np.linalg.norm(moved[ids, None] - moved[None, ids], axis=-1)
+        assert np.abs(after - before).max() < 0.01
+    assert 0.05 < drop["26"]["lower"] < drop["27"]["lower"]
+
+
+@pytest.mark.parametrize("character", ["ava", "kwame", "george"])
+def test_no_tooth_pokes_through_the_lips_at_rest(face_of, character):
+    face = face_of(character)
+    p = face.neutral
+    head = face.head
+    teeth = p[head.region == REGIONS.index("teeth")]
+    tri = head.triangles[(head.region[head.triangles] == REGIONS.index("skin")).all(axis=1)]
+    a, b, c = (p[tri[:, k]] for k in range(3))
+    near = np.linalg.norm((a + b + c) / 3 - teeth.mean(axis=0), axis=1) < 1.0
+    a, b, c = a[near], b[near], c[near]
+
+    def edge(u, v, q):
+        return (v[None, :, 0] - u[None, :, 0]) * (q[:, None, 1] - u[None, :, 1]) \
+            - (v[None, :, 1] - u[None, :, 1]) * (q[:, None, 0] - u[None, :, 0])
+
+    d1, d2, d3 = edge(a, b, teeth), edge(b, c, teeth), edge(c, a, teeth)
+    covers = ((d1 >= 0) & (d2 >= 0) & (d3 >= 0)) | ((d1 <= 0) & (d2 <= 0) & (d3 <= 0))
+    skin_z = np.where(covers, ((a + b + c) / 3)[None, :, 2], -np.inf).max(axis=1)
+    # Seen from the front, every tooth vertex lies behind the lip skin that covers it (the
+    # lips' parting line may leave a hair-thin slit, but nothing stands in front of the lips).
+    covered = np.isfinite(skin_z)
+    assert covered.mean() > 0.95
+    assert np.all(teeth[covered, 2] < skin_z[covered])
+    lips_front = p[head.skin][np.abs(p[head.skin, 1] - teeth[:, 1].mean()) < 0.1, 2].max()
+    assert teeth[:, 2].max() < lips_front
+
+
+# ------------------------------------------------------------------------------ rendered
+
+
+def _mouth_pixels(face, engine, expression, size=256):
+    """The render of ``expression`` and masks of its teeth and of its oral cavity (the
+    inside of the mouth and the tongue), from renders with those parts recoloured."""
+    from facsim import Face
+
+    deformation = face.deform(expression)
+    image = face.render(deformation=deformation, size=size)[..., :3].astype(float)
+    masks = []
+    for inside in ("#ffffff", "#000000"):
+        colors = {"teeth": "#00ff00", "mouth_interior": inside, "tongue": inside}
+        with Face(face.character.with_(colors=colors), engine=engine) as marked:
+            masks.append(marked.render(deformation=deformation, size=size)[..., :3].astype(int))
+    teeth = (masks[0][..., 1] > masks[0][..., 0] + 20) & (masks[0][..., 1] > masks[0][..., 2] + 20)
+    cavity = (np.abs(masks[0] - masks[1]).max(axis=-1) > 3) & ~teeth
+    return image, teeth, cavity
+
+
+def _luminance(pixels):
+    return pixels @ np.array([0.2126, 0.7152, 0.0722])
+
+
+def test_a_smile_shows_white_ivory_upper_teeth(face_of):
+    face = face_of("ava")
+    image, teeth, cavity = _mouth_pixels(face, "registers", "6+12+25")
+    assert teeth.sum() > 120
+    shown = image[teeth]
+    top = np.sort(_luminance(shown))[-teeth.sum() // 3:]
+    assert top.mean() > 185            # white, not a grey band
+    r, g, b = shown.mean(axis=0)
+    assert r >= b and r - b < 45       # ivory: warm but not yellow
+    # A band of crowns several pixels tall, not a thin white line.
+    rows = np.nonzero(teeth)[0]
+    assert rows.max() - rows.min() >= 5
+
+
+@pytest.mark.parametrize("expression", ["1+2+5+26", "16+26", "22+25"])
+def test_open_mouths_show_teeth_brighter_than_the_cavity(face_of, expression):
+    face = face_of("ava")
+    image, teeth, cavity = _mouth_pixels(face, "registers", expression)
+    assert teeth.sum() > 40 and cavity.sum() > 40
+    assert np.median(_luminance(image[teeth])) > 150
+    assert np.median(_luminance(image[cavity])) < 0.6 * np.median(_luminance(image[teeth]))
+
+
+def test_at_rest_the_lips_hide_the_teeth(face_of):
+    face = face_of("ava")
+    image, teeth, _ = _mouth_pixels(face, "registers", "0")
+    assert teeth.sum() < 12   # at most a few pixels in the lips' parting line
