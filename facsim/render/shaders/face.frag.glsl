@@ -273,8 +273,9 @@ void main() {
     float gap_w = gap_aa + 0.003;
     float gap = 1.0 - 0.45 * (1.0 - smoothstep(0.0, gap_w, min(arc - b0, b1 - arc)))
                     * clamp(1.5 - 120.0 * gap_aa, 0.3, 1.0) * mix(1.0, 0.5, smoothstep(0.1, 0.5, h));
-    // Scalloped gum line: papillae reach down between the crowns, arcs over each.
-    float gum_edge = mix(0.62, 0.56, lower) + 0.16 * (1.0 - sin(PI * w));
+    // Scalloped gum line: arched rootward over each crown, papillae reaching toward the
+    // biting edge between crowns.
+    float gum_edge = mix(0.58, 0.52, lower) + 0.16 * sin(PI * w);
     float gum = smoothstep(gum_edge - 0.03, gum_edge + 0.03, max(h, 2.0 * lingual));  // the crowns are ~4 mm thick
     // Ivory enamel: bluish translucent at the edge, warmer toward the neck where dentin shows,
     // each crown rounded (brighter mid-crown), a little variation tooth to tooth.
@@ -306,9 +307,9 @@ void main() {
     float groove = 1.0 - 0.35 * exp(-across * across / 0.012) * smoothstep(0.05, 0.3, along);
     float papillae = 0.85 + 0.3 * value_noise(v_uv * vec2(40.0, 60.0), 0);
     vec3 albedo = u_albedo * vec3(0.85, 0.72, 0.76) * papillae * groove;
-    // The tongue lies in the mouth's shadow: lit at the tip, dark toward the throat and at its
-    // sides against the teeth.
-    float mouth_shade = mix(0.85, 0.03, smoothstep(0.0, 0.22, along)) * mix(1.0, 0.5, smoothstep(0.4, 1.0, abs(across)));
+    // The tongue lies in the shadow of the lips and upper teeth: dim at the tip, dark toward
+    // the throat and at its sides against the teeth.
+    float mouth_shade = mix(0.55, 0.03, smoothstep(0.0, 0.22, along)) * mix(1.0, 0.5, smoothstep(0.4, 1.0, abs(across)));
     vec3 spec = specular_light(n, v, 40.0) * 0.12 * papillae;
     radiance = (diffuse_light(n, vec3(0.3, 0.15, 0.1), 1.0) * 0.8 * albedo + spec) * mouth_shade;
 #endif
