@@ -160,3 +160,10 @@ def test_at_rest_the_lips_hide_the_teeth(face_of):
     face = face_of("ava")
     image, teeth, _ = _mouth_pixels(face, "registers", "0")
     assert teeth.sum() < 12   # at most a few pixels in the lips' parting line
+
+
+def test_the_muscle_engine_shows_the_same_teeth(face_of):
+    face = face_of("ava", "muscle")
+    image, teeth, _ = _mouth_pixels(face, "muscle", "10+25")
+    assert teeth.sum() > 30
+    assert np.median(_luminance(image[teeth])) > 130
