@@ -6,7 +6,13 @@ import pytest
 
 from facsim.head.mesh import REGIONS
 from facsim.head.mouth import (
-    LOWER_ROW_OFFSET, LOWER_TEETH, TONGUE, TONGUE_BELOW_TEETH, UPPER_TEETH, rest_mouth, teeth_coordinates,
+    LOWER_ROW_OFFSET,
+    LOWER_TEETH,
+    TONGUE,
+    TONGUE_BELOW_TEETH,
+    UPPER_TEETH,
+    rest_mouth,
+    teeth_coordinates,
     tongue_coordinates,
 )
 
@@ -135,12 +141,12 @@ def _luminance(pixels):
 
 def test_a_smile_shows_white_ivory_upper_teeth(face_of):
     face = face_of("ava")
-    image, teeth, cavity = _mouth_pixels(face, "registers", "6+12+25")
+    image, teeth, _ = _mouth_pixels(face, "registers", "6+12+25")
     assert teeth.sum() > 120
     shown = image[teeth]
     top = np.sort(_luminance(shown))[-teeth.sum() // 3:]
     assert top.mean() > 185            # white, not a grey band
-    r, g, b = shown.mean(axis=0)
+    r, _, b = shown.mean(axis=0)
     assert r >= b and r - b < 45       # ivory: warm but not yellow
     # A band of crowns several pixels tall, not a thin white line.
     rows = np.nonzero(teeth)[0]
@@ -158,7 +164,7 @@ def test_open_mouths_show_teeth_brighter_than_the_cavity(face_of, expression):
 
 def test_at_rest_the_lips_hide_the_teeth(face_of):
     face = face_of("ava")
-    image, teeth, _ = _mouth_pixels(face, "registers", "0")
+    _, teeth, _ = _mouth_pixels(face, "registers", "0")
     assert teeth.sum() < 12   # at most a few pixels in the lips' parting line
 
 
