@@ -52,7 +52,7 @@ def test_the_tongue_rests_in_the_floor_of_the_mouth(face_of):
     from facsim.head.character import apply_targets, character_weights
 
     raw = apply_targets(data.base_vertices, data, character_weights(face.character, set(data.target_names)))
-    np.testing.assert_allclose(rest_mouth(raw, data), face.base_positions, atol=1e-6)
+    np.testing.assert_allclose(rest_mouth(raw, data, age=face.character.age), face.base_positions, atol=1e-6)
     assert raw[data.group_vertices(TONGUE), 1].max() > face.base_positions[data.group_vertices(TONGUE), 1].max() + 0.03
     tongue = face.base_positions[data.group_vertices(TONGUE)]
     lower = face.base_positions[data.group_vertices(LOWER_TEETH)]
@@ -65,6 +65,18 @@ def test_the_tongue_rests_in_the_floor_of_the_mouth(face_of):
     along = tongue_coordinates(face.head, face.data, face.base_positions)[_groups(face)["tongue"]]
     assert along[:, 0].min() == pytest.approx(-1) and along[:, 0].max() == pytest.approx(1)
     assert along[:, 1].min() == pytest.approx(0) and along[:, 1].max() == pytest.approx(1)
+
+
+def test_older_faces_rest_their_upper_teeth_higher(face_of):
+    face = face_of("ava")
+    data = face.data
+    upper, lower = data.group_vertices(UPPER_TEETH), data.group_vertices(LOWER_TEETH)
+    overlap = {}
+    for age in (25.0, 45.0, 70.0):
+        rested = rest_mouth(face.base_positions, data, age=age)
+        overlap[age] = float(rested[lower, 1].max() - rested[upper, 1].min())   # how far the rows overlap
+        np.testing.assert_array_equal(rested[lower], face.base_positions[lower])
+    assert overlap[25.0] > overlap[45.0] > overlap[70.0]
 
 
 @pytest.mark.parametrize("engine", ENGINES)

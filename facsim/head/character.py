@@ -244,7 +244,8 @@ def character_positions(character: Character, data) -> np.ndarray:
     (:func:`facsim.head.mouth.rest_mouth`)."""
     from facsim.head.mouth import rest_mouth
 
-    return rest_mouth(apply_targets(data.base_vertices, data, character_weights(character, set(data.target_names))), data)
+    return rest_mouth(apply_targets(data.base_vertices, data, character_weights(character, set(data.target_names))), data,
+                      age=character.age)
 
 
 # ------------------------------------------------------------------ presets

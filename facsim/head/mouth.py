@@ -27,11 +27,15 @@ LOWER_ROW_OFFSET = 4.0
 #: tongue fills the closed mouth up to the palate, so an open mouth showed a pink mound
 #: above the lower teeth; a relaxed tongue lies in the floor of the mouth, behind them.
 TONGUE_BELOW_TEETH = 0.012
-#: The upper teeth rest this far (dm) lower than hm08 puts them. hm08 hides the upper
-#: incisors 1 mm above the lips' meeting line, so a mouth that opened by the jaw alone
-#: (26, 27; the muscle engine's lips) showed no upper teeth; a relaxed adult shows 1–3 mm
-#: of them below the upper lip once the lips part (more in the young, less with age).
+#: The upper teeth rest this far (dm) lower than hm08 puts them, in young adults. hm08
+#: hides the upper incisors 1 mm above the lips' meeting line, so a mouth that opened by
+#: the jaw alone (26, 27) showed no upper teeth; a relaxed young adult shows 2–3 mm of them
+#: below the upper lip once the lips part. The display shrinks with age as the upper lip
+#: lengthens (Vig & Brundo 1978: from ~3.4 mm under 30 to ~0 past 60), so the drop fades
+#: out between the ages in :data:`UPPER_TEETH_DROP_AGES`: older faces show less upper and
+#: relatively more lower teeth, one of the cues that reads as age.
 UPPER_TEETH_DROP = 0.015
+UPPER_TEETH_DROP_AGES = (30.0, 60.0)
 #: Radius (dm, in plan) within which a tooth vertex's biting edge and root row are looked
 #: up: a column's rows lie within 3 mm of each other, columns 5–8 mm apart.
 COLUMN_REACH = 0.035
@@ -40,9 +44,10 @@ COLUMN_REACH = 0.035
 LINGUAL_REACH = 0.05
 
 
-def rest_mouth(base_positions: np.ndarray, data) -> np.ndarray:
+def rest_mouth(base_positions: np.ndarray, data, *, age: float = 25.0) -> np.ndarray:
     """Base positions (19158, 3) with the mouth's parts at rest: the upper teeth lowered by
-    :data:`UPPER_TEETH_DROP` and the tongue lowered into the floor of the mouth.
+    :data:`UPPER_TEETH_DROP` (less with ``age`` in years) and the tongue lowered into the
+    floor of the mouth.
 
     The tongue is squashed toward its underside (about its lowest point) until its top
     sits :data:`TONGUE_BELOW_TEETH` under the lower incisors' edge; its tip and sides
@@ -51,7 +56,8 @@ def rest_mouth(base_positions: np.ndarray, data) -> np.ndarray:
     with the skull and the jaw as they carry hm08's own.
     """
     out = np.array(base_positions, np.float32, copy=True)
-    out[data.group_vertices(UPPER_TEETH), 1] -= UPPER_TEETH_DROP
+    young, old = UPPER_TEETH_DROP_AGES
+    out[data.group_vertices(UPPER_TEETH), 1] -= UPPER_TEETH_DROP * float(np.clip((old - age) / (old - young), 0.0, 1.0))
     tongue = data.group_vertices(TONGUE)
     lower = data.group_vertices(LOWER_TEETH)
     y = out[tongue, 1]
