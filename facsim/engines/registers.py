@@ -184,7 +184,33 @@ class RegisterEngine:
         positions = self.head.positions(morphed, neutral_base=self.base_positions,
                                         eye_rotations=self.rigid.eye_rotations(act))
         positions = self.guard(positions)
-        return Deformation(self.rigid.move_head(positions, act))
+        skin = positions[: self.head.skin_vertex_count]
+        return Deformation(self.rigid.move_head(positions, act), creases=lambda: self._creases(skin))
+
+    def _creases(self, skin: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Skin compression (N_geo,) and furrow phase (N_geo,) of deformed skin positions.
+
+        The same field as the muscle engine's (:func:`~facsim.engines.muscle.wrinkles.wrinkle_field`):
+        the authored targets move the skin but carry no furrows, so the creases FACS
+        describes (glabellar furrows in 4, crow's feet in 6, forehead lines in 1+2,
+        the wrinkled nose of 9) come from where the targets compress the skin.
+        """
+        from facsim.engines.muscle.wrinkles import wrinkle_field
+
+        strength, phase = wrinkle_field(self.wrinkles, np.asarray(skin, np.float64))
+        wrinkle, crease_phase = (np.zeros(self.head.vertex_count, np.float32) for _ in range(2))
+        wrinkle[: len(skin)] = strength
+        crease_phase[: len(skin)] = phase
+        return wrinkle, crease_phase
+
+    @cached_property
+    def wrinkles(self):
+        """The wrinkle model of this character's skin (built on first use, a fraction of a second)."""
+        from facsim.engines.muscle.net import anatomy, build_net, load_spec
+        from facsim.engines.muscle.wrinkles import build_wrinkles
+
+        spec, anat = load_spec(), anatomy(self.head)
+        return build_wrinkles(anat, build_net(self.head, self.base_positions, anat=anat, spec=spec), spec)
 
     @cached_property
     def guard(self) -> SkinGuard:

@@ -323,10 +323,14 @@ def _sphincter(b: _Builder, m: dict, index: int, side: str, midline: bool):
         cx, cy = ring["centre"]
         a, r = ring["radii"]
         count = ring["count"]
-        angles = 2 * np.pi * np.arange(count) / count
+        if "arc" in ring:  # part of the ellipse, from one angle to another (degrees, 0 = lateral, 90 = up)
+            angles = np.radians(np.linspace(*ring["arc"], count))
+            closed = False
+        else:
+            angles = 2 * np.pi * np.arange(count) / count
+            closed = ring.get("closed", True)
         sels = [{"front": [cx + a * np.cos(t), cy + r * np.sin(t)]} for t in angles]
         radius = ring.get("radius", 0.04)
-        closed = ring.get("closed", True)
     else:
         sels, radius, closed = m["chain"], m.get("radius", 0.03), False
     # The anchored ends are bone points; the rest are muscle points under skin heads.

@@ -39,6 +39,7 @@ class WrinkleModel:
     rest: np.ndarray            # (N, 3) rest positions (phase of the furrow pattern)
     wavelength: np.ndarray      # (N,) furrow spacing
     zone_gain: np.ndarray       # (N,) how readily the skin creases there (deep forehead lines, fine crow's feet)
+    across_gain: np.ndarray     # (N,) the same for vertical furrows (skin squeezed sideways) where zones differ
     straight: np.ndarray        # (N,) 1 where lines run straight across the face (forehead, glabella)
     on_face: np.ndarray         # (N,) 1 on the outer skin, 0 inside the lips and lids
     crease: np.ndarray          # (N,) extra depth along anatomical folds (0 = none, 1 = twice as deep)
@@ -81,12 +82,14 @@ def build_wrinkles(anat: Anatomy, net: TensionNet, spec: dict) -> WrinkleModel:
     # Furrow spacing per zone (drawn per pixel by the renderer, so it may be finer than the mesh).
     wavelength = np.full(n, float(w["wavelength"]))
     zone_gain = np.ones(n)
+    across_gain = np.ones(n)
     straight = np.zeros(n)
     base = anat.base[: anat.skin_count]
     for zone in w.get("zones", []):
         weight = _blob(zone, base)
         wavelength = wavelength * (1 - weight) + zone["wavelength"] * weight
         zone_gain = zone_gain * (1 - weight) + zone.get("gain", 1.0) * weight
+        across_gain = across_gain * (1 - weight) + zone.get("across_gain", zone.get("gain", 1.0)) * weight
         if zone.get("straight"):
             straight = np.maximum(straight, weight)
     wavelength = wavelength * net.scale
@@ -109,7 +112,7 @@ def build_wrinkles(anat: Anatomy, net: TensionNet, spec: dict) -> WrinkleModel:
     integrate = spla.factorized((incidence.T @ incidence + 1e-4 * sp.identity(n)).tocsc())
     return WrinkleModel(
         triangles=tri, rest_inverse=inv, rest_frame=frame, to_vertex=to_vertex.tocsr(), rest=rest,
-        wavelength=wavelength, zone_gain=zone_gain, straight=np.clip(straight * 2.0, 0.0, 1.0), crease=crease,
+        wavelength=wavelength, zone_gain=zone_gain, across_gain=across_gain, straight=np.clip(straight * 2.0, 0.0, 1.0), crease=crease,
         on_face=on_face,
         gain=float(w["gain"]), threshold=float(w["threshold"]), exponent=float(w["exponent"]),
         smooth=smooth.tocsr(), passes=int(w.get("smoothing", 2)),
@@ -193,7 +196,11 @@ def wrinkle_field(model: WrinkleModel, positions: np.ndarray) -> tuple[np.ndarra
     snapped = np.where(np.abs(v_dir[:, 1:2]) >= np.abs(v_dir[:, 0:1]), [[0.0, 1.0, 0.0]], [[1.0, 0.0, 0.0]])
     along = (1 - model.straight)[:, None] * v_dir + model.straight[:, None] * snapped
     phase = _furrow_phase(model, along)
-    out = model.gain * model.zone_gain * strength * model.on_face * (1.0 + model.crease)
+    # Squeezed sideways the skin makes vertical furrows; zones may crease less that way (the
+    # forehead's deep lines are horizontal: drawn together, brows furrow the glabella, not the brow).
+    sideways = along[:, 0] ** 2 / np.maximum((along ** 2).sum(1), 1e-12)
+    gain = model.zone_gain * (1.0 - sideways) + model.across_gain * sideways
+    out = model.gain * gain * strength * model.on_face * (1.0 + model.crease)
     return np.clip(out, 0.0, 2.0).astype(np.float32), phase.astype(np.float32)
 
 
