@@ -28,7 +28,8 @@ def read_ply(path):
 def test_ply_holds_the_deformed_frame_in_metres(tmp_path, face_of):
     face = face_of("ava")
     props, vertices, faces, header = read_ply(write_mesh(face, "6+12", tmp_path / "smile.ply"))
-    assert props == ["x", "y", "z", "nx", "ny", "nz"]                   # registers: no wrinkle
+    assert props == ["x", "y", "z", "nx", "ny", "nz", "wrinkle"]        # both engines crease the skin
+    assert vertices[:, 6].max() > 0.3                                   # 6+12: crow's feet, nasolabial fold
     expected = np.asarray(face.engine.deform(Activations({(c, s): 1.0 for c in (6, 12) for s in ("left", "right")})).positions)
     assert np.abs(vertices[:, :3] - expected * 0.1).max() < 1e-6
     assert np.allclose(np.linalg.norm(vertices[:, 3:6], axis=1), 1, atol=1e-4)
@@ -47,7 +48,7 @@ def test_obj_is_standard_with_uvs_normals_and_region_groups(tmp_path, face_of):
                      "f": len(topo.faces), "g": 6}
     assert "g skin" in lines and "g eyeball" in lines
     first_v = next(line for line in lines if line.startswith("v "))
-    assert len(first_v.split()) == 4                                    # no wrinkle colour without one
+    assert len(first_v.split()) == 7                                    # the wrinkle as a vertex colour
     skin_face = lines[lines.index("g skin") + 1]
     assert skin_face.count("/") == 6 and "//" not in skin_face
 
