@@ -122,12 +122,18 @@ def test_muscle_data_is_consistent(model):
 
 
 def test_improved_muscles_bend_over_bone(model):
-    """Zygomaticus major and frontalis pass through intermediate muscle points (Platt & Badler fig. 5)."""
+    """Frontalis passes through intermediate muscle points (Platt & Badler fig. 5); zygomaticus
+    major bends over a pulley fixed on the cheekbone (issue 13: a pulley riding the skin let
+    AU 6 re-aim the smile)."""
     layer = model.layer
-    for name in ("zygomaticus_major_left", "frontalis_medial_left"):
-        k = layer.names.index(name)
-        segs = np.flatnonzero(layer.seg_muscle == k)
-        assert ((layer.seg_a[segs] >= 0) & (layer.seg_b[segs] >= 0)).any(), name  # muscle point → muscle point
+    k = layer.names.index("frontalis_medial_left")
+    segs = np.flatnonzero(layer.seg_muscle == k)
+    assert ((layer.seg_a[segs] >= 0) & (layer.seg_b[segs] >= 0)).any()  # muscle point → muscle point
+    k = layer.names.index("zygomaticus_major_left")
+    segs = np.flatnonzero(layer.seg_muscle == k)
+    assert len(segs) == 2                                                # origin → pulley → insertion
+    assert layer.seg_a[segs[0]] < 0 and layer.seg_b[segs[0]] < 0        # the pulley is bone
+    assert layer.seg_b[segs[1]] >= 0                                    # the insertion a muscle point
 
 
 def test_coverage_lists_every_facial_action(engine):
