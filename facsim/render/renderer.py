@@ -480,7 +480,8 @@ class Renderer:
         for name, _, _ in self._draws:
             self._program(self._variant(name))  # compiled before the camera's uniforms are set
         self._set_camera(camera, lighting or self.lighting)
-        self._content_box = self._screen_box([p] + [np.asarray(d.positions, np.float32) for d in proxies])
+        if self.aa_method == "fxaa":
+            self._content_box = self._screen_box([p] + [np.asarray(d.positions, np.float32) for d in proxies])
         self._lap("vertices")
         self._prepare_proxies(proxies, camera, lighting or self.lighting)
         self._lap("proxies")
@@ -594,9 +595,9 @@ class Renderer:
         are drawn over the head's depth pre-pass. The kept pixels are drawn when the
         camera, lights and hair colour are those of the last frame and at most
         :data:`HAIR_KEPT_MOVING` of the cards moved since; they are used while the cards
-        outside the moving set stay where they were. The only pixels that could differ from
-        drawing everything are exact depth ties between a card and the skin (the skin wins
-        either way) or between two cards.
+        outside the moving set stay where they were. Pixels that can differ from drawing
+        everything: the kept cards' shading, which the moving cards shift by a level or two
+        (the hair's volume normals look at every card), and exact depth ties between cards.
         """
         layers = self._hair_layers()
         if not layers or not self._in_sequence:
