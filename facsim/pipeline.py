@@ -12,10 +12,19 @@ PosixPath('happy.mp4')
 """
 from __future__ import annotations
 
+import os
+import sys
+import threading
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Iterator
 
 import numpy as np
+
+#: Frames below which deforming in a second process does not pay for starting it.
+FORKED_MIN_FRAMES = 8
+#: Frames the forked engine may run ahead of the drawing (a 512² frame's geometry is ~0.25 MB).
+LOOKAHEAD = 64
 
 
 def render_frame(face, expression=None, **render_options) -> np.ndarray:
@@ -48,6 +57,11 @@ def animate(timeline, path, *, face=None, character=None, engine=None, fps: floa
     -------
     Path of the finished file.
 
+    Speed: the engine runs a few frames ahead in a forked child where that is safe (see
+    :func:`deformations`), and the renderer keeps hair that holds still as pixels for the
+    length of the video (see :meth:`Renderer.sequence <facsim.render.renderer.Renderer.sequence>`).
+    ``benchmarks/bench_video.py`` measures the 3-s stimulus video end to end and per stage.
+
     A timeline with speech tracks gets their sound (unless ``audio`` is given):
     AAC in MP4, Opus in WebM, a WAV beside PNG frames (``frames/`` → ``frames.wav``);
     GIFs have no sound.
@@ -69,10 +83,10 @@ def animate(timeline, path, *, face=None, character=None, engine=None, fps: floa
     try:
         if speech is not None and video_format(path) in ("mp4", "webm"):
             audio = speech.name
-        with VideoWriter(path, fps, audio=audio, cut_audio=speech is None) as writer:
-            engine = face.start_animation()
-            for i, act in enumerate(frames):
-                writer.append(face.render(deformation=engine.step(act), **render_options))
+        with VideoWriter(path, fps, audio=audio, cut_audio=speech is None) as writer, \
+                deformations(face, frames) as stream, face.renderer(**render_options).sequence():
+            for i, deformation in enumerate(stream):
+                writer.append(face.render(deformation=deformation, **render_options))
                 if on_frame is not None:
                     on_frame(i + 1, len(frames))
         if speech is not None and writer.format == "png":     # PNG frames: the sound goes beside them
@@ -87,6 +101,98 @@ def animate(timeline, path, *, face=None, character=None, engine=None, fps: floa
             face.close()
         if speech is not None:
             speech.close()
+
+
+@contextmanager
+def deformations(face, frames) -> Iterator[Iterator]:
+    """The face's engine stepped through ``frames`` (Activations): an iterator of Deformations.
+
+    Deforming and drawing take turns in one process: on llvmpipe the GL threads wait while
+    Python deforms the next frame, and Python waits while they draw. Where it is safe, the
+    engine runs in a forked child instead, up to :data:`LOOKAHEAD` frames ahead of the
+    drawing (the child is a copy of this process, so it starts at once and computes exactly
+    what this process would; it deforms while this process starts its renderer, and while
+    llvmpipe draws). It is safe on Linux before this process has made its GL context (EGL does
+    not survive a fork) and with no other Python thread running; elsewhere, and with
+    ``FACSIM_SERIAL_FRAMES=1`` in the environment, frames are deformed here as they are drawn.
+    """
+    forked = (len(frames) >= FORKED_MIN_FRAMES and sys.platform.startswith("linux")
+              and os.environ.get("FACSIM_SERIAL_FRAMES", "") in ("", "0") and threading.active_count() == 1)
+    if forked:
+        from facsim.render.gl import context_exists
+
+        forked = not context_exists()
+    if not forked:
+        engine = face.start_animation()
+        yield (engine.step(act) for act in frames)
+        return
+    import multiprocessing
+
+    ctx = multiprocessing.get_context("fork")
+    queue = ctx.Queue(maxsize=LOOKAHEAD)
+    child = ctx.Process(target=_deform_frames, args=(face, frames, queue), daemon=True, name="facsim-deform")
+    child.start()
+    try:
+        yield _received(queue, len(frames), child)
+    finally:
+        if child.is_alive():  # stopped early (an error, a signal), or finishing: nothing to keep
+            child.join(timeout=0.5)
+            if child.is_alive():
+                child.kill()
+        child.join()
+        queue.close()
+        queue.cancel_join_thread()
+
+
+def _deform_frames(face, frames, queue) -> None:
+    """The forked child: put each frame's (positions, wrinkle, crease_phase), then None or an error.
+
+    Signals get their default actions back: the parent's handlers (the CLI's, which report and
+    clean up) are the parent's business, and Ctrl-C in a terminal reaches both processes.
+    """
+    import signal
+
+    for name in ("SIGINT", "SIGTERM", "SIGHUP"):
+        if hasattr(signal, name):
+            signal.signal(getattr(signal, name), signal.SIG_DFL)
+    try:
+        engine = face.start_animation()
+        for act in frames:
+            d = engine.step(act)
+            queue.put((d.positions, d.wrinkle, d.crease_phase))
+        queue.put(None)
+    except BaseException as exc:  # noqa: BLE001 — handed to the parent, which raises it
+        import pickle
+
+        try:
+            pickle.dumps(exc)
+        except Exception:  # noqa: BLE001 — an exception that does not pickle: its type and message
+            exc = RuntimeError(f"{type(exc).__name__}: {exc}")
+        queue.put(("error", exc))
+
+
+def _received(queue, count: int, child) -> Iterator:
+    import queue as queues
+
+    from facsim.engines.base import Deformation
+
+    def take():
+        while True:
+            try:
+                return queue.get(timeout=1.0)
+            except queues.Empty:
+                if not child.is_alive():
+                    raise RuntimeError(f"the deformation process stopped (exit code {child.exitcode})") from None
+
+    for i in range(count + 1):
+        item = take()
+        if isinstance(item, tuple) and len(item) == 2 and item[0] == "error":
+            raise item[1]
+        if (item is None) != (i == count):
+            raise RuntimeError(f"the deformation process sent {i} of {count} frames")
+        if item is not None:
+            positions, wrinkle, phase = item
+            yield Deformation(positions, creases=None if wrinkle is None else (lambda w=wrinkle, p=phase: (w, p)))
 
 
 def _speech_audio(timeline, fps):

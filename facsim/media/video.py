@@ -166,8 +166,10 @@ class VideoWriter:
         self._log = tempfile.TemporaryFile()
         # A session of its own: Ctrl-C in a terminal stops facsim, which then stops ffmpeg and
         # removes the temporary file, rather than ffmpeg dying first with a broken pipe.
-        return subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=self._log,
-                                start_new_session=True)
+        encoder = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=self._log,
+                                   start_new_session=True)
+        _widen_pipe(encoder.stdin, width * height * 4)
+        return encoder
 
     def _failure(self) -> Exception:
         """The error to raise when ffmpeg failed: its exit status and the last line it wrote."""
@@ -236,6 +238,19 @@ class VideoWriter:
             self.close()
         else:
             self.abort()
+
+
+def _widen_pipe(pipe, frame_bytes: int) -> None:
+    """Let the pipe to ffmpeg hold a whole frame (Linux; 64 KiB by default), so handing a frame
+    over returns at once and the next frame is drawn while ffmpeg encodes this one."""
+    try:
+        import fcntl
+
+        with open("/proc/sys/fs/pipe-max-size") as f:
+            limit = int(f.read())
+        fcntl.fcntl(pipe.fileno(), 1031, min(frame_bytes, limit))  # F_SETPIPE_SZ
+    except (ImportError, OSError, ValueError):  # not Linux, or not allowed: the default pipe works
+        pass
 
 
 def count_frames(path) -> int:

@@ -32,6 +32,12 @@ def gl_context():
         return _CTX
 
 
+def context_exists() -> bool:
+    """Whether this process has created its OpenGL context (a process that has must not fork:
+    the child's EGL would hang)."""
+    return _CTX is not None and _CTX_PID == os.getpid()
+
+
 def _create_context():
     import moderngl
 

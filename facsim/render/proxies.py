@@ -170,6 +170,12 @@ class ProxyLayer:
         self.texture.filter = (ctx.LINEAR_MIPMAP_LINEAR, ctx.LINEAR)
         self.programs, self.vaos = {}, {}
         self._last = None  # (camera position, vertex positions) of the last upload
+        self.look: tuple = ()  # (linear colour, sheen) of this frame
+        self._camera_uniforms: tuple = ()  # (view-projection, lights) the programs hold
+        self._vertex_triangles = np.asarray(mesh.corner_vertex)[self._triangles]  # ... over vertices
+        self._order = np.arange(len(self._triangles))  # back to front, as last sorted
+        # A subset of the triangles (front to back) for callers that keep part of the pass as pixels.
+        self._ibo["SUBSET"] = track(ctx.buffer(reserve=max(self._triangles.nbytes, 12), dynamic=True))
         for stage in ("OPAQUE", "BLEND"):
             defines = {f"PASS_{stage}": "", f"KIND_{mesh.kind.upper()}": "", "ALPHA_CUTOFF": f"{ALPHA_CUTOFF:.3f}"}
             prog = track(ctx.program(vertex_shader=_shader_source("proxy.vert.glsl", defines),
@@ -180,6 +186,10 @@ class ProxyLayer:
                 prog, [(self._vbo, "3f 3f 3f 1f", "in_pos", "in_normal", "in_tangent", "in_depth"),
                        (self._uv, "2f", "in_uv")],
                 index_buffer=self._ibo[stage], index_element_size=4, skip_errors=True))
+        self.vaos["SUBSET"] = track(ctx.vertex_array(
+            self.programs["OPAQUE"], [(self._vbo, "3f 3f 3f 1f", "in_pos", "in_normal", "in_tangent", "in_depth"),
+                                      (self._uv, "2f", "in_uv")],
+            index_buffer=self._ibo["SUBSET"], index_element_size=4, skip_errors=True))
 
     def update(self, draw: ProxyDraw, camera_position: np.ndarray) -> None:
         """Upload this frame's vertices, sorting triangles back to front for the blended pass."""
@@ -189,9 +199,11 @@ class ProxyLayer:
                              f"got {positions.shape}")
         camera_position = np.asarray(camera_position, np.float32)
         color = tuple(float(x) for x in srgb_to_linear(draw.color))
-        for prog in self.programs.values():
-            _set_uniform(prog, "u_color", color)
-            _set_uniform(prog, "u_sheen", float(draw.sheen))
+        if self.look != (color, float(draw.sheen)):
+            self.look = (color, float(draw.sheen))
+            for prog in self.programs.values():
+                _set_uniform(prog, "u_color", color)
+                _set_uniform(prog, "u_sheen", float(draw.sheen))
         # Hair mostly sits still (only 51-58 and the brow skin move it): skip the upload and
         # the sort when nothing moved since the last frame.
         if (self._last is not None and np.array_equal(self._last[0], camera_position)
@@ -213,8 +225,23 @@ class ProxyLayer:
         order = np.argsort(-np.einsum("ij,ij->i", centres, centres), kind="stable")
         self._ibo["BLEND"].write(self._triangles[order].tobytes())
         self._ibo["OPAQUE"].write(self._triangles[order[::-1]].tobytes())
+        self._order = order
+
+    @property
+    def positions(self) -> np.ndarray | None:
+        """The vertex positions drawn (as last uploaded; replaced, never changed in place)."""
+        return None if self._last is None else self._last[1]
+
+    def moved_triangles(self, reference: np.ndarray) -> np.ndarray:
+        """(T,) bool: triangles with a vertex not where it is in ``reference`` (V, 3)."""
+        moved = np.any(self.positions != reference, axis=1)
+        return moved[self._vertex_triangles].any(axis=1)
 
     def set_uniforms(self, vp_bytes: bytes, lights: dict) -> None:
+        key = (vp_bytes, tuple(lights.items()))
+        if key == self._camera_uniforms:  # a video's camera and lights hold still
+            return
+        self._camera_uniforms = key
         for prog in self.programs.values():
             try:
                 prog["u_view_proj"].write(vp_bytes)
@@ -223,6 +250,17 @@ class ProxyLayer:
             for name, value in lights.items():
                 _set_uniform(prog, name, value)
 
-    def draw(self, stage: str) -> None:
+    def draw(self, stage: str, triangles: np.ndarray | None = None) -> None:
+        """Draw one pass (``"OPAQUE"`` or ``"BLEND"``); ``triangles``, a (T,) bool mask,
+        limits the alpha-tested pass to some triangles (still front to back)."""
         self.texture.use(1)
-        self.vaos[stage].render(self.ctx.TRIANGLES, vertices=3 * len(self._triangles))
+        if triangles is None:
+            self.vaos[stage].render(self.ctx.TRIANGLES, vertices=3 * len(self._triangles))
+            return
+        if stage != "OPAQUE":
+            raise ValueError("only the alpha-tested pass draws a subset of the triangles")
+        front_to_back = self._order[::-1]
+        picked = self._triangles[front_to_back[triangles[front_to_back]]]
+        if len(picked):
+            self._ibo["SUBSET"].write(np.ascontiguousarray(picked).tobytes())
+            self.vaos["SUBSET"].render(self.ctx.TRIANGLES, vertices=3 * len(picked))

@@ -40,6 +40,8 @@ Examples
 """
 from __future__ import annotations
 
+from contextlib import contextmanager
+
 import numpy as np
 
 from facsim.render.camera import Camera, projection_matrix, view_matrix, _size_pair
@@ -73,6 +75,14 @@ void main() { gl_Position = u_view_proj * vec4(in_pos, 1.0); }
 _DEPTH_FRAGMENT = """#version 330 core
 void main() {}
 """
+
+#: Largest share of the hair's cards that may move from frame to frame for the rest to be
+#: kept as pixels (a facial expression moves a few sideburn cards; head motion moves all).
+HAIR_KEPT_MOVING = 0.25
+
+#: Pixels around the drawn geometry's screen box that FXAA still filters (it reads one
+#: pixel around each pixel; the rest of the frame is copied as it is).
+CONTENT_MARGIN = 3
 
 #: Smallest image side (pixels, after supersampling) at which skin pores are shaded.
 PORES_MIN_SIZE = 1024
@@ -179,6 +189,9 @@ class Renderer:
             raise ValueError(f"antialias (supersampling factor) must be 1..4, got {antialias}")
         self.antialias = antialias
 
+        #: Seconds spent per stage of :meth:`render` as ``{stage: (wall, CPU of every thread)}``
+        #: while this is a dict (set it to ``{}`` to profile; None, the default, measures nothing).
+        self.timings: dict | None = None
         self.cull_backfaces = bool(cull_backfaces)
         # The hair's blended fringe (the soft wisps at the hairline) costs ~10-15 % of a 512²
         # video frame on llvmpipe; without it the hairline is a hard cut-out edge, so it stays
@@ -206,6 +219,13 @@ class Renderer:
         self._appearance = None
         self._proxy_layers: dict = {}  # ProxyMesh -> ProxyLayer, created on first use
         self._proxy_draws: tuple = ()
+        # The hair's alpha-tested pass, kept as pixels (colour + depth) while the hair holds
+        # still (see _prepare_hair_layer).
+        self._in_sequence = False  # frames of one video (see sequence())
+        self._hair_fbo = None
+        self._hair_kept = None    # {"key", "positions", "moving"} of the kept pixels
+        self._hair_last = None    # (key, positions) of the last frame's hair
+        self._hair_moving = None  # this frame: {layer: cards drawn over the kept pixels}, or None
         self._eyes = region_components(topology, "eyeball")
         self._lashes = region_components(topology, "lashes")
         self._lash_vertices = (np.concatenate(self._lashes) if self._lashes
@@ -301,6 +321,9 @@ class Renderer:
         self._detail_tex = None
         self._depth_vao = self._depth_prog = None
         self._vp_bytes = b""
+        self._lights: dict = {}
+        self._camera_uniforms: dict = {}  # program name -> (view-projection, lights) it holds
+        self._content_box = None
         self._rebuild_draws()
 
         w, h = self.size
@@ -320,6 +343,9 @@ class Renderer:
             self._scene_tex = self._track(ctx.texture((w * k, h * k), 4))
             # Never mipmapped (a render target); FXAA reads between texels.
             self._scene_tex.filter = (ctx.LINEAR, ctx.LINEAR) if self.aa_method == "fxaa" else (ctx.NEAREST, ctx.NEAREST)
+            # FXAA reads around each pixel: at the frame's edge it must see that edge, not the
+            # opposite one (a repeating texture smeared the neck into the top row).
+            self._scene_tex.repeat_x = self._scene_tex.repeat_y = False
             self._scene_fbo = self._track(ctx.framebuffer(
                 color_attachments=[self._scene_tex],
                 depth_attachment=self._track(ctx.depth_renderbuffer((w * k, h * k)))))
@@ -427,6 +453,7 @@ class Renderer:
         """
         if self._closed:
             raise RenderError("this Renderer is closed")
+        self._lap(None)
         if not isinstance(appearance, Appearance):
             raise TypeError(f"appearance must be an Appearance, got {type(appearance).__name__}")
         if not isinstance(camera, Camera):
@@ -453,9 +480,62 @@ class Renderer:
         for name, _, _ in self._draws:
             self._program(self._variant(name))  # compiled before the camera's uniforms are set
         self._set_camera(camera, lighting or self.lighting)
+        if self.aa_method == "fxaa":
+            self._content_box = self._screen_box([p] + [np.asarray(d.positions, np.float32) for d in proxies])
+        self._lap("vertices")
         self._prepare_proxies(proxies, camera, lighting or self.lighting)
+        self._lap("proxies")
         self._draw()
-        return self._read()
+        self._lap("draw")
+        self._resolve()
+        self._lap("antialias")
+        image = self._read()
+        self._lap("readback")
+        return image
+
+    def _lap(self, stage: str | None) -> None:
+        """With :attr:`timings` a dict, add the time since the last lap to ``stage`` (None: start).
+
+        Each lap waits for the GL work issued so far (``finish``), so the stages are
+        measured apart but not overlapped: for profiling (benchmarks/bench_video.py), not
+        for speed.
+        """
+        if self.timings is None:
+            return
+        import time
+
+        if stage is not None:
+            self._ctx.finish()
+        now = (time.perf_counter(), time.process_time())
+        if stage is not None:
+            wall, cpu = self.timings.get(stage, (0.0, 0.0))
+            self.timings[stage] = (wall + now[0] - self._lap_start[0], cpu + now[1] - self._lap_start[1])
+        self._lap_start = now
+
+    def _screen_box(self, point_sets) -> tuple[int, int, int, int] | None:
+        """(x, y, width, height), GL pixel coordinates, of a box around everything drawn, with
+        :data:`CONTENT_MARGIN` pixels to spare; None where it would be the whole image."""
+        w, h = self.size
+        vp = np.frombuffer(self._vp_bytes, np.float32).reshape(4, 4)  # transposed (column-major)
+        lo, hi = np.array([np.inf, np.inf]), np.array([-np.inf, -np.inf])
+        for points in point_sets:
+            if not len(points):
+                continue
+            clip = points @ vp[:3] + vp[3]
+            if not (clip[:, 3] > 1e-6).all():  # behind the camera: no box
+                return None
+            xy = clip[:, :2] / clip[:, 3:4]
+            lo, hi = np.minimum(lo, xy.min(axis=0)), np.maximum(hi, xy.max(axis=0))
+        if not np.isfinite(lo).all():
+            return None
+        x0, y0 = np.floor((lo * 0.5 + 0.5) * (w, h)).astype(int) - CONTENT_MARGIN
+        x1, y1 = np.ceil((hi * 0.5 + 0.5) * (w, h)).astype(int) + CONTENT_MARGIN
+        x0, y0, x1, y1 = max(x0, 0), max(y0, 0), min(x1, w), min(y1, h)
+        if x1 <= x0 or y1 <= y0:
+            return (0, 0, 0, 0)
+        if (x0, y0, x1, y1) == (0, 0, w, h):
+            return None
+        return int(x0), int(y0), int(x1 - x0), int(y1 - y0)
 
     def _prepare_proxies(self, proxies, camera: Camera, lighting: Lighting) -> None:
         from facsim.render.proxies import ProxyDraw, ProxyLayer
@@ -467,14 +547,103 @@ class Renderer:
                 self._proxy_layers[draw.mesh] = ProxyLayer(self._ctx, draw.mesh, self._track)
         self._proxy_draws = tuple(proxies)
         if not proxies:
+            self._hair_last, self._hair_moving = None, None
             return
-        w, h = self.size
-        vp_bytes = (projection_matrix(camera, w / h) @ view_matrix(camera)).T.astype(np.float32).tobytes()
-        lights = lighting.world_uniforms(camera)
+        vp_bytes, lights = self._vp_bytes, self._lights  # this frame's (see _set_camera)
+        position = camera.position
         for draw in proxies:
             layer = self._proxy_layers[draw.mesh]
-            layer.update(draw, camera.position)
+            layer.update(draw, position)
             layer.set_uniforms(vp_bytes, lights)
+        self._prepare_hair_layer(vp_bytes, lights)
+
+    @contextmanager
+    def sequence(self):
+        """Render the frames of one video in this ``with`` block (the renderer is yielded).
+
+        Within it, hair that holds still from frame to frame is kept as pixels instead of
+        being drawn again (see :meth:`_prepare_hair_layer`): the kept cards keep the shading of
+        the frame they were drawn in, which the motion of a few other cards (sideburns over a
+        smiling cheek) changes by a level or two of 255 at most. Each sequence starts afresh,
+        so a video does not depend on what the renderer drew before it, and a single
+        :meth:`render` outside a sequence draws everything.
+        """
+        self._forget_hair()
+        self._in_sequence = True
+        try:
+            yield self
+        finally:
+            self._in_sequence = False
+            self._forget_hair()
+
+    def _forget_hair(self) -> None:
+        self._hair_kept = self._hair_last = self._hair_moving = None
+
+    def _hair_layers(self) -> list:
+        return [self._proxy_layers[d.mesh] for d in self._proxy_draws if d.mesh.kind == "hair"]
+
+    def _prepare_hair_layer(self, vp_bytes: bytes, lights: dict) -> None:
+        """Keep the hair's alpha-tested pass as pixels while the hair holds still.
+
+        Hair moves with the head (AUs 51-58), the face's shape and the camera; a facial
+        expression moves only the few cards bound to skin that moves (sideburns over the
+        cheeks). The alpha-tested pass of the cards that hold still (the costliest proxy
+        pass on llvmpipe) does not depend on the face, so it is drawn once into a frame
+        buffer of its own, without the head's depth, and each frame starts from a copy of
+        it (colour and depth) instead of a clear; the cards that moved are drawn over it,
+        then the head hides what it covers by the depth test, as it does when all cards
+        are drawn over the head's depth pre-pass. The kept pixels are drawn when the
+        camera, lights and hair colour are those of the last frame and at most
+        :data:`HAIR_KEPT_MOVING` of the cards moved since; they are used while the cards
+        outside the moving set stay where they were. Pixels that can differ from drawing
+        everything: the kept cards' shading, which the moving cards shift by a level or two
+        (the hair's volume normals look at every card), and exact depth ties between cards.
+        """
+        layers = self._hair_layers()
+        if not layers or not self._in_sequence:
+            self._hair_last, self._hair_moving = None, None
+            return
+        key = (vp_bytes, tuple(sorted(lights.items())), tuple((id(layer), layer.look) for layer in layers))
+        now = {layer: layer.positions for layer in layers}
+        kept = self._hair_kept
+        moving = None
+        if kept is not None and kept["key"] == key:
+            moved = {layer: layer.moved_triangles(kept["positions"][layer]) for layer in layers}
+            if not any((moved[layer] & ~kept["moving"][layer]).any() for layer in layers):
+                moving = kept["moving"]
+        if self._hair_last is not None and self._hair_last[0] == key:
+            moved = {layer: layer.moved_triangles(self._hair_last[1][layer]) for layer in layers}
+            redraw = None
+            if all(m.mean() <= HAIR_KEPT_MOVING for m in moved.values()):
+                if moving is None:
+                    redraw = moved
+                    if kept is not None and kept["key"] == key:  # once moving, a card is kept out...
+                        redraw = {layer: moved[layer] | kept["moving"][layer] for layer in layers}
+                elif not any(m.any() for m in moved.values()) and any(m.any() for m in moving.values()):
+                    redraw = moved  # ... until every card holds still (an expression's apex)
+            if redraw is not None:
+                self._draw_hair_layer(layers, redraw)
+                self._hair_kept = kept = {"key": key, "positions": now, "moving": redraw}
+                moving = redraw
+        self._hair_last = (key, now)
+        self._hair_moving = moving
+
+    def _draw_hair_layer(self, layers, moving: dict) -> None:
+        """The alpha-tested pass of the hair cards not in ``moving``, into the kept frame buffer."""
+        ctx = self._ctx
+        if self._hair_fbo is None:
+            scene = self._scene_fbo
+            size, samples = scene.size, scene.samples
+            self._hair_fbo = self._track(ctx.framebuffer(
+                color_attachments=[self._track(ctx.renderbuffer(size, 4, samples=samples))],
+                depth_attachment=self._track(ctx.depth_renderbuffer(size, samples=samples))))
+        fbo = self._hair_fbo
+        fbo.use()
+        self._clear(fbo)
+        ctx.enable_only(ctx.DEPTH_TEST)
+        ctx.depth_func = "<"
+        for layer in layers:
+            layer.draw("OPAQUE", ~moving[layer])
 
     def _draw_head_depth(self, fbo) -> None:
         """Depth only (colour writes off, a trivial shader) of the culled, closed groups."""
@@ -495,13 +664,18 @@ class Renderer:
         fbo.color_mask = (True, True, True, True)
         ctx.disable(ctx.CULL_FACE)
 
-    def _draw_proxies_opaque(self) -> None:
+    def _draw_proxies_opaque(self, hair_moving: dict | None = None) -> None:
         """Proxy cards' alpha-tested pass. Drawn before the head, so the skin hidden under
-        the hair fails the depth test before it is shaded (on llvmpipe shading is the cost)."""
+        the hair fails the depth test before it is shaded (on llvmpipe shading is the cost).
+        With ``hair_moving``, only those hair cards (the rest is in the kept pixels)."""
         ctx = self._ctx
         ctx.disable(ctx.CULL_FACE)
         for draw in self._proxy_draws:
-            self._proxy_layers[draw.mesh].draw("OPAQUE")
+            layer = self._proxy_layers[draw.mesh]
+            if hair_moving is None or draw.mesh.kind != "hair":
+                layer.draw("OPAQUE")
+            elif hair_moving[layer].any():
+                layer.draw("OPAQUE", hair_moving[layer])
         if self._paint_tex is not None:
             self._paint_tex.use(0)
 
@@ -514,8 +688,12 @@ class Renderer:
         ctx.enable(ctx.BLEND)
         ctx.blend_func = (ctx.SRC_ALPHA, ctx.ONE_MINUS_SRC_ALPHA, ctx.ONE, ctx.ONE_MINUS_SRC_ALPHA)
         fbo.depth_mask = False
+        # Strictly in front: a card's own alpha-tested fragments (the depth they wrote) fail
+        # the test before the shader fetches their texture only to discard them.
+        ctx.depth_func = "<"
         for layer in layers:
             layer.draw("BLEND")
+        ctx.depth_func = "<="  # what the head's groups after the proxies use
         fbo.depth_mask = True
         ctx.disable(ctx.BLEND)
         if self._paint_tex is not None:
@@ -555,8 +733,12 @@ class Renderer:
         vp = projection_matrix(camera, w / h) @ view_matrix(camera)
         vp_bytes = vp.T.astype(np.float32).tobytes()  # GLSL matrices are column-major
         self._vp_bytes = vp_bytes
-        lights = lighting.world_uniforms(camera)
-        for prog in self._programs.values():
+        lights = self._lights = lighting.world_uniforms(camera)
+        key = (vp_bytes, tuple(lights.items()))
+        for name, prog in self._programs.items():
+            if self._camera_uniforms.get(name) == key:  # a video's camera and lights hold still
+                continue
+            self._camera_uniforms[name] = key
             try:
                 prog["u_view_proj"].write(vp_bytes)
             except KeyError:
@@ -567,13 +749,14 @@ class Renderer:
     def _draw(self) -> None:
         ctx = self._ctx
         fbo = self._scene_fbo
+        kept = self._hair_moving is not None and bool(self._proxy_draws)
+        if kept:
+            ctx.copy_framebuffer(fbo, self._hair_fbo)  # the background with the still hair on it
         fbo.use()
         ctx.enable_only(ctx.DEPTH_TEST)
         ctx.depth_func = "<"
-        if self.background is None:
-            fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
-        else:
-            fbo.clear(*self.background, 1.0, depth=1.0)
+        if not kept:
+            self._clear(fbo)
         if self._paint_tex is not None:
             self._paint_tex.use(0)
         if self._detail_tex is not None:
@@ -583,8 +766,11 @@ class Renderer:
             # Depth of the closed head first (no shading), so hair behind the head fails the
             # depth test; then the hair's alpha-tested cards, so the skin under the hair does;
             # then the head, shaded only where it shows.
-            self._draw_head_depth(fbo)
-            self._draw_proxies_opaque()
+            if kept:  # still hair already there: the head hides it where it is in front
+                self._draw_proxies_opaque(self._hair_moving)
+            else:
+                self._draw_head_depth(fbo)
+                self._draw_proxies_opaque()
             ctx.depth_func = "<="
         proxies_drawn = not self._proxy_draws
         for name, first, count in self._draws:
@@ -607,13 +793,30 @@ class Renderer:
         fbo.depth_mask = True
         ctx.depth_func = "<"
         ctx.disable(ctx.BLEND | ctx.CULL_FACE)
+
+    def _resolve(self) -> None:
+        """The drawn scene into the output image: FXAA, supersampling's filter or the MSAA resolve."""
+        ctx = self._ctx
         if self._downsample is not None:
+            box = self._content_box if self.aa_method == "fxaa" else None
+            if box is not None:
+                # FXAA leaves a pixel as it is where its neighbours match it: everywhere
+                # further than a pixel from what was drawn. Copy the frame, filter only the box.
+                ctx.copy_framebuffer(self._out_fbo, self._scene_fbo)
             self._out_fbo.use()
             ctx.disable(ctx.DEPTH_TEST)
+            self._out_fbo.scissor = box
             self._scene_tex.use(0)
             self._downsample.render(ctx.TRIANGLES, vertices=3)
+            self._out_fbo.scissor = None
         elif self._out_fbo is not self._scene_fbo:
             ctx.copy_framebuffer(self._out_fbo, self._scene_fbo)
+
+    def _clear(self, fbo) -> None:
+        if self.background is None:
+            fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+        else:
+            fbo.clear(*self.background, 1.0, depth=1.0)
 
     def _read(self) -> np.ndarray:
         w, h = self.size

@@ -1,0 +1,118 @@
+"""The video frame loop's shortcuts give the frames that drawing everything, in order, gives.
+
+- still hair kept as pixels between the frames of a video (renderer), redrawn when the head
+  moves, never outside a video;
+- FXAA over the drawn geometry's box only;
+- the engine stepped in a forked child a frame ahead of the drawing (pipeline).
+"""
+from __future__ import annotations
+
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+
+SIZE = 128
+
+
+def _renderer(face):
+    from facsim.render.renderer import Renderer
+
+    return Renderer(face.topology, size=SIZE, antialias=1, aa_method="fxaa", background=(1.0, 1.0, 1.0))
+
+
+def _frame(renderer, face, expression):
+    d = face.deform(expression)
+    positions = np.asarray(d.positions, np.float32)
+    return renderer.render(positions, appearance=face.appearance, camera=face.camera(size=(SIZE, SIZE)),
+                           wrinkle=d.wrinkle, crease_phase=d.crease_phase, occlusion=face.shading_occlusion,
+                           proxies=face.proxy_draws(positions))
+
+
+def test_kept_hair_gives_the_frame_drawing_everything_gives(face_of):
+    face = face_of("ava")
+    with _renderer(face) as r:
+        with r.sequence():
+            for expression in ("12@10%", "12@20%", "6+12@30%", "6+12@40%"):
+                kept = _frame(r, face, expression)
+            assert r._hair_moving is not None, "a smile moves a few sideburn cards: the rest should be kept"
+            assert 0 < r._hair_moving[next(iter(r._hair_moving))].mean() < 0.25
+        for expression in ("12@10%", "12@20%", "6+12@30%", "6+12@40%"):  # not a video: every frame in full
+            full = _frame(r, face, expression)
+            assert r._hair_moving is None
+    with _renderer(face) as fresh:
+        assert np.array_equal(_frame(fresh, face, "6+12@40%"), full)
+    diff = np.abs(kept.astype(int) - full.astype(int)).max(axis=2)
+    # The kept cards keep the shading of the frame they were drawn in; the sideburns' motion moves
+    # the hair volume's centre by a hair, which changes that shading by at most a level or two.
+    assert diff.max() <= 3 and (diff > 0).mean() < 0.01
+
+
+def test_head_motion_redraws_all_hair(face_of):
+    face = face_of("ava")
+    with _renderer(face) as r, r.sequence():
+        for expression in ("51@20%", "51@40%", "51@60%"):
+            _frame(r, face, expression)
+        assert r._hair_moving is None
+        _frame(r, face, "51@60%")  # the head holds still: the hair is kept again
+        assert r._hair_moving is not None
+
+
+def test_fxaa_filters_the_drawn_box_and_copies_the_rest_exactly(face_of, monkeypatch):
+    from facsim.render.renderer import Renderer
+
+    face = face_of("kwame")
+    with _renderer(face) as r:
+        boxed = _frame(r, face, "12")
+        x, y, w, h = r._content_box
+        assert w * h < 0.9 * SIZE * SIZE
+        monkeypatch.setattr(Renderer, "_screen_box", lambda self, point_sets: None)
+        whole = _frame(r, face, "12")
+    assert np.array_equal(boxed, whole)
+    assert (boxed[0, :, :3] == 255).all(), "the top row is background: FXAA must not wrap the neck around"
+
+
+FORKED = textwrap.dedent("""
+    import multiprocessing, os
+    import numpy as np
+    from facsim.face import Face
+    from facsim.pipeline import deformations
+    from facsim.timeline.builders import stimulus_timeline
+    from facsim.timeline.sampling import sample_frames
+
+    face = Face("ava")
+    frames = sample_frames(stimulus_timeline("happiness", 0.2, 0.1, 0.2, 30), 30)
+    with deformations(face, frames) as stream:
+        forked = [d.positions for d in stream]
+        assert multiprocessing.active_children(), "expected the engine in a child process"
+    os.environ["FACSIM_SERIAL_FRAMES"] = "1"
+    with deformations(face, frames) as stream:
+        serial = [d.positions for d in stream]
+        assert not multiprocessing.active_children()
+    assert len(forked) == len(serial) == len(frames)
+    assert all(np.array_equal(a, b) for a, b in zip(forked, serial))
+    del os.environ["FACSIM_SERIAL_FRAMES"]
+
+    class Broken:
+        def start_animation(self):
+            raise ValueError("no engine for this face")
+
+    try:
+        with deformations(Broken(), frames) as stream:
+            list(stream)
+    except ValueError as exc:
+        assert "no engine for this face" in str(exc)
+    else:
+        raise AssertionError("the child's error did not reach the parent")
+    print("ok")
+""")
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="frames are deformed in a forked child on Linux")
+def test_forked_engine_gives_the_serial_frames_and_its_errors():
+    # A fresh process: this one may already hold a GL context, where forking is refused.
+    done = subprocess.run([sys.executable, "-c", FORKED], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.strip().endswith("ok")
