@@ -75,8 +75,8 @@ def periorbital_density(positions: np.ndarray) -> np.ndarray:
 def translucency_density(positions: np.ndarray) -> np.ndarray:
     """Thin tissue: the ears (rims most), the nose's wings and tip."""
     ears = blob(positions, (0.74, 7.1, 0.72), (0.13, 0.34, 0.3))
-    nose = (0.55 * blob(positions, (0.15, 6.88, 1.5), (0.06, 0.06, 0.1))
-            + 0.4 * blob(positions, (0.0, 6.95, 1.68), (0.08, 0.08, 0.1)))
+    nose = (0.3 * blob(positions, (0.15, 6.88, 1.5), (0.06, 0.06, 0.1))
+            + 0.2 * blob(positions, (0.0, 6.95, 1.68), (0.08, 0.08, 0.1)))
     return np.clip(ears + nose, 0, 1).astype(np.float32)
 
 

@@ -100,6 +100,9 @@ def shade_texture(texture: np.ndarray) -> np.ndarray:
     solid = alpha > 128
     mean = float(lum[solid].mean()) if solid.any() else float(lum.mean())
     rel = np.clip(lum / max(mean, 1.0), 0.4, 1.6) * 0.5
+    # Transparent texels' colour is arbitrary (often white): toward the edge of the strands,
+    # fade to the mean, so filtering never draws light outlines around the cards.
+    rel = 0.5 + (rel - 0.5) * (alpha.astype(np.float32) / 255.0)
     out = np.empty(texture.shape, np.uint8)
     out[..., 0] = np.clip(rel * 255 + 0.5, 0, 255).astype(np.uint8)
     # The direction field is smooth: found at half resolution (4x cheaper), then repeated.
@@ -240,9 +243,6 @@ class ProxyLayer:
         self.texture = track(ctx.texture((tex.shape[1], tex.shape[0]), 4, tex.tobytes()))
         self.texture.build_mipmaps()  # an input texture, never rendered into
         self.texture.filter = (ctx.LINEAR_MIPMAP_LINEAR, ctx.LINEAR)
-        # Clamp, never wrap: hair caps put their roots (a parting) at the texture's top edge,
-        # and wrapping would filter in the tips from the bottom edge there, a light seam.
-        self.texture.repeat_x = self.texture.repeat_y = False
         self.programs, self.vaos = {}, {}
         self._last = None  # (camera position, vertex positions) of the last upload
         for stage in ("OPAQUE", "BLEND"):

@@ -81,14 +81,17 @@ void main() {
     vec3 h = normalize(u_key_dir + v);
     // Roots at the parting lie in the outer strands' shadow: little highlight there, so the
     // two sides' different strand directions do not draw a line along it.
-    float gate = smoothstep(0.3, 0.6, kl) * mix(0.35, 1.0, smoothstep(0.0, 0.5, v_depth));
+    // Where a card's corner tangents disagree (opposite signs), the interpolated tangent
+    // shrinks and its direction means nothing: no highlight there (else a bright outline).
+    float gate = smoothstep(0.3, 0.6, kl) * mix(0.35, 1.0, smoothstep(0.0, 0.5, v_depth))
+               * smoothstep(0.6, 0.9, length(v_tangent));
     float th1 = dot(normalize(t + (0.08 + jitter) * n), h);
     float th2 = dot(normalize(t + (-0.12 + jitter) * n), h);
     float s1 = max(1.0 - th1 * th1, 1e-6);   // sin^2
     float s2 = max(1.0 - th2 * th2, 1e-6);
     float sparkle = smoothstep(0.45, 0.75, fine);
-    vec3 spec = u_key_col * gate * (0.22 * exp2(60.0 * log2(s1))
-                                    + 0.55 * sparkle * u_color * exp2(12.0 * log2(s2)));
+    vec3 spec = u_key_col * gate * (0.13 * exp2(70.0 * log2(s1))
+                                    + 0.5 * sparkle * u_color * exp2(12.0 * log2(s2)));
 #else
     vec3 spec = vec3(0.0);
 #endif
