@@ -90,3 +90,19 @@ def test_hair_is_shaded_without_a_seam_at_its_parting(face_of):
     finally:
         for obj in (layer.texture, *layer.programs.values(), *layer.vaos.values()):
             obj.release()
+
+
+def test_hair_shadows_the_forehead_under_a_fringe_not_the_chin(face_of, head, marks):
+    from facsim.head.proxies import hair_shadow
+
+    face = face_of("liam")
+    hair = next(b for b in face.proxies if b.proxy.kind == "hair").binding.positions(face.neutral)
+    skin = face.neutral[head.skin]
+    shade = hair_shadow(skin, hair)
+    no_cast = hair_shadow(skin, hair, cast=0.0)
+    glabella, chin = face.neutral[marks["glabella"]], face.neutral[marks["chin"]]
+    upper_forehead = (skin[:, 1] > glabella[1] + 0.35) & (skin[:, 2] > glabella[2] - 0.3) & (np.abs(skin[:, 0]) < 0.3)
+    assert upper_forehead.sum() > 10
+    assert (shade[upper_forehead] < no_cast[upper_forehead] - 0.05).mean() > 0.3  # the fringe's shadow
+    near_chin = np.linalg.norm(skin - chin, axis=1) < 0.2
+    assert np.all(shade[near_chin] == 1.0)

@@ -156,6 +156,13 @@ void main() {
     // Mottling at two scales so large areas are not a flat plastic colour; stronger with age.
     float mottle = 0.6 * value_noise(v_uv * 150.0, 0) + 0.4 * value_noise(v_uv * 600.0 + 17.0, 0);
     vec3 albedo = u_skin * (1.0 + vec3(0.07, 0.09, 0.10) * (1.0 + 1.5 * u_age) * (mottle - 0.5));
+    // Skin grain a few pixels across at 512²: pores and fine lines averaged, which keep both
+    // the colour and the sheen from reading as a smooth plastic surface. Faded to its mean
+    // where it would be finer than a pixel.
+    vec2 grain_uv = v_uv * vec2(350.0, 700.0);
+    float grain = mix(0.5, value_noise(grain_uv, 0),
+                      clamp(2.0 - 1.2 * max(fwidth(grain_uv.x), fwidth(grain_uv.y)), 0.0, 1.0));
+    albedo *= 1.0 + vec3(0.05, 0.07, 0.07) * (grain - 0.5);
     // Regional colour: redder nose, cheeks and ears (blood close to the surface); darker,
     // cooler skin around the eyes (thin skin over vessels and muscle), more so with age;
     // a shaved beard's blue-grey shadow.
@@ -223,7 +230,7 @@ void main() {
     float oil = detail.b * (1.0 - 0.35 * u_age);
     vec3 broad = specular_light(bumped, v, mix(10.0, 16.0, oil)) * mix(0.35, 0.8, oil);
     vec3 tight = blinn(bumped, u_key_dir, v, mix(45.0, 90.0, lips)) * u_key_col * mix(mix(0.08, 1.3, oil * oil), 1.8, lips);
-    vec3 spec = (broad + tight) * fres * (1.0 - hair);
+    vec3 spec = (broad + tight) * fres * (1.0 - hair) * (0.5 + grain);
     radiance = (diffuse + spec * occ) * cavity;
 #endif
 

@@ -90,7 +90,7 @@ void main() {
     float s1 = max(1.0 - th1 * th1, 1e-6);   // sin^2
     float s2 = max(1.0 - th2 * th2, 1e-6);
     float sparkle = smoothstep(0.45, 0.75, fine);
-    vec3 spec = u_key_col * gate * (0.13 * exp2(70.0 * log2(s1))
+    vec3 spec = u_key_col * gate * (0.09 * exp2(70.0 * log2(s1))
                                     + 0.5 * sparkle * u_color * exp2(12.0 * log2(s2)));
 #else
     vec3 spec = vec3(0.0);
