@@ -154,24 +154,24 @@ void main() {
     vec4 detail = texture(u_detail, v_uv);
     vec4 tone = texture(u_tone, v_uv);   // periorbital, translucency, pores, sun
     // Mottling at two scales so large areas are not a flat plastic colour; stronger with age.
-    float mottle = 0.6 * value_noise(v_uv * 150.0, 0) + 0.4 * value_noise(v_uv * 600.0 + 17.0, 0);
-    vec3 albedo = u_skin * (1.0 + vec3(0.07, 0.09, 0.10) * (1.0 + 1.5 * u_age) * (mottle - 0.5));
-    // Skin grain a few pixels across at 512²: pores and fine lines averaged, which keep both
-    // the colour and the sheen from reading as a smooth plastic surface. Faded to its mean
-    // where it would be finer than a pixel.
+    // The fine scale is skin grain a few pixels across at 512² (pores and fine lines,
+    // averaged), faded to its mean where it would be finer than a pixel; it also breaks up
+    // the sheen below. (hm08's paint box is twice as long in v as in u, hence the 1:2
+    // frequencies: round cells.)
     vec2 grain_uv = v_uv * vec2(350.0, 700.0);
     float grain = mix(0.5, value_noise(grain_uv, 0),
                       clamp(2.0 - 1.2 * max(fwidth(grain_uv.x), fwidth(grain_uv.y)), 0.0, 1.0));
-    albedo *= 1.0 + vec3(0.05, 0.07, 0.07) * (grain - 0.5);
+    float blotch = value_noise(v_uv * vec2(150.0, 300.0), 0);
+    float mottle = 0.6 * blotch + 0.4 * grain;
+    vec3 albedo = u_skin * (1.0 + vec3(0.08, 0.1, 0.11) * (1.0 + 1.5 * u_age) * (mottle - 0.5));
     // Regional colour: redder nose, cheeks and ears (blood close to the surface); darker,
     // cooler skin around the eyes (thin skin over vessels and muscle), more so with age;
     // a shaved beard's blue-grey shadow.
     albedo *= mix(vec3(1.0), vec3(1.05, 0.80, 0.77), 0.7 * detail.r);
     albedo *= mix(vec3(1.0), vec3(0.80, 0.72, 0.76), tone.r * (0.55 + 0.45 * u_age));
     albedo = mix(albedo, albedo * vec3(0.70, 0.72, 0.78), u_beard * detail.g * (1.0 - paint.g));
-    // Age spots: sparse, soft tan patches where the sun reaches, growing with age. (hm08's
-    // paint box is twice as long in v as in u, hence the 1:2 frequencies: round cells.)
-    float spot = smoothstep(0.7, 0.86, value_noise(v_uv * vec2(220.0, 440.0) + 41.0, 0)) * tone.a * u_age;
+    // Age spots: sparse, soft tan patches where the sun reaches, growing with age.
+    float spot = smoothstep(0.72, 0.9, blotch) * tone.a * u_age;
     albedo *= mix(vec3(1.0), vec3(0.86, 0.76, 0.66), spot);
     albedo = mix(albedo, u_cheek, paint.a);
     albedo = mix(albedo, u_eyelid, paint.b);
@@ -215,11 +215,10 @@ void main() {
     lit.gb = mix(lit.gb, diffuse_light(bumped, 0.5 * wrap, occ).gb, 0.6);
 #endif
     vec3 diffuse = lit * albedo;
-    // Translucency: thin ears and nose wings glow red where the rim or key light comes from
-    // behind them.
+    // Translucency: thin ears and nose wings glow red where the rim light comes from behind
+    // them.
     float back_rim = clamp(dot(v, -normalize(u_rim_dir + 0.4 * n)), 0.0, 1.0);
-    float back_key = clamp(dot(v, -normalize(u_key_dir + 0.4 * n)), 0.0, 1.0);
-    vec3 glow = (back_rim * back_rim * u_rim_col + back_key * back_key * u_key_col) * occ;
+    vec3 glow = back_rim * back_rim * u_rim_col * occ;
     diffuse += tone.g * 0.55 * glow * u_skin * vec3(1.0, 0.42, 0.3);
     // Specular in two lobes, as skin has: a broad one from the rough horny layer and a tight
     // one from the oil film, which the T-zone (detail.b) has most and the cheeks little; the
@@ -228,7 +227,10 @@ void main() {
     float fres = schlick(0.028, ndv);
     float lips = paint.g;
     float oil = detail.b * (1.0 - 0.35 * u_age);
-    vec3 broad = specular_light(bumped, v, mix(10.0, 16.0, oil)) * mix(0.35, 0.8, oil);
+    // (The fill is too weak to show in a broad lobe: key and rim only.)
+    float broad_shine = mix(10.0, 16.0, oil);
+    vec3 broad = (blinn(bumped, u_key_dir, v, broad_shine) * u_key_col
+                  + blinn(bumped, u_rim_dir, v, broad_shine) * u_rim_col) * mix(0.35, 0.8, oil);
     vec3 tight = blinn(bumped, u_key_dir, v, mix(45.0, 90.0, lips)) * u_key_col * mix(mix(0.08, 1.3, oil * oil), 1.8, lips);
     vec3 spec = (broad + tight) * fres * (1.0 - hair) * (0.5 + grain);
     radiance = (diffuse + spec * occ) * cavity;

@@ -54,11 +54,15 @@ void main() {
     // (tex.gb, from its structure tensor; e.g. a ponytail's crown), the breakup fades out
     // rather than cross the strands (proxies.py sets u_along_v = 1 for textures running
     // along v throughout).
+#ifdef PASS_OPAQUE
     float along_v = max(u_along_v, smoothstep(0.75, 0.92, abs(tex.b * 2.0 - 1.0)));
     vec2 sp = v_uv * vec2(420.0, 5.0);
     float fine = mix(0.5, value_noise(sp, 0), along_v * clamp(1.8 - 1.6 * fwidth(sp.x), 0.0, 1.0));
     vec2 cp = v_uv * vec2(60.0, 1.2) + 7.0;
     float clump = mix(0.5, value_noise(cp, 0), along_v * clamp(2.0 - 1.5 * fwidth(cp.x), 0.0, 1.0));
+#else
+    float fine = 0.5, clump = 0.5;   // the thin fringe: too sparse for the breakup to show
+#endif
     // The texture's strand brightness with more contrast than the 512² source gives alone.
     albedo = u_color * (0.45 + 1.1 * tex.r) * (0.72 + 0.56 * fine) * (0.8 + 0.4 * clump);
     // Self-shadowing: layers near the scalp lie under the outer ones, the gaps between clumps
