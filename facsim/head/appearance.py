@@ -192,7 +192,7 @@ def character_appearance(character: Character, head, *, blush: float | None = No
     age = float(np.clip((character.age - 32) / 45, 0, 1))
     return Appearance(colors=colors, paint=paint_texture(head, round(blush, 3), painted_brows),
                       detail=detail_texture(head), beard=round(beard, 3), age=round(age, 3),
-                      tone=tone_texture(head))
+                      tone=tone_texture(head, position_map))
 
 
 DETAIL_SIZE = (1024, 512)  # rows (v), columns (u) over assets.PAINT_UV_BOX

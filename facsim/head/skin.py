@@ -18,6 +18,7 @@ The maps depend on the base mesh only, so they are computed once and cached on d
 from __future__ import annotations
 
 from functools import lru_cache
+from typing import Callable
 
 import numpy as np
 
@@ -32,16 +33,25 @@ EYE_CENTRE = (0.308, 7.284, 1.245)
 
 
 @lru_cache(maxsize=2)
-def tone_texture(head) -> np.ndarray:
-    """(rows, cols, 4) uint8: periorbital darkening, translucency, pore strength, sun exposure."""
-    return cached_array(cache_dir() / f"skin-tone-v{TONE_VERSION}.npy", lambda: _build_tone(head),
+def tone_texture(head, position_map: Callable) -> np.ndarray:
+    """(rows, cols, 4) uint8: periorbital darkening, translucency, pore strength, sun exposure.
+
+    ``position_map(head)`` gives the base-mesh position (rows, cols, 3) at each texel of
+    the paint box, NaN or far away off the mesh (:func:`facsim.head.appearance.position_map`).
+    """
+    return cached_array(cache_dir() / f"skin-tone-v{TONE_VERSION}.npy",
+                        lambda: build_tone(position_map(head)),
                         valid=lambda a: a.shape == (*TONE_SIZE, 4) and a.dtype == np.uint8)
 
 
-def _build_tone(head) -> np.ndarray:
-    from facsim.head.appearance import _resize, position_map
+def build_tone(positions: np.ndarray) -> np.ndarray:
+    """The tone maps at base-mesh ``positions`` (rows, cols, 3), resampled to :data:`TONE_SIZE`."""
+    positions = np.asarray(positions, np.float32)
+    if positions.shape[:2] != TONE_SIZE:
+        from scipy.ndimage import zoom
 
-    positions = _resize(position_map(head), TONE_SIZE)
+        factors = (TONE_SIZE[0] / positions.shape[0], TONE_SIZE[1] / positions.shape[1], 1)
+        positions = zoom(positions, factors, order=1)
     channels = (periorbital_density(positions), translucency_density(positions),
                 pore_density(positions), sun_density(positions))
     tone = np.empty((*TONE_SIZE, 4), np.uint8)
