@@ -306,7 +306,7 @@ def hair_shadow(skin_positions: np.ndarray, hair_positions: np.ndarray, *, stren
     toward = np.array([0.0, 0.75, 0.66]) / np.hypot(0.75, 0.66)
     steps = np.linspace(0.06, 0.6, 10)
     blocked = np.zeros(len(skin_positions), np.float64)
-    for step in steps:
+    for step in steps if cast > 0 else ():
         near, _ = tree.query(skin_positions + step * toward, k=1)
         blocked += smoothstep(0.12, 0.05, near)
     shadow = 1.0 - cast * np.clip(blocked / 3.0, 0.0, 1.0)

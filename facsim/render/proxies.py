@@ -86,9 +86,10 @@ class ProxyDraw:
     sheen: float = 1.0
 
 
-def shade_texture(texture: np.ndarray) -> np.ndarray:
+def shade_texture(texture: np.ndarray, *, directions: bool = False) -> np.ndarray:
     """RGBA for upload: R = brightness relative to the mean strand (0.5 = mean), GB = the
-    strands' direction in UV (:func:`strand_directions`, as 0.5 + 0.5 (u, v)), A kept.
+    strands' direction in UV (:func:`strand_directions`, as 0.5 + 0.5 (u, v); with
+    ``directions=False``, along v everywhere), A kept.
 
     MakeHuman's hair textures are near-black strands; the colour comes from the character,
     so only the relative brightness (strand-to-strand variation) is kept. Rows are flipped
@@ -105,9 +106,11 @@ def shade_texture(texture: np.ndarray) -> np.ndarray:
     rel = 0.5 + (rel - 0.5) * (alpha.astype(np.float32) / 255.0)
     out = np.empty(texture.shape, np.uint8)
     out[..., 0] = np.clip(rel * 255 + 0.5, 0, 255).astype(np.uint8)
-    # The direction field is smooth: found at half resolution (4x cheaper), then repeated.
-    half = strand_directions(lum[::-1][::2, ::2], sigma=3.0)
-    direction = np.repeat(np.repeat(half, 2, axis=0), 2, axis=1)[: lum.shape[0], : lum.shape[1]][::-1]
+    if directions:  # the field is smooth: found at half resolution (4x cheaper), then repeated
+        half = strand_directions(lum[::-1][::2, ::2], sigma=3.0)
+        direction = np.repeat(np.repeat(half, 2, axis=0), 2, axis=1)[: lum.shape[0], : lum.shape[1]][::-1]
+    else:
+        direction = np.broadcast_to(np.array([0.0, 1.0], np.float32), (*lum.shape, 2))
     out[..., 1:3] = np.clip((0.5 + 0.5 * direction) * 255 + 0.5, 0, 255).astype(np.uint8)
     out[..., 3] = alpha
     return np.ascontiguousarray(out[::-1])
@@ -227,7 +230,7 @@ class ProxyLayer:
         # layers then fail the depth test before they are shaded), back to front for blending.
         self._ibo = {"OPAQUE": track(ctx.buffer(self._triangles.tobytes(), dynamic=True)),
                      "BLEND": track(ctx.buffer(self._triangles.tobytes(), dynamic=True))}
-        tex = shade_texture(np.asarray(mesh.texture))
+        tex = shade_texture(np.asarray(mesh.texture), directions=mesh.kind == "hair")
         # Strand direction in UV: most styles' textures run along v throughout (their
         # root bands' cross-wise features would only mislead the texture's own direction
         # field); where they do not (a ponytail's radiating crown), the field steers the
