@@ -22,6 +22,7 @@ from typing import Mapping
 
 from facsim.head.character import COLOR_NAMES, EXTRA_COLOR_NAMES, Character
 from facsim.head.colour import hex_to_rgb, linear_to_srgb, srgb_to_linear
+from facsim.head.skin import tone_texture
 from facsim.head.surface import smoothstep
 
 #: A plausible default appearance (light-medium skin, brown eyes), display sRGB.
@@ -64,6 +65,9 @@ class Appearance:
         0 … 1: how much the beard area shows a shaved stubble shadow.
     age : float
         0 … 1: how strongly the age lines of ``detail`` show (and the skin's mottling).
+    tone : (H, W, 4) uint8, optional
+        Skin tone maps in the same UV space and row order: R = periorbital darkening,
+        G = translucency, B = pore strength, A = sun exposure (see :mod:`facsim.head.skin`).
     """
 
     colors: Mapping[str, tuple[float, float, float]] = field(default_factory=lambda: DEFAULT_COLORS)
@@ -71,6 +75,7 @@ class Appearance:
     detail: np.ndarray | None = None
     beard: float = 0.0
     age: float = 0.0
+    tone: np.ndarray | None = None
 
     def __post_init__(self):
         colors = dict(self.colors)
@@ -96,6 +101,10 @@ class Appearance:
             detail = np.asarray(self.detail)
             if detail.ndim != 3 or detail.shape[2] != 4 or detail.dtype != np.uint8:
                 raise ValueError(f"detail must be an (H, W, 4) uint8 array, got {detail.dtype} {detail.shape}")
+        if self.tone is not None:
+            tone = np.asarray(self.tone)
+            if tone.ndim != 3 or tone.shape[2] != 4 or tone.dtype != np.uint8:
+                raise ValueError(f"tone must be an (H, W, 4) uint8 array, got {tone.dtype} {tone.shape}")
         for name in ("beard", "age"):
             value = float(getattr(self, name))
             if not 0.0 <= value <= 1.0:
@@ -182,7 +191,8 @@ def character_appearance(character: Character, head, *, blush: float | None = No
     beard = float(np.clip((character.gender - 0.5) * 2, 0, 1) * np.clip((character.age - 16) / 6, 0, 1)) * 0.8
     age = float(np.clip((character.age - 32) / 45, 0, 1))
     return Appearance(colors=colors, paint=paint_texture(head, round(blush, 3), painted_brows),
-                      detail=detail_texture(head), beard=round(beard, 3), age=round(age, 3))
+                      detail=detail_texture(head), beard=round(beard, 3), age=round(age, 3),
+                      tone=tone_texture(head, position_map))
 
 
 DETAIL_SIZE = (1024, 512)  # rows (v), columns (u) over assets.PAINT_UV_BOX

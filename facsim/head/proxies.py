@@ -283,17 +283,34 @@ def bind_character_proxies(character, head, base_positions, neutral_geometry, *,
     return out
 
 
-def hair_shadow(skin_positions: np.ndarray, hair_positions: np.ndarray, *, strength: float = 0.6) -> np.ndarray:
+def hair_shadow(skin_positions: np.ndarray, hair_positions: np.ndarray, *, strength: float = 0.6,
+                cast: float = 0.45) -> np.ndarray:
     """Ambient visibility factor (1 open … 1 - strength) per skin vertex under the hair.
 
     Skin within a few millimetres of hair cards is shadowed by them: the scalp shows
-    dark between strands and the forehead darkens softly under the hairline.
+    dark between strands and the forehead darkens softly under the hairline. Beyond that
+    contact shadow, hair that hangs over the skin toward the light (above and in front:
+    a fringe, the hairline's edge) casts a soft shadow of up to ``cast`` a little way down
+    the forehead and temples.
     """
     from scipy.spatial import cKDTree
 
-    distance = cKDTree(hair_positions).query(skin_positions, k=4)[0].mean(axis=1)
+    from facsim.head.surface import smoothstep
+
+    tree = cKDTree(hair_positions)
+    distance = tree.query(skin_positions, k=4)[0].mean(axis=1)
     t = np.clip((distance - 0.04) / (0.22 - 0.04), 0.0, 1.0)
-    return (1.0 - strength * (1.0 - t * t * (3 - 2 * t))).astype(np.float32)
+    contact = 1.0 - strength * (1.0 - t * t * (3 - 2 * t))
+    # March toward a light above and in front of the face (the studio key, averaged over
+    # left and right so the bake suits every view); count the steps that pass hair.
+    toward = np.array([0.0, 0.75, 0.66]) / np.hypot(0.75, 0.66)
+    steps = np.linspace(0.06, 0.6, 10)
+    blocked = np.zeros(len(skin_positions), np.float64)
+    for step in steps if cast > 0 else ():
+        near, _ = tree.query(skin_positions + step * toward, k=1)
+        blocked += smoothstep(0.12, 0.05, near)
+    shadow = 1.0 - cast * np.clip(blocked / 3.0, 0.0, 1.0)
+    return np.minimum(contact, shadow).astype(np.float32)
 
 
 # ------------------------------------------------------------------------- the cache

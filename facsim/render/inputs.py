@@ -62,13 +62,13 @@ class Lighting:
     """
 
     key_direction: tuple[float, float, float] = (-0.6, 0.55, 0.6)
-    key_color: tuple[float, float, float] = (1.3, 1.24, 1.15)
+    key_color: tuple[float, float, float] = (1.42, 1.35, 1.25)
     fill_direction: tuple[float, float, float] = (0.8, -0.05, 0.6)
-    fill_color: tuple[float, float, float] = (0.22, 0.21, 0.22)
+    fill_color: tuple[float, float, float] = (0.17, 0.165, 0.175)
     rim_direction: tuple[float, float, float] = (0.35, 0.55, -0.75)
     rim_color: tuple[float, float, float] = (0.55, 0.55, 0.58)
-    sky: tuple[float, float, float] = (0.22, 0.22, 0.23)
-    ground: tuple[float, float, float] = (0.11, 0.08, 0.065)
+    sky: tuple[float, float, float] = (0.18, 0.18, 0.19)
+    ground: tuple[float, float, float] = (0.095, 0.07, 0.057)
     exposure: float = 1.0
 
     def world_uniforms(self, camera: Camera) -> dict[str, tuple[float, ...]]:

@@ -86,8 +86,10 @@ class ProxyDraw:
     sheen: float = 1.0
 
 
-def shade_texture(texture: np.ndarray) -> np.ndarray:
-    """RGBA for upload: RGB = brightness relative to the mean strand (0.5 = mean), A kept.
+def shade_texture(texture: np.ndarray, *, directions: bool = False) -> np.ndarray:
+    """RGBA for upload: R = brightness relative to the mean strand (0.5 = mean), GB = the
+    strands' direction in UV (:func:`strand_directions`, as 0.5 + 0.5 (u, v); with
+    ``directions=False``, along v everywhere), A kept.
 
     MakeHuman's hair textures are near-black strands; the colour comes from the character,
     so only the relative brightness (strand-to-strand variation) is kept. Rows are flipped
@@ -99,10 +101,54 @@ def shade_texture(texture: np.ndarray) -> np.ndarray:
     solid = alpha > 128
     mean = float(lum[solid].mean()) if solid.any() else float(lum.mean())
     rel = np.clip(lum / max(mean, 1.0), 0.4, 1.6) * 0.5
+    # Transparent texels' colour is arbitrary (often white): toward the edge of the strands,
+    # fade to the mean, so filtering never draws light outlines around the cards.
+    rel = 0.5 + (rel - 0.5) * (alpha.astype(np.float32) / 255.0)
     out = np.empty(texture.shape, np.uint8)
-    out[..., :3] = np.clip(rel * 255 + 0.5, 0, 255).astype(np.uint8)[..., None]
+    out[..., 0] = np.clip(rel * 255 + 0.5, 0, 255).astype(np.uint8)
+    if directions:  # the field is smooth: found at half resolution (4x cheaper), then repeated
+        half = strand_directions(lum[::-1][::2, ::2], sigma=3.0)
+        direction = np.repeat(np.repeat(half, 2, axis=0), 2, axis=1)[: lum.shape[0], : lum.shape[1]][::-1]
+    else:
+        direction = np.broadcast_to(np.array([0.0, 1.0], np.float32), (*lum.shape, 2))
+    out[..., 1:3] = np.clip((0.5 + 0.5 * direction) * 255 + 0.5, 0, 255).astype(np.uint8)
     out[..., 3] = alpha
     return np.ascontiguousarray(out[::-1])
+
+
+def strand_directions(luminance: np.ndarray, *, sigma: float = 6.0) -> np.ndarray:
+    """(H, W, 2) unit strand direction (du, dv) per texel of a GL-order (row 0 = v = 0)
+    luminance image, from its structure tensor: strands run across the brightness gradient.
+
+    Hair textures do not all run along v (a ponytail's cap radiates from the crown), so the
+    strand shading reads the direction from the texture itself. Signs are chosen with
+    dv >= 0; where the texture has no clear direction, strands run along v.
+    """
+    from scipy.ndimage import gaussian_filter, sobel
+
+    lum = np.asarray(luminance, np.float32)
+    gu, gv = sobel(lum, axis=1), sobel(lum, axis=0)
+    juu, jvv, juv = (gaussian_filter(a, sigma) for a in (gu * gu, gv * gv, gu * gv))
+    # The gradient's mean orientation (doubled angle); strands run perpendicular to it.
+    c2, s2 = juu - jvv, 2.0 * juv
+    strength = np.hypot(c2, s2)
+    coherent = strength > 0.2 * (juu + jvv) + 1e-6
+    theta = 0.5 * np.arctan2(s2, c2) + 0.5 * np.pi
+    d = np.stack([np.cos(theta), np.sin(theta)], axis=-1)
+    d[~coherent] = (0.0, 1.0)
+    d[d[..., 1] < 0] *= -1
+    return d.astype(np.float32)
+
+
+def triangle_strand_directions(mesh: "ProxyMesh", shaded: np.ndarray) -> np.ndarray:
+    """(T, 2) strand direction in UV at each triangle's UV centroid (``shaded``: the
+    :func:`shade_texture` output, GL row order)."""
+    h, w = shaded.shape[:2]
+    uv = mesh.uv[mesh.triangles].mean(axis=1)
+    col = np.clip((uv[:, 0] * w).astype(np.int64), 0, w - 1)
+    row = np.clip((uv[:, 1] * h).astype(np.int64), 0, h - 1)
+    d = shaded[row, col, 1:3].astype(np.float32) / 127.5 - 1.0
+    return d / (np.linalg.norm(d, axis=1, keepdims=True) + 1e-12)
 
 
 def volume_normals(points: np.ndarray, card_normals: np.ndarray, *, card_weight: float = 0.3) -> np.ndarray:
@@ -118,9 +164,11 @@ def volume_normals(points: np.ndarray, card_normals: np.ndarray, *, card_weight:
     return (n / (np.linalg.norm(n, axis=1, keepdims=True) + 1e-12)).astype(np.float32)
 
 
-def strand_tangents(positions: np.ndarray, mesh: ProxyMesh, operator=None) -> np.ndarray:
-    """Unit strand direction (dP/dv) per corner, averaged over the corner's triangles.
+def strand_tangents(positions: np.ndarray, mesh: ProxyMesh, operator=None, directions=None) -> np.ndarray:
+    """Unit strand direction per corner, averaged over the corner's triangles.
 
+    ``directions`` (T, 2) gives each triangle's strand direction in UV
+    (:func:`triangle_strand_directions`); by default strands run along v (dP/dv).
     ``operator`` is :func:`~facsim.render_geometry.normal_operator` of the triangles over
     the corners (it sums per-triangle values onto corners; built here when not given).
     """
@@ -131,8 +179,11 @@ def strand_tangents(positions: np.ndarray, mesh: ProxyMesh, operator=None) -> np
     d1, d2 = uv[t[:, 1]] - uv[t[:, 0]], uv[t[:, 2]] - uv[t[:, 0]]
     det = d1[:, 0] * d2[:, 1] - d2[:, 0] * d1[:, 1]
     det = np.where(np.abs(det) < 1e-12, 1e-12, det)
-    # dP/dv = (-d2.u * e1 + d1.u * e2) / det
+    # dP/dv = (-d2.u * e1 + d1.u * e2) / det, dP/du = (d2.v * e1 - d1.v * e2) / det
     tv = (-d2[:, :1] * e1 + d1[:, :1] * e2) / det[:, None]
+    if directions is not None:
+        tu = (d2[:, 1:] * e1 - d1[:, 1:] * e2) / det[:, None]
+        tv = directions[:, :1] * tu + directions[:, 1:] * tv
     tv /= np.linalg.norm(tv, axis=1, keepdims=True) + 1e-12
     if operator is None:
         operator = normal_operator(t, len(p))
@@ -146,6 +197,18 @@ def strand_tangents(positions: np.ndarray, mesh: ProxyMesh, operator=None) -> np
     return out.astype(np.float32)
 
 
+def _weld_operator(corner_vertex: np.ndarray):
+    """Sparse (V, R) matrix summing corners onto their proxy vertex; None if no vertex is split."""
+    from scipy.sparse import csr_matrix
+
+    corner_vertex = np.asarray(corner_vertex, np.int64)
+    n_vertices = int(corner_vertex.max()) + 1 if len(corner_vertex) else 0
+    if n_vertices == len(corner_vertex):
+        return None
+    ones = np.ones(len(corner_vertex), np.float32)
+    return csr_matrix((ones, (corner_vertex, np.arange(len(corner_vertex)))), shape=(n_vertices, len(corner_vertex)))
+
+
 class ProxyLayer:
     """GL objects for one :class:`ProxyMesh` (owned and released by a Renderer)."""
 
@@ -155,6 +218,9 @@ class ProxyLayer:
         self._triangles = np.ascontiguousarray(mesh.triangles, np.uint32)
         self._n_corners = len(mesh.corner_vertex)
         self._normal_op = normal_operator(self._triangles, self._n_corners)
+        # Corners of one proxy vertex (split by a UV seam, e.g. a hair cap's parting) get the
+        # vertex's mean normal, so the shading does not step along the seam.
+        self._weld = _weld_operator(mesh.corner_vertex)
         depth = np.ones(mesh.vertex_count, np.float32) if mesh.depth is None else np.asarray(mesh.depth, np.float32)
         self._depth = depth[mesh.corner_vertex]
         self._buffer = np.zeros((self._n_corners, 10), np.float32)  # pos, normal, tangent, depth
@@ -164,7 +230,19 @@ class ProxyLayer:
         # layers then fail the depth test before they are shaded), back to front for blending.
         self._ibo = {"OPAQUE": track(ctx.buffer(self._triangles.tobytes(), dynamic=True)),
                      "BLEND": track(ctx.buffer(self._triangles.tobytes(), dynamic=True))}
-        tex = shade_texture(np.asarray(mesh.texture))
+        tex = shade_texture(np.asarray(mesh.texture), directions=mesh.kind == "hair")
+        # Strand direction in UV: most styles' textures run along v throughout (their
+        # root bands' cross-wise features would only mislead the texture's own direction
+        # field); where they do not (a ponytail's radiating crown), the field steers the
+        # strand tangents and the shader's strand breakup.
+        self._along_v = 1.0
+        self._directions = None
+        if mesh.kind == "hair":
+            solid = tex[..., 3] > 128
+            along = np.abs(tex[..., 2][solid].astype(np.float32) / 127.5 - 1.0) if solid.any() else np.ones(1)
+            if np.median(along) < 0.9:
+                self._along_v = 0.0
+                self._directions = triangle_strand_directions(mesh, tex)
         self.texture = track(ctx.texture((tex.shape[1], tex.shape[0]), 4, tex.tobytes()))
         self.texture.build_mipmaps()  # an input texture, never rendered into
         self.texture.filter = (ctx.LINEAR_MIPMAP_LINEAR, ctx.LINEAR)
@@ -181,6 +259,7 @@ class ProxyLayer:
             prog = track(ctx.program(vertex_shader=_shader_source("proxy.vert.glsl", defines),
                                      fragment_shader=_shader_source("proxy.frag.glsl", defines)))
             _set_uniform(prog, "u_texture", 1)
+            _set_uniform(prog, "u_along_v", self._along_v)
             self.programs[stage] = prog
             self.vaos[stage] = track(ctx.vertex_array(
                 prog, [(self._vbo, "3f 3f 3f 1f", "in_pos", "in_normal", "in_tangent", "in_depth"),
@@ -217,8 +296,9 @@ class ProxyLayer:
         normals = vertex_normals(p, self._triangles, self._normal_op)
         if self.mesh.kind == "hair":
             normals = volume_normals(p, normals)
-        buf[:, 3:6] = normals
-        buf[:, 6:9] = strand_tangents(positions, self.mesh, self._normal_op)
+        buf[:, 3:6] = self._welded(normals)
+        # Tangents stay per corner: strands really do flow apart on the two sides of a parting.
+        buf[:, 6:9] = strand_tangents(positions, self.mesh, self._normal_op, self._directions)
         buf[:, 9] = self._depth
         self._vbo.write(buf)
         centres = p[self._triangles].mean(axis=1) - np.asarray(camera_position, np.float32)
@@ -236,6 +316,13 @@ class ProxyLayer:
         """(T,) bool: triangles with a vertex not where it is in ``reference`` (V, 3)."""
         moved = np.any(self.positions != reference, axis=1)
         return moved[self._vertex_triangles].any(axis=1)
+
+    def _welded(self, per_corner: np.ndarray) -> np.ndarray:
+        """Unit vectors averaged over the corners of each proxy vertex."""
+        if self._weld is None:
+            return per_corner
+        mean = np.asarray(self._weld @ per_corner)[self.mesh.corner_vertex]
+        return (mean / (np.linalg.norm(mean, axis=1, keepdims=True) + 1e-12)).astype(np.float32)
 
     def set_uniforms(self, vp_bytes: bytes, lights: dict) -> None:
         key = (vp_bytes, tuple(lights.items()))

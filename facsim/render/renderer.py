@@ -261,6 +261,7 @@ class Renderer:
             index_buffer=self._ibo, index_element_size=4, skip_errors=True))
         _set_uniform(prog, "u_paint", 0)
         _set_uniform(prog, "u_detail", 2)
+        _set_uniform(prog, "u_tone", 3)
         _set_uniform(prog, "u_wrinkle_darken", self.wrinkle_darken)
         try:
             prog["u_brow_frame"].write(self.brow_uv_frame.T.astype(np.float32).tobytes())
@@ -319,6 +320,7 @@ class Renderer:
         self._creased = False
         self._paint_tex = None
         self._detail_tex = None
+        self._tone_tex = None
         self._depth_vao = self._depth_prog = None
         self._vp_bytes = b""
         self._lights: dict = {}
@@ -392,6 +394,18 @@ class Renderer:
         self._detail_tex.repeat_x = self._detail_tex.repeat_y = False
         self._detail_tex.build_mipmaps()
         self._detail_tex.filter = (ctx.LINEAR_MIPMAP_LINEAR, ctx.LINEAR)
+        # Skin tone maps (periorbital darkening, translucency, pores, sun); neutral when not given.
+        tone = appearance.tone
+        if tone is None:
+            tone = np.array([[[0, 0, 128, 0]]], dtype=np.uint8)
+        tone = np.ascontiguousarray(tone)
+        if self._tone_tex is not None:
+            self._gl_objects.remove(self._tone_tex)
+            self._tone_tex.release()
+        self._tone_tex = self._track(ctx.texture((tone.shape[1], tone.shape[0]), 4, tone.tobytes()))
+        self._tone_tex.repeat_x = self._tone_tex.repeat_y = False
+        self._tone_tex.build_mipmaps()
+        self._tone_tex.filter = (ctx.LINEAR_MIPMAP_LINEAR, ctx.LINEAR)
         self._appearance = appearance
         for name in self._programs:
             self._set_colors(name, appearance)
@@ -761,6 +775,8 @@ class Renderer:
             self._paint_tex.use(0)
         if self._detail_tex is not None:
             self._detail_tex.use(2)
+        if self._tone_tex is not None:
+            self._tone_tex.use(3)
         ctx.front_face = "ccw"
         if self._proxy_draws:
             # Depth of the closed head first (no shading), so hair behind the head fails the

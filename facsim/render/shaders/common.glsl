@@ -29,11 +29,17 @@ vec3 srgb_encode(vec3 c) {
     return mix(12.92 * c, curve, step(0.0031308, c));
 }
 
-// Identity up to 0.8, then a soft shoulder that approaches 1: highlights roll off instead of
-// clipping to flat white patches.
+// Filmic curve: a slight toe (deep shadows a little deeper, for contrast), near-identity
+// through the mid-tones (a colour lit by the key shows as the user set it), then an
+// exponential shoulder from 0.55 that keeps gradation in lit pale skin and rolls
+// highlights off toward white instead of clipping them to flat patches. Continuous in
+// value and slope at the joint.
+const float SHOULDER = 0.55;
 vec3 tonemap(vec3 c) {
-    vec3 x = max(c - 0.8, 0.0) / 0.2;
-    return min(c, 0.8) + 0.2 * x / (1.0 + x);
+    c = max(c, 0.0);
+    c = c * (c + 0.012) / (c + 0.02);
+    vec3 over = max(c - SHOULDER, 0.0) / (1.0 - SHOULDER);
+    return min(c, SHOULDER) + (1.0 - SHOULDER) * (1.0 - exp2(-1.442695 * over));
 }
 
 // ---- hashing and noise (deterministic: the same inputs give the same image) ---------------

@@ -56,6 +56,7 @@ vec3 specular_light(vec3 n, vec3 v, float shininess) {
 #ifdef REGION_SKIN
 uniform sampler2D u_paint;   // R brow hair density, G lips, B eyelids, A cheek blush
 uniform sampler2D u_detail;  // R redness, G beard area, B oiliness, A age lines
+uniform sampler2D u_tone;    // R periorbital darkening, G translucency, B pores, A sun (facsim.head.skin)
 uniform float u_beard;       // 0..1 stubble shadow
 uniform float u_age;         // 0..1 how much the age lines show
 uniform vec3 u_skin;
@@ -151,12 +152,27 @@ void main() {
 #ifdef REGION_SKIN
     vec4 paint = texture(u_paint, v_uv);
     vec4 detail = texture(u_detail, v_uv);
+    vec4 tone = texture(u_tone, v_uv);   // periorbital, translucency, pores, sun
     // Mottling at two scales so large areas are not a flat plastic colour; stronger with age.
-    float mottle = 0.6 * value_noise(v_uv * 150.0, 0) + 0.4 * value_noise(v_uv * 600.0 + 17.0, 0);
-    vec3 albedo = u_skin * (1.0 + vec3(0.07, 0.09, 0.10) * (1.0 + 1.5 * u_age) * (mottle - 0.5));
-    // Regional colour: redder nose, cheeks and ears; a shaved beard's blue-grey shadow.
-    albedo *= mix(vec3(1.0), vec3(1.04, 0.80, 0.78), 0.6 * detail.r);
+    // The fine scale is skin grain a few pixels across at 512² (pores and fine lines,
+    // averaged), faded to its mean where it would be finer than a pixel; it also breaks up
+    // the sheen below. (hm08's paint box is twice as long in v as in u, hence the 1:2
+    // frequencies: round cells.)
+    vec2 grain_uv = v_uv * vec2(350.0, 700.0);
+    float grain = mix(0.5, value_noise(grain_uv, 0),
+                      clamp(2.0 - 1.2 * max(fwidth(grain_uv.x), fwidth(grain_uv.y)), 0.0, 1.0));
+    float blotch = value_noise(v_uv * vec2(150.0, 300.0), 0);
+    float mottle = 0.6 * blotch + 0.4 * grain;
+    vec3 albedo = u_skin * (1.0 + vec3(0.08, 0.1, 0.11) * (1.0 + 1.5 * u_age) * (mottle - 0.5));
+    // Regional colour: redder nose, cheeks and ears (blood close to the surface); darker,
+    // cooler skin around the eyes (thin skin over vessels and muscle), more so with age;
+    // a shaved beard's blue-grey shadow.
+    albedo *= mix(vec3(1.0), vec3(1.05, 0.80, 0.77), 0.7 * detail.r);
+    albedo *= mix(vec3(1.0), vec3(0.80, 0.72, 0.76), tone.r * (0.55 + 0.45 * u_age));
     albedo = mix(albedo, albedo * vec3(0.70, 0.72, 0.78), u_beard * detail.g * (1.0 - paint.g));
+    // Age spots: sparse, soft tan patches where the sun reaches, growing with age.
+    float spot = smoothstep(0.72, 0.9, blotch) * tone.a * u_age;
+    albedo *= mix(vec3(1.0), vec3(0.86, 0.76, 0.66), spot);
     albedo = mix(albedo, u_cheek, paint.a);
     albedo = mix(albedo, u_eyelid, paint.b);
     albedo = mix(albedo, u_lips, paint.g);
@@ -167,35 +183,57 @@ void main() {
 #endif
     float hair = brow.x;
     albedo = mix(albedo, u_brows * brow.y, hair);
-    float cavity = 1.0 - 0.38 * u_age * detail.a;   // age lines and folds
+    float cavity = 1.0 - 0.42 * u_age * detail.a;   // age lines and folds
 #ifdef USE_WRINKLE
     cavity *= crease_shade(v_wrinkle, v_crease, v_uv);
 #endif
 #ifdef USE_PORES
-    // Pores and fine relief: a bump from high-frequency noise (surface gradient from screen
-    // derivatives), faded out where it would be finer than a pixel, so it never shimmers.
-    // Compiled only for large images (render.py), where pores are bigger than a pixel.
-    float pore_h = value_noise(v_uv * 2400.0, 0) + 0.5 * value_noise(v_uv * 900.0 + 3.0, 0);
+    // Pores and fine relief: small pits and a finer orange-peel bump (surface gradient from
+    // screen derivatives), strongest on the nose and cheeks (tone.b), deeper with age, faded
+    // out where it would be finer than a pixel, so it never shimmers. Compiled only for large
+    // images (render.py), where pores are bigger than a pixel.
+    vec2 pore_uv = v_uv * vec2(700.0, 1400.0);   // cells ~0.5 mm, round (1:2, see the spots)
+    float pit = smoothstep(0.55, 0.85, value_noise(pore_uv, 0));
+    float pore_h = 0.5 * value_noise(pore_uv * 0.37 + 3.0, 0) - pit;
     vec3 dpdx = dFdx(v_pos), dpdy = dFdy(v_pos);
     vec3 r1 = cross(dpdy, n), r2 = cross(n, dpdx);
     float det = dot(dpdx, r1);
     vec3 grad = sign(det) * (dFdx(pore_h) * r1 + dFdy(pore_h) * r2);
-    float pore_fade = clamp(1.5 - 40.0 * fwidth(v_uv.x * 100.0), 0.0, 1.0);
-    vec3 bumped = normalize(abs(det) * n - (0.0006 + 0.0008 * u_age) * pore_fade * grad);
+    float pore_fade = clamp(2.2 - 2.5 * max(fwidth(pore_uv.x), fwidth(pore_uv.y)), 0.0, 1.0);
+    float pore_amount = pore_fade * (0.3 + 1.2 * tone.b) * (1.0 - paint.g) * (1.0 - hair);
+    vec3 bumped = normalize(abs(det) * n - (0.0006 + 0.0003 * u_age) * pore_amount * grad);
+    cavity *= 1.0 - 0.07 * pit * pore_amount;
 #else
     vec3 bumped = n;
 #endif
-    // Soft subsurface look: light wraps past the terminator, red furthest (less with age).
-    vec3 wrap = vec3(0.5, 0.24, 0.17) * (1.0 - hair) * (1.0 - 0.3 * u_age);
-    vec3 diffuse = diffuse_light(n, wrap, occ) * albedo;
-    // Sheen: broad and low on skin, glossier on the oily T-zone, tight and strong on the wet
-    // lips; none on hair. Pores break up the sheen (bumped normal in the specular only).
+    // Subsurface look: light wraps past the terminator, red furthest, so the shadow edge is
+    // soft and warm (less with age: thinner skin). Red scatters furthest under the skin, so it
+    // sees the smooth normal; green and blue see the pores' relief (normal blending).
+    vec3 wrap = vec3(0.42, 0.2, 0.14) * (1.0 - hair) * (1.0 - 0.3 * u_age);
+    vec3 lit = diffuse_light(n, wrap, occ);
+#ifdef USE_PORES
+    lit.gb = mix(lit.gb, diffuse_light(bumped, 0.5 * wrap, occ).gb, 0.6);
+#endif
+    vec3 diffuse = lit * albedo;
+    // Translucency: thin ears and nose wings glow red where the rim light comes from behind
+    // them.
+    float back_rim = clamp(dot(v, -normalize(u_rim_dir + 0.4 * n)), 0.0, 1.0);
+    vec3 glow = back_rim * back_rim * u_rim_col * occ;
+    diffuse += tone.g * 0.55 * glow * u_skin * vec3(1.0, 0.42, 0.3);
+    // Specular in two lobes, as skin has: a broad one from the rough horny layer and a tight
+    // one from the oil film, which the T-zone (detail.b) has most and the cheeks little; the
+    // lips are wet and glossy; brow hair has none. Pores break up the sheen (bumped normal).
     float ndv = max(dot(n, v), 0.0);
     float fres = schlick(0.028, ndv);
     float lips = paint.g;
-    float oil = mix(0.55, 1.6, detail.b) * (1.0 - 0.35 * u_age);
-    vec3 spec = specular_light(bumped, v, mix(mix(14.0, 28.0, detail.b), 70.0, lips)) * mix(oil, 2.2, lips);
-    radiance = (diffuse + spec * fres * (1.0 - hair) * occ) * cavity;
+    float oil = detail.b * (1.0 - 0.35 * u_age);
+    // (The fill is too weak to show in a broad lobe: key and rim only.)
+    float broad_shine = mix(10.0, 16.0, oil);
+    vec3 broad = (blinn(bumped, u_key_dir, v, broad_shine) * u_key_col
+                  + blinn(bumped, u_rim_dir, v, broad_shine) * u_rim_col) * mix(0.35, 0.8, oil);
+    vec3 tight = blinn(bumped, u_key_dir, v, mix(45.0, 90.0, lips)) * u_key_col * mix(mix(0.08, 1.3, oil * oil), 1.8, lips);
+    vec3 spec = (broad + tight) * fres * (1.0 - hair) * (0.5 + grain);
+    radiance = (diffuse + spec * occ) * cavity;
 #endif
 
 #ifdef REGION_EYEBALL

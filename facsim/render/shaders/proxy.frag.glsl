@@ -10,8 +10,9 @@ in vec3 v_tangent;
 in float v_depth;
 in vec2 v_uv;
 
-uniform sampler2D u_texture;  // RGB: strand brightness (0.5 = mean), A: coverage
+uniform sampler2D u_texture;  // R: strand brightness (0.5 = mean), GB: strand direction in UV, A: coverage
 uniform vec3 u_color;         // linear RGB
+uniform float u_along_v;      // 1: the texture's strands run along v everywhere (else: tex.gb says where)
 uniform float u_sheen;        // strand highlight strength (1 straight hair, less for coily)
 
 out vec4 f_color;
@@ -47,26 +48,54 @@ void main() {
 
 #ifdef KIND_HAIR
     vec3 t = normalize(v_tangent);
-    // Inner layers are shadowed by the outer ones.
-    float self_shadow = mix(0.5, 1.0, smoothstep(0.0, 0.8, v_depth));
-    float jitter = 0.2 * (tex.r - 0.5);  // shift the highlight per strand so it breaks up
-    // Key light: strand diffuse blended with a wrapped Lambert to keep the volume readable.
+    // Strand breakup: fine strands and coarser clumps along the texture's v, each faded to
+    // its mean where it would be finer than a pixel, so small images do not shimmer. Most of
+    // MakeHuman's hair textures run along v; where a texture's own strands turn away from v
+    // (tex.gb, from its structure tensor; e.g. a ponytail's crown), the breakup fades out
+    // rather than cross the strands (proxies.py sets u_along_v = 1 for textures running
+    // along v throughout).
+#ifdef PASS_OPAQUE
+    float along_v = max(u_along_v, smoothstep(0.75, 0.92, abs(tex.b * 2.0 - 1.0)));
+    vec2 sp = v_uv * vec2(420.0, 5.0);
+    float fine = mix(0.5, value_noise(sp, 0), along_v * clamp(1.8 - 1.6 * fwidth(sp.x), 0.0, 1.0));
+    vec2 cp = v_uv * vec2(60.0, 1.2) + 7.0;
+    float clump = mix(0.5, value_noise(cp, 0), along_v * clamp(2.0 - 1.5 * fwidth(cp.x), 0.0, 1.0));
+#else
+    float fine = 0.5, clump = 0.5;   // the thin fringe: too sparse for the breakup to show
+#endif
+    // The texture's strand brightness with more contrast than the 512² source gives alone.
+    albedo = u_color * (0.45 + 1.1 * tex.r) * (0.72 + 0.56 * fine) * (0.8 + 0.4 * clump);
+    // Self-shadowing: layers near the scalp lie under the outer ones, the gaps between clumps
+    // are darker, and thin strands at a card's edge let the darker layers beneath show.
+    float self_shadow = mix(0.5, 1.0, smoothstep(0.0, 0.9, v_depth)) * mix(0.68, 1.0, clump)
+                      * mix(0.8, 1.0, smoothstep(ALPHA_CUTOFF, 1.0, tex.a));
+    float jitter = 0.25 * (tex.r - 0.5) + 0.12 * (fine - 0.5) + 0.1 * (clump - 0.5);  // breaks up the highlight
+    // Key light: strand diffuse blended with a squared half-Lambert, which keeps the volume
+    // readable without the flat look of a plain wrap.
     float kl = clamp(dot(n, u_key_dir) * 0.5 + 0.5, 0.0, 1.0);
-    float dk = mix(strand_diffuse(t, u_key_dir), 1.0, 0.3) * kl;
+    float dk = mix(strand_diffuse(t, u_key_dir), 1.0, 0.3) * kl * kl * 1.25;
     float df = clamp(dot(n, u_fill_dir) * 0.5 + 0.5, 0.0, 1.0);
     float dr = clamp(dot(n, u_rim_dir) * 0.5 + 0.5, 0.0, 1.0);
-    vec3 lit = dk * u_key_col + df * u_fill_col + dr * u_rim_col * 0.6 + hemisphere(n);
+    vec3 lit = dk * u_key_col + df * u_fill_col + dr * dr * u_rim_col * 0.8 + hemisphere(n) * 0.85;
 #ifdef PASS_OPAQUE
     // Two Kajiya-Kay lobes of the key light, shifted along the normal: a white primary
-    // and a hair-coloured secondary (Marschner's R and TRT, as Scheuermann approximates them).
-    // The blended fringe (thin wisps) skips them: they barely show there and cost time.
+    // and a hair-coloured, sparkly secondary (Marschner's R and TRT, as Scheuermann
+    // approximates them). The blended fringe (thin wisps) skips them: they barely show there
+    // and cost time.
     vec3 h = normalize(u_key_dir + v);
-    float gate = smoothstep(0.35, 0.6, kl);
+    // Roots at the parting lie in the outer strands' shadow: little highlight there, so the
+    // two sides' different strand directions do not draw a line along it.
+    // Where a card's corner tangents disagree (opposite signs), the interpolated tangent
+    // shrinks and its direction means nothing: no highlight there (else a bright outline).
+    float gate = smoothstep(0.3, 0.6, kl) * mix(0.35, 1.0, smoothstep(0.0, 0.5, v_depth))
+               * smoothstep(0.6, 0.9, length(v_tangent));
     float th1 = dot(normalize(t + (0.08 + jitter) * n), h);
     float th2 = dot(normalize(t + (-0.12 + jitter) * n), h);
     float s1 = max(1.0 - th1 * th1, 1e-6);   // sin^2
     float s2 = max(1.0 - th2 * th2, 1e-6);
-    vec3 spec = u_key_col * gate * (0.10 * exp2(40.0 * log2(s1)) + 0.4 * u_color * exp2(10.0 * log2(s2)));
+    float sparkle = smoothstep(0.45, 0.75, fine);
+    vec3 spec = u_key_col * gate * (0.09 * exp2(70.0 * log2(s1))
+                                    + 0.5 * sparkle * u_color * exp2(12.0 * log2(s2)));
 #else
     vec3 spec = vec3(0.0);
 #endif

@@ -1,0 +1,108 @@
+"""Skin and hair shading: tone maps, age cues, translucency, strand directions, the parting."""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from facsim.render.camera import project
+
+SIZE = 192
+
+
+def render(face, appearance, *, lighting=None):
+    positions = face.neutral
+    camera = face.camera(size=(SIZE, SIZE))
+    image = face.renderer(size=SIZE).render(positions, appearance=appearance, camera=camera, lighting=lighting,
+                                            occlusion=face.shading_occlusion, proxies=face.proxy_draws(positions))
+    return image[..., :3].astype(int), camera
+
+
+def patch(image, camera, point, r=3):
+    """Mean RGB of a small square around a world point's pixel."""
+    (x, y), = project(camera, [point], SIZE)[0]
+    x, y = int(x), int(y)
+    return image[y - r:y + r + 1, x - r:x + r + 1].reshape(-1, 3).mean(axis=0)
+
+
+def test_tone_maps_darken_the_skin_around_the_eyes_not_the_cheeks(face_of, marks):
+    face = face_of("ava")
+    with_tone, camera = render(face, face.appearance)
+    without, _ = render(face, dataclasses.replace(face.appearance, tone=None))
+    under_eye = face.neutral[marks["lower_lid_left"]] + np.array([-0.02, -0.07, 0.0])
+    cheek = face.neutral[marks["cheek_left"]]
+    assert patch(with_tone, camera, under_eye).sum() < patch(without, camera, under_eye).sum() - 6
+    assert abs(patch(with_tone, camera, cheek).sum() - patch(without, camera, cheek).sum()) < 3
+
+
+def test_older_skin_shows_age_cues_on_the_face_only(face_of, marks):
+    face = face_of("george")
+    assert face.appearance.age > 0.5
+    old, camera = render(face, face.appearance)
+    young, _ = render(face, dataclasses.replace(face.appearance, age=0.0))
+    changed = np.abs(old - young).sum(-1) > 6
+    assert changed.sum() > 0.02 * SIZE * SIZE        # lines, spots, mottling over the face ...
+    assert not changed[:, :8].any() and not changed[:, -8:].any()  # ... not the background
+    forehead = face.neutral[marks["glabella"]] + np.array([0.0, 0.3, -0.05])
+    assert np.abs(patch(old, camera, forehead, 8) - patch(young, camera, forehead, 8)).sum() > 3
+
+
+def test_backlit_thin_skin_glows_red(face_of):
+    from facsim.render.inputs import Lighting
+
+    face = face_of("liam")
+    backlit = Lighting(rim_direction=(0.0, 0.1, -1.0), rim_color=(2.0, 2.0, 2.0))
+    no_glow = face.appearance.tone.copy()
+    no_glow[..., 1] = 0
+    glow, _ = render(face, face.appearance, lighting=backlit)
+    plain, _ = render(face, dataclasses.replace(face.appearance, tone=no_glow), lighting=backlit)
+    d = glow - plain
+    assert (d.sum(-1) > 6).sum() > 30                 # the ears (and nose wings) light up ...
+    assert d[..., 0].sum() > 1.4 * d[..., 1].sum() > 0  # ... red more than green
+
+
+@pytest.mark.parametrize("axis, expected", [(1, (0.0, 1.0)), (0, (1.0, 0.0))])
+def test_strand_directions_run_along_the_texture_strands(axis, expected):
+    from facsim.render.proxies import strand_directions
+
+    rows, cols = np.mgrid[0:64, 0:64]
+    stripes = 128 + 100 * np.sin((cols if axis == 1 else rows) * 1.3)  # strands along v, then along u
+    d = strand_directions(stripes.astype(np.float32))[16:48, 16:48]
+    assert np.allclose(np.abs(d).mean(axis=(0, 1)), expected, atol=0.05)
+
+
+def test_hair_is_shaded_without_a_seam_at_its_parting(face_of):
+    from facsim.render.gl import gl_context
+    from facsim.render.proxies import ProxyLayer
+
+    face = face_of("ava")
+    (draw, mesh), = [(d, m) for d, m in zip(face.proxy_draws(face.neutral), face.proxy_meshes) if m.kind == "hair"]
+    layer = ProxyLayer(gl_context(), mesh, lambda obj: obj)
+    try:
+        layer.update(draw, np.array([0.0, 7.0, 10.0]))
+        normals = layer._buffer[:, 3:6]
+        split = np.flatnonzero(np.bincount(mesh.corner_vertex) > 1)
+        assert split.size  # long01's cap is split along its parting (a UV seam) ...
+        for vertex in split[:50]:
+            corners = normals[mesh.corner_vertex == vertex]
+            assert np.allclose(corners, corners[0], atol=1e-5)  # ... but shaded as one surface
+    finally:
+        for obj in (layer.texture, *layer.programs.values(), *layer.vaos.values()):
+            obj.release()
+
+
+def test_hair_shadows_the_forehead_under_a_fringe_not_the_chin(face_of, head, marks):
+    from facsim.head.proxies import hair_shadow
+
+    face = face_of("liam")
+    hair = next(b for b in face.proxies if b.proxy.kind == "hair").binding.positions(face.neutral)
+    skin = face.neutral[head.skin]
+    shade = hair_shadow(skin, hair)
+    no_cast = hair_shadow(skin, hair, cast=0.0)
+    glabella, chin = face.neutral[marks["glabella"]], face.neutral[marks["chin"]]
+    upper_forehead = (skin[:, 1] > glabella[1] + 0.35) & (skin[:, 2] > glabella[2] - 0.3) & (np.abs(skin[:, 0]) < 0.3)
+    assert upper_forehead.sum() > 10
+    assert (shade[upper_forehead] < no_cast[upper_forehead] - 0.05).mean() > 0.3  # the fringe's shadow
+    near_chin = np.linalg.norm(skin - chin, axis=1) < 0.2
+    assert np.all(shade[near_chin] == 1.0)
