@@ -112,7 +112,8 @@ class Face:
         """This frame's :class:`facsim.render.proxies.ProxyDraw` s for geometry ``positions``."""
         from facsim.render.proxies import ProxyDraw
 
-        return [ProxyDraw(mesh, bound.binding.positions(positions), tuple(self.colors[bound.color_key]), bound.sheen)
+        return [ProxyDraw(mesh, bound.binding.positions(positions), tuple(self.colors[bound.color_key]), bound.sheen,
+                          bound.density)
                 for bound, mesh in zip(self.proxies, self.proxy_meshes)]
 
     @cached_property

@@ -164,7 +164,9 @@ def character_colors(character: Character) -> dict[str, tuple[float, float, floa
         * (1.0 - 0.1 * older),
         "eyelid": skin * (female * np.array([0.86, 0.74, 0.74]) + (1 - female) * np.array([0.92, 0.80, 0.80])),
         "cheek": skin * np.array([1.0, 0.70, 0.70]),
-        "brows": (1 - 0.5 * older) * blend("brows") + 0.5 * older * srgb_to_linear(hex_to_rgb(GREY_HAIR)),
+        # Brows a shade darker than the scalp hair (their hairs are drawn translucent over
+        # the skin, which lightens them); they grey later and less than the scalp.
+        "brows": (1 - 0.5 * older) * 0.7 * blend("brows") + 0.5 * older * srgb_to_linear(hex_to_rgb(GREY_HAIR)),
         "iris": blend("iris"),
         # Scalp hair greys earlier and further than the brows.
         "hair": (1 - 0.85 * greying) * blend("brows") * 1.15 + 0.85 * greying * srgb_to_linear(hex_to_rgb(GREY_HAIR)),

@@ -75,8 +75,9 @@ TEAM_AUTHORS = ("manuel bastioni", "jonas hauquier")
 #: Reference distances (dm) on base hm08 used to scale offsets per axis, as the
 #: ``.mhclo`` ``x_scale``/``y_scale``/``z_scale`` lines do: the head's extent.
 _SCALE_REGION_MIN_Y = 6.0
-#: Fraction of their offsets lashes keep: MakeHuman's lash cards are theatrical; drawn
-#: shortened toward the lid (as facsim does with hm08's own lash strips) they read as
+#: Fraction of their offsets lashes keep when a character's sex gives none
+#: (``lash_reach`` in ``facsim/data/hair.yaml``): MakeHuman's lash cards are theatrical;
+#: drawn shortened toward the lid (as facsim does with hm08's own lash strips) they read as
 #: natural lashes instead of false ones.
 LASH_REACH = 0.5
 
@@ -182,7 +183,7 @@ def character_proxies(character) -> dict[str, str | None]:
     pick = int(hashlib.sha256(key.encode()).hexdigest()[:8], 16)
     auto = {
         "hair": table["automatic"][sex][group],
-        "eyebrows": table["brows"][sex],
+        "eyebrows": table["brows"][sex][group.removeprefix("african_")],
         "eyelashes": table["lashes"][sex],
     }
     own = {"hair": character.hair, "eyebrows": character.brows, "eyelashes": character.lashes}
@@ -196,6 +197,51 @@ def character_proxies(character) -> dict[str, str | None]:
             choices = auto[kind]
             out[kind] = choices[pick % len(choices)]
     return out
+
+
+@dataclass(frozen=True)
+class ProxyLook:
+    """How a character wears its brows and lashes (``facsim/data/hair.yaml``).
+
+    Attributes
+    ----------
+    brow_lift : (3,) float
+        Millimetres the brows sit above MakeHuman's fit at their head (medial end), peak
+        and tail, moved along the skin.
+    brow_spread : float
+        Millimetres the brow heads move away from the midline (the tail stays).
+    brow_density, lash_density : float
+        0 … 1: how much of the skin the hairs cover (sparser with age).
+    lash_reach, lower_lash_reach : float
+        Fraction of MakeHuman's lash length the upper and lower lashes keep.
+    """
+
+    brow_lift: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    brow_spread: float = 0.0
+    brow_density: float = 1.0
+    lash_density: float = 1.0
+    lash_reach: float = LASH_REACH
+    lower_lash_reach: float = LASH_REACH
+
+
+def character_look(character) -> ProxyLook:
+    """The :class:`ProxyLook` of ``character``: by sex, thinning from ``thin_from_age``."""
+    table = hair_table()["look"]
+    female = float(np.clip(1.0 - character.gender, 0.0, 1.0))
+
+    def by_sex(key):
+        f, m = np.asarray(table[key]["female"], float), np.asarray(table[key]["male"], float)
+        return female * f + (1.0 - female) * m
+
+    thin = table["thinning"] * float(np.clip((character.age - table["thin_from_age"]) / 30.0, 0.0, 1.0))
+    return ProxyLook(
+        brow_lift=tuple(float(v) for v in by_sex("brow_lift_mm")),
+        brow_spread=float(by_sex("brow_spread_mm")),
+        brow_density=float(by_sex("brow_density")) * (1.0 - thin),
+        lash_density=float(by_sex("lash_density")) * (1.0 - thin),
+        lash_reach=float(by_sex("lash_reach")) * (1.0 - 0.5 * thin),
+        lower_lash_reach=float(by_sex("lower_lash_reach")) * (1.0 - 0.5 * thin),
+    )
 
 
 # --------------------------------------------------------------------- binding to a frame
@@ -220,18 +266,100 @@ class FrameBinding:
         return anchor + self.offsets
 
 
-def bind_to_frame(proxy: Proxy, head, base_positions: np.ndarray, neutral_geometry: np.ndarray) -> FrameBinding:
-    """Bind ``proxy`` (fitted on ``base_positions``) to ``head``'s geometry vertices."""
+def along_brow(points: np.ndarray) -> np.ndarray:
+    """(V,) 0 at each brow's head (medial end) … 1 at its tail, from the distance to the midline."""
+    ax = np.abs(np.asarray(points)[:, 0])
+    return np.clip((ax - ax.min()) / max(float(np.ptp(ax)), 1e-6), 0.0, 1.0).astype(np.float32)
+
+
+def closest_on_surface(points: np.ndarray, vertices: np.ndarray, triangles: np.ndarray):
+    """Nearest point of a triangle mesh to each of ``points`` (P, 3).
+
+    Returns the triangle (P,) and barycentric weights (P, 3) of each nearest point (the
+    plane projection clamped into the triangle: exact enough for points within a few
+    millimetres of a fine mesh) and the triangles' unit normals (P, 3).
+    """
+    a, b, c = (np.asarray(vertices, np.float64)[triangles[:, k]] for k in range(3))
+    ab, ac = b - a, c - a
+    d00, d01, d11 = (ab * ab).sum(1), (ab * ac).sum(1), (ac * ac).sum(1)
+    denom = np.where(np.abs(d00 * d11 - d01 ** 2) < 1e-18, 1e-18, d00 * d11 - d01 ** 2)
+    vp = np.asarray(points, np.float64)[:, None, :] - a[None]
+    d20, d21 = (vp * ab).sum(2), (vp * ac).sum(2)
+    v = (d11 * d20 - d01 * d21) / denom
+    w = (d00 * d21 - d01 * d20) / denom
+    bary = np.clip(np.stack([1.0 - v - w, v, w], axis=2), 0.0, None)
+    bary /= bary.sum(2, keepdims=True) + 1e-12
+    q = bary[..., :1] * a + bary[..., 1:2] * b + bary[..., 2:] * c
+    best = np.argmin(((vp + a[None] - q) ** 2).sum(2), axis=1)
+    rows = np.arange(len(best))
+    normal = np.cross(ab, ac)[best]
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True) + 1e-12
+    return best, bary[rows, best], normal
+
+
+def place_brows(points: np.ndarray, skin: np.ndarray, triangles: np.ndarray, look: ProxyLook):
+    """Brow vertices moved up and apart along the skin by ``look``, bound to that skin.
+
+    MakeHuman's brows on hm08 rest low on the orbital rim with their heads close together,
+    which reads as a frown on a neutral face. Each vertex slides by the look's lift (mm,
+    interpolated head → peak → tail) and spread, and keeps its height over the skin.
+
+    Parameters
+    ----------
+    points : (V, 3)
+        The fitted brow on the neutral face.
+    skin : (N, 3)
+        Neutral skin vertex positions; ``triangles`` (T, 3) index them.
+
+    Returns
+    -------
+    ref : (V, 3) int, weights : (V, 3) float32, positions : (V, 3) float32
+        The skin triangle under each moved vertex, its barycentric weights there, and the
+        moved vertices (``Σ w·skin[ref]`` plus the height along the skin's normal).
+    """
+    points = np.asarray(points, np.float64)
+    s = along_brow(points)
+    lift = np.interp(s, (0.0, 0.65, 1.0), look.brow_lift) * 0.01           # mm -> dm
+    spread = look.brow_spread * 0.01 * (1.0 - s) ** 2 * np.sign(points[:, 0])
+    lo, hi = points.min(0) - 0.15, points.max(0) + 0.15
+    centroid = np.asarray(skin, np.float64)[triangles].mean(1)
+    near = triangles[np.all((centroid > lo) & (centroid < hi), axis=1)]
+    tri, bary, normal = closest_on_surface(points, skin, near)
+    foot = np.einsum("vk,vkd->vd", bary, np.asarray(skin, np.float64)[near[tri]])
+    height = ((points - foot) * normal).sum(1)
+    slid = foot + np.stack([spread, lift, np.zeros_like(lift)], axis=1)
+    tri, bary, normal = closest_on_surface(slid, skin, near)
+    ref = near[tri]
+    moved = np.einsum("vk,vkd->vd", bary, np.asarray(skin, np.float64)[ref]) + height[:, None] * normal
+    return ref.astype(np.int64), bary.astype(np.float32), moved.astype(np.float32)
+
+
+def bind_to_frame(proxy: Proxy, head, base_positions: np.ndarray, neutral_geometry: np.ndarray,
+                  look: ProxyLook | None = None) -> FrameBinding:
+    """Bind ``proxy`` (fitted on ``base_positions``, worn as ``look`` says) to ``head``'s
+    geometry vertices."""
     from scipy.spatial import cKDTree
 
+    look = look or ProxyLook()
     fitted = fit_proxy(proxy, base_positions, scale=offset_scale(base_positions, head.base_vertices))
     geo_of_base = np.full(len(head.base_vertices), -1, np.int64)
     skin = np.asarray(head.base_index)[: head.skin_vertex_count]
     geo_of_base[skin] = np.arange(len(skin))
+    skin_now = np.asarray(neutral_geometry, np.float32)[: head.skin_vertex_count]
     if proxy.kind == "eyelashes":  # shorten toward the lid skin they grow from
-        lid = np.asarray(neutral_geometry, np.float32)[: head.skin_vertex_count]
-        nearest = lid[cKDTree(lid).query(fitted)[1]]
-        fitted = nearest + LASH_REACH * (fitted - nearest)
+        nearest = skin_now[cKDTree(skin_now).query(fitted)[1]]
+        eye = head.eye_pivot(base_positions, "left")[0]
+        lower = nearest[:, 1] < eye[1]  # grown from the lower lid
+        reach = np.where(lower, look.lower_lash_reach, look.lash_reach)[:, None].astype(np.float32)
+        fitted = nearest + reach * (fitted - nearest)
+    if proxy.kind == "eyebrows" and (any(look.brow_lift) or look.brow_spread):
+        # The brows now sit over other skin: bind each vertex to the skin triangle under
+        # it, so AU 1, 2 and 4 move it exactly as they move that skin.
+        tris = head.topology.geo_faces
+        tris = tris[np.all(tris < head.skin_vertex_count, axis=1)]
+        ref, weights, fitted = place_brows(fitted, skin_now, tris, look)
+        anchor = np.einsum("vk,vkd->vd", weights, skin_now[ref])
+        return FrameBinding(ref=ref, weights=weights, offsets=(fitted - anchor).astype(np.float32))
     ref = geo_of_base[proxy.ref]
     missing = ref < 0
     if missing.any():
@@ -251,11 +379,16 @@ class BoundProxy:
     proxy: Proxy
     binding: FrameBinding
     color_key: str  # "hair", "brows" or "lashes" in the character's colours
+    density: float = 1.0  # brows and lashes: how much of the skin their hairs cover (0 … 1)
+    neutral: np.ndarray | None = None  # (V, 3) positions on the neutral face
 
     @cached_property
     def depth(self) -> np.ndarray:
-        """(V,) 0 at the skin … 1 at the outermost strands: how far each vertex sits off the
-        skin relative to the style (the renderer's self-shadowing)."""
+        """(V,) per-vertex shading coordinate for the renderer. Hair and lashes: 0 at the
+        skin … 1 at the outermost strands / lash tips (self-shadowing, tapering). Brows:
+        0 at each brow's head … 1 at its tail (:func:`along_brow`), where the hairs thin."""
+        if self.proxy.kind == "eyebrows" and self.neutral is not None:
+            return along_brow(self.neutral)
         reach = np.linalg.norm(self.binding.offsets, axis=1)
         return np.clip(reach / (np.percentile(reach, 95) + 1e-6), 0.0, 1.0).astype(np.float32)
 
@@ -274,12 +407,16 @@ def bind_character_proxies(character, head, base_positions, neutral_geometry, *,
     if not any(chosen.values()):
         return []
     library = library or load_proxies()
+    look = character_look(character)
+    density = {"hair": 1.0, "eyebrows": look.brow_density, "eyelashes": look.lash_density}
     out = []
     for kind in ("hair", "eyebrows", "eyelashes"):
         name = chosen[kind]
         if name:
             proxy = library[name]
-            out.append(BoundProxy(proxy, bind_to_frame(proxy, head, base_positions, neutral_geometry), COLOR_KEY[kind]))
+            binding = bind_to_frame(proxy, head, base_positions, neutral_geometry, look)
+            out.append(BoundProxy(proxy, binding, COLOR_KEY[kind], density[kind],
+                                  binding.positions(neutral_geometry)))
     return out
 
 

@@ -14,6 +14,7 @@ uniform sampler2D u_texture;  // R: strand brightness (0.5 = mean), GB: strand d
 uniform vec3 u_color;         // linear RGB
 uniform float u_along_v;      // 1: the texture's strands run along v everywhere (else: tex.gb says where)
 uniform float u_sheen;        // strand highlight strength (1 straight hair, less for coily)
+uniform float u_density;      // brows and lashes: how much of the skin their hairs cover
 
 out vec4 f_color;
 
@@ -26,18 +27,33 @@ float strand_diffuse(vec3 t, vec3 l) {
 
 void main() {
     vec4 tex = texture(u_texture, v_uv);
-#ifdef KIND_EYEBROWS
-    // Brow hairs are finer than a pixel in most stimuli; denser cover keeps the brow's shape
-    // (what AU 1, 2 and 4 move) legible at small sizes.
-    tex.a = min(1.0, tex.a * 1.5);
-#endif
     float alpha = tex.a;
+#if defined(KIND_EYEBROWS) || defined(KIND_EYELASHES)
+    // Brows and lashes are one thin layer of fine hairs: drawn whole in the blended pass and
+    // translucent, so skin shows between the hairs and they read as hair, not paint. Their
+    // hairs are finer than a pixel in most stimuli; the mipmapped alpha is then the fraction
+    // of the skin they cover, scaled by the character's density (sparser with age).
+#ifdef PASS_OPAQUE
+    discard;
+#endif
+#ifdef KIND_EYEBROWS
+    // v_depth: 0 at the brow's head ... 1 at its tail. The head's hairs grow upward, spaced,
+    // so skin shows through (a solid dark head reads as a frown); the tail thins out.
+    float thin = mix(0.5, 1.0, smoothstep(0.0, 0.35, v_depth)) * mix(1.0, 0.55, smoothstep(0.7, 1.0, v_depth));
+    alpha = clamp(tex.a * 1.6, 0.0, 0.92) * thin * u_density;
+#else
+    // v_depth: 0 at the lid ... 1 at the lash tips: each lash tapers to a fine point.
+    alpha = clamp(tex.a * 1.25, 0.0, 1.0) * mix(1.0, 0.4, v_depth) * u_density;
+#endif
+    if (alpha < 0.01) discard;
+#else
 #ifdef PASS_OPAQUE
     if (alpha < ALPHA_CUTOFF) discard;
     alpha = 1.0;
 #else
     if (alpha >= ALPHA_CUTOFF || alpha < 0.02) discard;
     alpha = alpha / ALPHA_CUTOFF;  // the fringe fades out fully at its edge
+#endif
 #endif
     vec3 n = normalize(v_normal);
     vec3 v = normalize(u_cam_pos - v_pos);
