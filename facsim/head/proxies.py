@@ -390,7 +390,13 @@ class BoundProxy:
         if self.proxy.kind == "eyebrows" and self.neutral is not None:
             return along_brow(self.neutral)
         reach = np.linalg.norm(self.binding.offsets, axis=1)
-        return np.clip(reach / (np.percentile(reach, 95) + 1e-6), 0.0, 1.0).astype(np.float32)
+        depth = reach / (np.percentile(reach, 95) + 1e-6)
+        if self.proxy.kind == "eyelashes" and self.neutral is not None:
+            # Lower lashes are sparser and finer than upper ones: start them part-way
+            # along the taper.
+            y = self.neutral[:, 1]
+            depth = np.where(y < 0.5 * (y.min() + y.max()), 0.45 + 0.55 * depth, depth)
+        return np.clip(depth, 0.0, 1.0).astype(np.float32)
 
     @property
     def sheen(self) -> float:

@@ -117,6 +117,7 @@ uniform vec3 u_pupil;
 const float IRIS_RADIUS = 0.368;
 const float PUPIL_RADIUS = 0.13;
 const float LIMBUS_WIDTH = 0.22;   // fraction of the iris annulus darkened at its rim
+const float CORNEA_RADIUS = 0.49;  // radius of the cornea's curvature, 1.33 iris radii
 const int IRIS_FIBRES = 96;        // radial noise cells around the iris
 #endif
 
@@ -244,30 +245,53 @@ void main() {
     float iris_mask = front * (1.0 - smoothstep(IRIS_RADIUS - aa, IRIS_RADIUS + aa, r));
     float pupil_mask = front * (1.0 - smoothstep(PUPIL_RADIUS - aa, PUPIL_RADIUS + aa, r));
     float t = clamp((r - PUPIL_RADIUS) / (IRIS_RADIUS - PUPIL_RADIUS), 0.0, 1.0);
-    float turns = (atan(e.y, e.x) / (2.0 * PI) + 0.5) * float(IRIS_FIBRES);
-    float fibre = 0.6 * value_noise(vec2(turns, t * 5.0), IRIS_FIBRES)
-                + 0.4 * value_noise(vec2(turns * 0.5, t * 11.0 + 7.0), IRIS_FIBRES / 2);
-    // Stroma: radial fibres, a lighter collarette around the pupil, crypts, and a dark
-    // limbal ring; a little less saturated than the base colour (real irises are greyish).
-    vec3 base_iris = mix(u_iris, vec3(dot(u_iris, vec3(0.3, 0.55, 0.15))), 0.25);
-    vec3 iris = base_iris * (0.5 + 0.8 * fibre);
-    iris *= mix(1.35, 1.0, smoothstep(0.12, 0.4, t));                // lighter collarette
-    iris *= mix(1.0, 0.25, smoothstep(1.0 - LIMBUS_WIDTH, 1.0, t));  // dark limbal ring
+    float angle = atan(e.y, e.x);
+    float turns = (angle / (2.0 * PI) + 0.5) * float(IRIS_FIBRES);
+    // Stroma: fine radial fibres (long along the radius, narrow around it), coarser crypts,
+    // faded to their mean where they would be finer than a pixel (small images stay calm).
+    float fibre = 0.55 * value_noise(vec2(turns, t * 3.0), IRIS_FIBRES)
+                + 0.3 * value_noise(vec2(turns * 2.0, t * 1.5 + 3.0), IRIS_FIBRES * 2)
+                + 0.15 * value_noise(vec2(turns * 0.25, t * 6.0 + 11.0), IRIS_FIBRES / 4);
+    fibre = mix(0.5, fibre, clamp(1.6 - 0.6 * fwidth(turns), 0.0, 1.0));
+    // A little less saturated than the base colour (real irises are greyish), a lighter
+    // collarette ring a third of the way out, a dark pupillary ruff, and a dark limbal ring
+    // at the rim that blurs into the sclera.
+    vec3 base_iris = mix(u_iris, vec3(dot(u_iris, vec3(0.3, 0.55, 0.15))), 0.2);
+    vec3 iris = base_iris * (0.5 + 1.0 * fibre);
+    iris *= 1.0 + 0.35 * exp(-pow((t - 0.3) / 0.12, 2.0));
+    iris *= mix(0.45, 1.0, smoothstep(0.0, 0.08, t));
+    iris *= mix(1.0, 0.3, smoothstep(1.0 - LIMBUS_WIDTH, 1.0, t));
     iris = mix(iris, u_pupil, pupil_mask);
     float theta = acos(clamp(e.z, -1.0, 1.0));
-    // Off-white sclera, warmer and pinker toward the corners, with faint vessels.
-    float vessels = smoothstep(0.72, 0.95, value_noise(vec2(atan(e.y, e.x) * 9.0, theta * 14.0), 0));
-    vec3 sclera = u_sclera * vec3(0.93, 0.9, 0.87)
-                * mix(vec3(1.0), vec3(1.0, 0.78, 0.74), smoothstep(0.6, 1.5, theta) + 0.3 * vessels * smoothstep(0.5, 1.0, theta));
-    // The limbus blends softly into the sclera (no cut-out edge).
+    // Off-white sclera (never paper white): a touch warmer and pinker toward the corners
+    // (conjunctival vessels, strongest nasally and temporally), with faint vessels there.
+    float corner = smoothstep(0.4, 0.8, theta) * (0.55 + 0.45 * abs(cos(angle)));
+    float vessels = smoothstep(0.7, 0.95, value_noise(vec2(angle * 9.0, theta * 14.0), 0)) * corner;
+    vec3 sclera = u_sclera * vec3(0.72, 0.7, 0.68)
+                * mix(vec3(1.0), vec3(1.0, 0.8, 0.76), 0.6 * corner + 0.4 * vessels);
+    // The limbus blends softly into the sclera as a greyish ring (no cut-out edge).
+    float limbal = front * exp(-pow((r - IRIS_RADIUS) / 0.035, 2.0));
+    sclera *= 1.0 - 0.35 * limbal;
     float iris_soft = front * (1.0 - smoothstep(IRIS_RADIUS - aa - 0.015, IRIS_RADIUS + aa, r));
     vec3 albedo = mix(sclera, iris, max(iris_mask, 0.6 * iris_soft));
-    // The upper lid and lashes shade the top third of the eyeball.
-    float lid_shade = 1.0 - 0.45 * smoothstep(-0.1, 0.5, n.y);
-    vec3 diffuse = diffuse_light(n, vec3(0.1), occ) * albedo * lid_shade;
-    // Wet surface: a crisp corneal catch-light plus a broader sheen.
-    vec3 spec = specular_light(n, v, 1600.0) * 0.35 + specular_light(n, v, 150.0) * 0.06;
-    radiance = diffuse + spec * schlick(0.04, max(dot(n, v), 0.0)) * 8.0 * occ;
+    // The eyeball sits in the lids' shade: the upper lid and lashes shadow its top, the
+    // canthi its corners (eye frame: +y up, +x across the eye).
+    // (At rest about e.y in [-0.2, 0.2] and e.x in [-0.65, 0.65] show between the lids.)
+    float lid_shade = (1.0 - 0.5 * smoothstep(-0.12, 0.2, e.y)) * (1.0 - 0.15 * smoothstep(0.05, 0.2, -e.y))
+                    * (1.0 - 0.3 * smoothstep(0.35, 0.7, abs(e.x)));
+    vec3 diffuse = diffuse_light(n, vec3(0.15), occ) * albedo * lid_shade;
+    // Wet surface: a small soft catch-light on the cornea only, a faint broad sheen
+    // elsewhere; no bright Fresnel rim (it made the eyes look like glass). The cornea bulges
+    // over the iris as a sphere of 1.33 iris radii (7.8 mm over an 11.7-mm iris), so its
+    // normal tilts faster than the eyeball's: the catch-light sits on the iris, not beside it.
+    // (The eye frame is the world's while head and gaze are at rest; the tilt is added to the
+    // world normal, exact at rest and close for the small turns of 51-58 and 61-64.)
+    float cornea = front * (1.0 - smoothstep(IRIS_RADIUS - 0.02, IRIS_RADIUS + 0.02, r));
+    vec2 bulge = e.xy / CORNEA_RADIUS;
+    vec3 corneal = vec3(bulge, sqrt(max(1.0 - dot(bulge, bulge), 0.0)));
+    vec3 nc = normalize(n + (corneal - e) * cornea);
+    vec3 spec = specular_light(nc, v, 400.0) * 0.1 * cornea + specular_light(n, v, 40.0) * 0.025;
+    radiance = diffuse + spec * mix(0.4, 1.0, lid_shade) * occ;
 #endif
 
     // Inside the mouth the lips and cheeks shade everything; occlusion baked on a closed

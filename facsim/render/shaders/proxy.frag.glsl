@@ -40,7 +40,7 @@ void main() {
     // v_depth: 0 at the brow's head ... 1 at its tail. The head's hairs grow upward, spaced,
     // so skin shows through (a solid dark head reads as a frown); the tail thins out.
     float thin = mix(0.5, 1.0, smoothstep(0.0, 0.35, v_depth)) * mix(1.0, 0.55, smoothstep(0.7, 1.0, v_depth));
-    alpha = clamp(tex.a * 1.6, 0.0, 0.92) * thin * u_density;
+    alpha = clamp(tex.a * 2.0, 0.0, 0.92) * thin * u_density;
 #else
     // v_depth: 0 at the lid ... 1 at the lash tips: each lash tapers to a fine point.
     alpha = clamp(tex.a * 1.25, 0.0, 1.0) * mix(1.0, 0.4, v_depth) * u_density;
