@@ -94,8 +94,47 @@ def test_unknown_hair_is_a_character_error():
         Character(hair="mohawk")
 
 
-def test_brows_follow_the_skin_and_hair_follows_the_head(face_of):
-    face = face_of("ava")
+def _brow_and_lashes(face):
+    """(brow positions, lash positions, left eye centre) on ``face``'s neutral."""
+    bound = {b.proxy.kind: b for b in face.proxies}
+    return (bound["eyebrows"].binding.positions(face.neutral), bound["eyelashes"].binding.positions(face.neutral),
+            face.head.eye_pivot(face.base_positions, "left")[0])
+
+
+def test_neutral_brows_sit_relaxed_and_women_wear_theirs_higher():
+    """Issue 13: no preset frowns at neutral (brow heads clear of the eyes and apart), and
+    women's brows sit higher over the eyes and their lashes reach further than men's."""
+    from facsim.face import Face
+
+    heads, lashes = {"female": [], "male": []}, {"female": [], "male": []}
+    for name in preset_names():
+        character = preset(name)
+        with Face(character) as face:
+            brows, lash, eye = _brow_and_lashes(face)
+        left = brows[:, 0] > 0
+        head = left & (proxies.along_brow(brows) < 0.15)
+        gap = 2 * np.abs(brows[:, 0]).min()
+        height = brows[head, 1].mean() - eye[1]
+        assert gap > 0.15, f"{name}: brow heads {gap * 100:.1f} mm apart (knitted)"
+        assert height > 0.06, f"{name}: brow head {height * 100:.1f} mm over the eye centre (lowered)"
+        sex = "male" if character.gender >= 0.5 else "female"
+        heads[sex].append(height)
+        lashes[sex].append(lash[lash[:, 0] > 0, 1].max() - eye[1])
+    assert np.mean(heads["female"]) > np.mean(heads["male"]) + 0.015
+    assert np.mean(lashes["female"]) > np.mean(lashes["male"]) + 0.005
+
+
+def test_brows_and_lashes_thin_with_age():
+    young, old = proxies.character_look(Character(age=25)), proxies.character_look(Character(age=75))
+    assert old.brow_density < 0.85 * young.brow_density and old.lash_density < 0.85 * young.lash_density
+    assert old.lash_reach < young.lash_reach
+    woman, man = proxies.character_look(Character(gender=0.0)), proxies.character_look(Character(gender=1.0))
+    assert woman.lash_reach > man.lash_reach and woman.brow_lift[1] > man.brow_lift[1]
+
+
+@pytest.mark.parametrize("name", ["ava", "liam"])
+def test_brows_follow_the_skin_and_hair_follows_the_head(face_of, name):
+    face = face_of(name)
     bound = {b.proxy.kind: b for b in face.proxies}
     neutral_brows = bound["eyebrows"].binding.positions(face.neutral)
     # at neutral the binding gives MakeHuman's fit raised along the skin as the character's

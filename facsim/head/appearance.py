@@ -115,14 +115,14 @@ class Appearance:
 
 #: Young-adult colours per ethnicity (sRGB). Sources: typical values of the
 #: Fitzpatrick II / IV / V–VI skin types; brows and irises the commonest shade.
+#: Scleras are warmer where the conjunctiva holds more melanin (darker skin types).
 ETHNIC_COLORS = {
-    "caucasian": {"skin": "#e6b8a2", "brows": "#5c4332", "iris": "#5b7088"},
-    "asian": {"skin": "#e1b690", "brows": "#211b17", "iris": "#3b2618"},
-    "african": {"skin": "#7b4b31", "brows": "#161210", "iris": "#2e1b10"},
+    "caucasian": {"skin": "#e6b8a2", "brows": "#5c4332", "iris": "#5b7088", "sclera": "#ede6df"},
+    "asian": {"skin": "#e1b690", "brows": "#211b17", "iris": "#3b2618", "sclera": "#ebe3d8"},
+    "african": {"skin": "#7b4b31", "brows": "#161210", "iris": "#2e1b10", "sclera": "#e6dccc"},
 }
 FIXED_COLORS = {
     "lashes": "#1b1511",
-    "sclera": "#ede6df",
     "pupil": "#060505",
     "teeth": "#e8dfcf",
     "tongue": "#c46f6c",
@@ -168,6 +168,8 @@ def character_colors(character: Character) -> dict[str, tuple[float, float, floa
         # the skin, which lightens them); they grey later and less than the scalp.
         "brows": (1 - 0.5 * older) * 0.7 * blend("brows") + 0.5 * older * srgb_to_linear(hex_to_rgb(GREY_HAIR)),
         "iris": blend("iris"),
+        # The sclera yellows a little with age.
+        "sclera": blend("sclera") * (1.0 - 0.08 * older * np.array([0.0, 0.25, 1.0])),
         # Scalp hair greys earlier and further than the brows.
         "hair": (1 - 0.85 * greying) * blend("brows") * 1.15 + 0.85 * greying * srgb_to_linear(hex_to_rgb(GREY_HAIR)),
     }

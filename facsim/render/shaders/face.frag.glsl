@@ -267,7 +267,7 @@ void main() {
     // (conjunctival vessels, strongest nasally and temporally), with faint vessels there.
     float corner = smoothstep(0.4, 0.8, theta) * (0.55 + 0.45 * abs(cos(angle)));
     float vessels = smoothstep(0.7, 0.95, value_noise(vec2(angle * 9.0, theta * 14.0), 0)) * corner;
-    vec3 sclera = u_sclera * vec3(0.72, 0.7, 0.68)
+    vec3 sclera = u_sclera * vec3(0.84, 0.82, 0.8)
                 * mix(vec3(1.0), vec3(1.0, 0.8, 0.76), 0.6 * corner + 0.4 * vessels);
     // The limbus blends softly into the sclera as a greyish ring (no cut-out edge).
     float limbal = front * exp(-pow((r - IRIS_RADIUS) / 0.035, 2.0));

@@ -1,0 +1,69 @@
+"""Eyes as a viewer sees them (issue 13): iris size, off-white sclera, a catch-light on the cornea.
+
+The eye's pixels are found by rendering the same face again with a loud sclera or iris colour
+and keeping the pixels that changed.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from facsim.face import Face
+from facsim.head.character import preset
+
+SIZE = 320
+
+
+def _render(character) -> np.ndarray:
+    with Face(character) as face:
+        return face.render("", size=SIZE, antialias=1, background=(1.0, 1.0, 1.0))[..., :3].astype(int)
+
+
+@pytest.fixture(scope="module")
+def eye_pixels():
+    ava = preset("ava")
+    normal = _render(ava)
+    green_sclera = _render(ava.with_(colors={**ava.colors, "sclera": "#00ff00"}))
+    red_iris = _render(ava.with_(colors={**ava.colors, "iris": "#ff0000"}))
+    iris = np.abs(red_iris - normal).sum(-1) > 60
+    sclera = (np.abs(green_sclera - normal).sum(-1) > 60) & ~iris
+    return normal, sclera, iris
+
+
+def _luminance(rgb):
+    return rgb @ np.array([0.2126, 0.7152, 0.0722])
+
+
+def test_iris_is_about_11_7_mm_across(eye_pixels):
+    _, _, iris = eye_pixels
+    half = SIZE // 2
+    widths, centres = [], []
+    for side in (slice(0, half), slice(half, SIZE)):
+        cols = np.flatnonzero(iris[:, side].any(axis=0)) + side.start
+        widths.append(cols.max() - cols.min() + 1)
+        centres.append(np.nonzero(iris[:, side])[1].mean() + side.start)
+    # hm08's eye centres are 57.6 mm apart: an 11.7-mm iris is about a fifth of that
+    ratio = np.mean(widths) / (centres[1] - centres[0])
+    assert 0.17 < ratio < 0.24, ratio
+
+
+def test_sclera_is_off_white_and_redder_toward_the_corners(eye_pixels):
+    image, sclera, iris = eye_pixels
+    lum = _luminance(image[sclera])
+    assert 150 < np.percentile(lum, 95) < 215  # not paper white (it was 229), not grey
+    assert (image[sclera][:, 2] < image[sclera][:, 0]).mean() > 0.8  # warm, not blue-white
+    redness = image[..., 0] - image[..., 1]
+    ys, xs = np.nonzero(sclera)
+    iris_x = np.nonzero(iris)[1]
+    for right_half in (False, True):
+        side = (xs >= SIZE // 2) == right_half
+        centre = iris_x[(iris_x >= SIZE // 2) == right_half].mean()
+        d = np.abs(xs[side] - centre)
+        far, near = d > np.percentile(d, 75), d < np.percentile(d, 25)
+        assert redness[ys[side][far], xs[side][far]].mean() > redness[ys[side][near], xs[side][near]].mean() + 3
+
+def test_a_catch_light_sits_on_the_iris(eye_pixels):
+    image, _, iris = eye_pixels
+    lum_iris = _luminance(image[iris])
+    assert lum_iris.max() > np.median(lum_iris) + 60  # a small bright catch-light ...
+    assert (lum_iris > np.median(lum_iris) + 60).mean() < 0.05  # ... not a glossy sheet
