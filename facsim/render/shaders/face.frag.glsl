@@ -269,6 +269,10 @@ void main() {
     float vessels = smoothstep(0.7, 0.95, value_noise(vec2(angle * 9.0, theta * 14.0), 0)) * corner;
     vec3 sclera = u_sclera * vec3(0.84, 0.82, 0.8)
                 * mix(vec3(1.0), vec3(1.0, 0.8, 0.76), 0.6 * corner + 0.4 * vessels);
+    // Caruncle and plica: a pink fleshy fold fills the inner corner (e.x toward the nose:
+    // -x for the eye on the +x side of the head).
+    float nasal = front * smoothstep(0.45, 0.63, -sign(v_pos.x) * e.x);
+    sclera = mix(sclera, u_sclera * vec3(0.82, 0.52, 0.5), 0.85 * nasal);
     // The limbus blends softly into the sclera as a greyish ring (no cut-out edge).
     float limbal = front * exp(-pow((r - IRIS_RADIUS) / 0.035, 2.0));
     sclera *= 1.0 - 0.35 * limbal;
