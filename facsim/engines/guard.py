@@ -49,15 +49,6 @@ MAX_RINGS = 4
 MAX_CORRECTION = 0.03
 #: Rest triangles smaller than this (twice the area, dm²) have no reliable orientation.
 DEGENERATE_AREA2 = 1e-10
-#: Target repair (:meth:`SkinGuard.unfold`, once per morph target when it is loaded): the least
-#: share of its rest area a skin triangle keeps at any weight of the target. Well above
-#: MIN_AREA_SHARE, so that targets summed with others (a closed lid under a raised cheek) keep
-#: room before they fold.
-UNFOLD_SHARE = 0.2
-#: Weights (as shares of the largest weight the register table gives the target) checked.
-UNFOLD_STEPS = 5
-#: Rings of skin around the folded triangles whose displacement is made harmonic, at most.
-UNFOLD_RINGS = 8
 
 
 class SkinGuard:
@@ -114,67 +105,6 @@ class SkinGuard:
         out[: self.skin] = skin
         return out
 
-    def unfold(self, offsets: np.ndarray, reach: float = 1.0) -> np.ndarray:
-        """A morph target's offsets repaired so that it folds no skin at any weight up to ``reach``.
-
-        Some authored targets fold the skin by themselves: eyeBlink drags the
-        upper lid's corners down past the lower lid's (the canthi do not
-        move in a real blink), mouthClose pushes the lips through each other.
-        Where a triangle would fall below :data:`UNFOLD_SHARE` of its rest area
-        (at any of :data:`UNFOLD_STEPS` weights, with the skin kept off the
-        eyeballs as :meth:`__call__` keeps it), the displacement of its corners
-        and of a ring around them is replaced by the harmonic one that meets the
-        authored motion at the patch's border (a harmonic map of a disc does
-        not fold), widening the patch a ring at a time while folds remain. Everything else keeps the authored motion, so the
-        lid still closes and the lips still meet.
-
-        Parameters
-        ----------
-        offsets : (N, 3) array
-            The target's offsets on geometry vertices (skin first); only the skin's are repaired.
-        reach : float
-            The largest weight the target is given.
-        """
-        d = np.asarray(offsets, float)[: self.skin].copy()
-        if not np.any(d):
-            return np.asarray(offsets)
-        weights = reach * np.linspace(1.0 / UNFOLD_STEPS, 1.0, UNFOLD_STEPS)
-        adjacency = self._adjacency
-        # Only skin near what the target moves can fold: check those triangles (and eye points).
-        near = np.flatnonzero(np.abs(d).sum(axis=1) > 0)
-        for _ in range(UNFOLD_RINGS + 2):
-            near = np.union1d(near, adjacency[near].indices)
-        region = np.zeros(self.skin, bool)
-        region[near] = True
-        tris = np.flatnonzero(region[self.triangles].all(axis=1))
-        t = self.triangles[tris]
-        eyes = [(centre, outside[region[outside]], floor[region[outside]]) for centre, outside, floor in self.eyes]
-        authored, folds = d.copy(), np.zeros(0, np.int64)
-        for rings in range(1, UNFOLD_RINGS + 1):
-            bad = []
-            for w in weights:
-                p = self.rest + w * d
-                for centre, outside, floor in eyes:
-                    offset = p[outside] - centre
-                    dist = np.linalg.norm(offset, axis=1)
-                    lift = np.maximum(floor / np.maximum(dist, 1e-12), 1.0)
-                    p[outside] = centre + offset * lift[:, None]
-                cross = np.cross(p[t[:, 1]] - p[t[:, 0]], p[t[:, 2]] - p[t[:, 0]])
-                kept = (cross * self.rest_normal[tris]).sum(axis=1) / self.rest_area2[tris]
-                bad.append(tris[kept < UNFOLD_SHARE])
-            bad = np.unique(np.concatenate(bad))
-            if not len(bad):
-                break
-            folds = np.union1d(folds, bad)
-            patch = np.unique(self.triangles[folds])
-            for _ in range(rings):
-                patch = np.union1d(patch, adjacency[patch].indices)
-            d = authored.copy()
-            d[patch] = _harmonic_fill(adjacency, patch, authored)
-        out = np.array(offsets, dtype=np.float32, copy=True)
-        out[: self.skin] = d
-        return out
-
     # -- the two steps (in place on skin positions (N_skin, 3), float64)
 
     def off_eyes(self, skin: np.ndarray) -> int:
@@ -190,16 +120,12 @@ class SkinGuard:
                 count += int(inside.sum())
         return count
 
-    def folded(self, skin: np.ndarray, *, share: float = MIN_AREA_SHARE, off_eyes: bool = False) -> np.ndarray:
-        """Indices of skin triangles below ``share`` of their rest area along the rest normal
-        (with the skin first moved off the eyeballs, on a copy, if ``off_eyes``)."""
-        if off_eyes:
-            skin = skin.copy()
-            self.off_eyes(skin)
+    def folded(self, skin: np.ndarray) -> np.ndarray:
+        """Indices of skin triangles below :data:`MIN_AREA_SHARE` of their rest area along the rest normal."""
         t = self.triangles
         cross = np.cross(skin[t[:, 1]] - skin[t[:, 0]], skin[t[:, 2]] - skin[t[:, 0]])
-        kept = (cross * self.rest_normal).sum(axis=1) / self.rest_area2
-        return np.flatnonzero(kept < share)
+        share = (cross * self.rest_normal).sum(axis=1) / self.rest_area2
+        return np.flatnonzero(share < MIN_AREA_SHARE)
 
     def _patches(self, bad: np.ndarray, rings: int) -> tuple[np.ndarray, np.ndarray]:
         """Patches of ``rings`` rings around triangles ``bad`` (built on first use, then kept)."""
@@ -250,20 +176,6 @@ class SkinGuard:
             self.off_eyes(skin)
             bad = self.folded(skin)
         return first
-
-
-def _harmonic_fill(adjacency, patch: np.ndarray, values: np.ndarray) -> np.ndarray:
-    """Values (len(patch), 3) on ``patch`` that are harmonic (each the mean of its neighbours')
-    and meet ``values`` (N, 3) on the vertices around the patch."""
-    from scipy.sparse.linalg import spsolve
-
-    inner = adjacency[patch][:, patch]
-    degree = np.asarray(adjacency[patch].sum(axis=1)).ravel()
-    laplace = sp.diags(degree) - inner
-    inside = np.zeros(adjacency.shape[0], bool)
-    inside[patch] = True
-    border = adjacency[patch][:, ~inside] @ values[~inside]
-    return np.asarray(spsolve(laplace.tocsc(), border)).reshape(len(patch), -1)
 
 
 def _patches(triangles: np.ndarray, adjacency, rings: int) -> tuple[np.ndarray, np.ndarray]:

@@ -47,13 +47,6 @@ def simulated_codes() -> set[int]:
     return set(register_table()["action_units"]) | rigid_codes()
 
 
-def largest_weight(pattern: str) -> float:
-    """The largest maximum weight any AU gives target ``pattern`` in the table (combinations only lower it)."""
-    table = register_table()["action_units"]
-    return max((float(reg["max"]) for spec in table.values() for reg in spec.get("registers", [])
-                if reg["target"] == pattern), default=1.0)
-
-
 def combine_registers(contributions: Iterable[tuple[float, float]]) -> float:
     """HapFACS Eq. 1: sum of ``intensity × max`` over AUs, clamped to the smallest max.
 
@@ -159,36 +152,24 @@ class RegisterEngine:
         """Offsets (N_base_geo, 3) of one column, mixed by ethnicity and split by side.
 
         Right-side columns are the mirror images of the left ones: the authored
-        targets are a little asymmetric, and FACS stimuli must not be. Authored
-        targets that fold the skin by themselves (eyeBlink's lid corners,
-        mouthClose's lips) are repaired here, once, for every weight the table
-        gives them (:meth:`~facsim.engines.guard.SkinGuard.unfold`): each side
-        on its own, and a two-sided target as a whole before it is split.
+        targets are a little asymmetric, and FACS stimuli must not be.
         """
-        if col not in self._columns:
-            reach = largest_weight(col.pattern)
-            if col.sided:
-                self._columns[col] = self.guard.unfold(self._authored(col.pattern, col.side), reach)
-            else:
-                whole = self.guard.unfold(self._authored(col.pattern, "left") + self._authored(col.pattern, "right"), reach)
-                half = self._half if col.side == "left" else 1.0 - self._half
-                self._columns[col] = self.guard.unfold(whole * half[:, None], reach)
-        return self._columns[col]
-
-    def _authored(self, pattern: str, side: str) -> np.ndarray:
-        """The authored offsets of one column (ethnicity mix, side split; the right mirrors the left)."""
-        if side == "right":
+        if col not in self._columns and col.side == "right":
+            left = self.column(Column(col.pattern, "left"))
             mirror = self.head.mirror[: len(self.head.base_index)]
-            return self._authored(pattern, "left")[mirror] * np.array([-1.0, 1.0, 1.0], np.float32)
-        name, sided = _expand(pattern, side)
-        offsets = np.zeros((len(self.head.base_index), 3), np.float32)
-        mixes = self.ethnicity.items() if "{ethnicity}" in name else [(None, 1.0)]
-        for ethnicity, weight in mixes:
-            idx, delta = self.data.target(name.replace("{ethnicity}", ethnicity) if ethnicity else name)
-            geo = self.head.geo_of_base[idx]
-            keep = geo >= 0
-            offsets[geo[keep]] += weight * delta[keep]
-        return offsets * (self._reach if sided else self._half)[:, None]
+            self._columns[col] = left[mirror] * np.array([-1.0, 1.0, 1.0], np.float32)
+        if col not in self._columns:
+            offsets = np.zeros((len(self.head.base_index), 3), np.float32)
+            mixes = self.ethnicity.items() if "{ethnicity}" in col.target else [(None, 1.0)]
+            for ethnicity, weight in mixes:
+                name = col.target.replace("{ethnicity}", ethnicity) if ethnicity else col.target
+                idx, delta = self.data.target(name)
+                geo = self.head.geo_of_base[idx]
+                keep = geo >= 0
+                offsets[geo[keep]] += weight * delta[keep]
+            offsets *= (self._reach if col.sided else self._half)[:, None]
+            self._columns[col] = offsets
+        return self._columns[col]
 
     def deform(self, act: Activations) -> Deformation:
         """The expression ``act``: targets weighted by Eq. 1, then the eyes and the head moved rigidly."""
