@@ -12,6 +12,8 @@ variable, named in the error a user sees when they reach it::
     FACSIM_MAX_FRAMES        frames in one video (duration x fps)            default 1,000,000 (9.3 h at 30 fps)
     FACSIM_MAX_FPS           frame rate                                      default 1,000
     FACSIM_MAX_NOTATION      characters of one FACS string                   default 10,000
+    FACSIM_MAX_IMAGE_PIXELS  pixels of an image or video frame to analyse    default 50,000,000 (50 MP)
+    FACSIM_MAX_ITEMS         output files one batch spec expands to          default 100,000
 
 YAML aliases (``*name``) are refused outright: timeline files never need them,
 and nested aliases are how a 450-byte file expands to gigabytes.
@@ -38,6 +40,8 @@ LIMITS = {
     "max_frames": ("FACSIM_MAX_FRAMES", 1_000_000),
     "max_fps": ("FACSIM_MAX_FPS", 1000),
     "max_notation": ("FACSIM_MAX_NOTATION", 10_000),
+    "max_image_pixels": ("FACSIM_MAX_IMAGE_PIXELS", 50_000_000),
+    "max_items": ("FACSIM_MAX_ITEMS", 100_000),
 }
 #: The slowest frame rate a video may have (one frame every 100 s).
 MIN_FPS = 0.01
@@ -105,6 +109,14 @@ def check_frames(frames: float, what: str) -> None:
         raise ValueError(f"{what} makes {frames:,.0f} frames, too many for one video {override_hint('max_frames')}")
 
 
+def check_image_size(width: int, height: int, what: str) -> None:
+    """``ValueError`` if an image of ``width`` × ``height`` pixels is over the pixel limit
+    (checked before it is decoded); ``what`` names the image."""
+    if width * height > limit("max_image_pixels"):
+        raise ValueError(f"{what} is {width:,}x{height:,} pixels, too big to analyse "
+                         f"{override_hint('max_image_pixels')}")
+
+
 def check_file_size(path, problem=ValueError) -> None:
     """Raise ``problem(message)`` if the file at ``path`` is bigger than the input limit."""
     size = os.path.getsize(path)
@@ -113,5 +125,5 @@ def check_file_size(path, problem=ValueError) -> None:
                       "long recordings are smaller as .facs")
 
 
-__all__ = ["LIMITS", "MAX_MESSAGE", "MIN_FPS", "check_file_size", "check_fps", "check_frames", "clip", "limit",
+__all__ = ["LIMITS", "MAX_MESSAGE", "MIN_FPS", "check_file_size", "check_fps", "check_frames", "check_image_size", "clip", "limit",
            "override_hint", "short"]

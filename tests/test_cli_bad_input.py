@@ -31,7 +31,15 @@ FILES = {
     "binary.csv": b"\xff\xfe" + OPENFACE.encode(),
     "bad.facs": "facsim-notation 1\nAU12 0-1e17\n",
     "deep.json": '{"tracks": ' + "[" * 100_000 + "]" * 100_000 + "}",
+    # a 150x120 black PNG: over the pixel limit the fixture sets
+    "wide.png": b'\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR\x00\x00\x00\x96\x00\x00\x00x\x08\x02\x00\x00\x00\x9f-\x9cG\x00\x00\x00KIDATx\x9c\xed\xc1\x01\r\x00\x00\x00\xc2\xa0\xf7Om\x0f\x07\x14\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x0f\x06\xd3h\x00\x01\xc6\xa4\x1e[\x00\x00\x00\x00IEND\xaeB`\x82',
+    # 3 characters x 20 AUs x 5 intensities x 2 views x 2 sizes = 1,200 stills: over the fixture's limit
+    "big_set.yaml": "characters: [ava, liam, zola]\nviews: [front, profile-left]\nsizes: [64, 128]\nblocks:\n"
+                    "  - {name: b, aus: [1, 2, 4, 5, 6, 7, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 20, 22, 23, 24],\n"
+                    "     intensities: [0.2, 0.4, 0.6, 0.8, 1.0], outputs: {stills: [1]}}\n",
 }
+#: Limits lowered for the table (they only concern the camera processor and batch specs).
+LOW_LIMITS = {"FACSIM_MAX_IMAGE_PIXELS": "10000", "FACSIM_MAX_ITEMS": "1000"}
 
 BAD = [
     # render: notation, options, outputs
@@ -116,6 +124,10 @@ BAD = [
     "analyse ok.csv --face \u0664",
     "retarget ok.csv -o x.mp4 --size 0",
     "validate --size 1e9",
+    "analyse wide.png",
+    "retarget wide.png -o x.mp4",
+    # batch
+    "batch big_set.yaml -o out --dry-run",
     # the command line itself
     "frobnicate",
     "",
@@ -129,6 +141,8 @@ def workdir(tmp_path, monkeypatch):
         path.write_bytes(content if isinstance(content, bytes) else content.encode("utf-8"))
     monkeypatch.chdir(tmp_path)
     monkeypatch.delenv("FACSIM_DEBUG", raising=False)
+    for name, value in LOW_LIMITS.items():
+        monkeypatch.setenv(name, value)
     return tmp_path
 
 
@@ -168,6 +182,9 @@ def test_messages_name_the_problem(workdir, capsys):
         "animate long.yaml -o x.mp4": "FACSIM_MAX_FRAMES",
         "animate binary.yaml -o x.mp4": "binary.yaml: not UTF-8",
         "import openface close.csv -o t.yaml": "close.csv: timestamps",
+        "analyse wide.png": "image wide.png is 150x120 pixels, too big to analyse (limit 10,000; set FACSIM_MAX_IMAGE_PIXELS",
+        "batch big_set.yaml -o out --dry-run": "expands to 1,200 output files, too many for one set (limit 1,000; "
+                                               "set FACSIM_MAX_ITEMS",
     }
     for command, fragment in expected.items():
         _, err = run(command.split(), capsys)

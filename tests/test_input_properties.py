@@ -12,6 +12,7 @@ import signal
 import string
 from contextlib import contextmanager
 
+import numpy as np
 import pytest
 
 hypothesis = pytest.importorskip("hypothesis")
@@ -289,3 +290,72 @@ def test_blinks_up_to_a_time_are_a_prefix_of_all_blinks(seed, until):
     every = blink_times(timeline)
     early = blink_times(timeline, until)
     assert np.array_equal(early, every[every < until])
+
+
+# ------------------------------------------------------------------ camera processor and batch limits
+
+
+@pytest.fixture(scope="module")
+def tiny_video(tmp_path_factory):
+    """A 5-frame 32x32 MP4 (libx264 needs even sizes)."""
+    from facsim.media.video import VideoWriter
+
+    path = tmp_path_factory.mktemp("video") / "five.mp4"
+    with VideoWriter(path, fps=10) as writer:
+        for k in range(5):
+            writer.append(np.full((32, 32, 3), 40 * k, np.uint8))
+    return path
+
+
+def test_analysed_images_over_the_pixel_limit_are_refused_before_decoding(tmp_path, monkeypatch):
+    import imageio.v3 as iio
+    from facsim.analysis.processor import AnalysisError, iter_frames
+
+    path = tmp_path / "frame.png"
+    iio.imwrite(path, np.zeros((40, 50, 3), np.uint8))
+    monkeypatch.setenv("FACSIM_MAX_IMAGE_PIXELS", "1999")
+    with pytest.raises(AnalysisError, match=r"frame\.png is 50x40 pixels.*FACSIM_MAX_IMAGE_PIXELS") as caught:
+        next(iter_frames(path)[0])
+    one_bounded_line(caught.value)
+    with pytest.raises(AnalysisError, match="FACSIM_MAX_IMAGE_PIXELS"):
+        iter_frames(np.zeros((40, 50, 3), np.uint8))
+    monkeypatch.setenv("FACSIM_MAX_IMAGE_PIXELS", "2000")
+    assert next(iter_frames(path)[0])[1].shape == (40, 50, 3)
+
+
+def test_analysed_folders_and_videos_over_the_frame_limit_are_refused(tmp_path, monkeypatch, tiny_video):
+    import imageio.v3 as iio
+    from facsim.analysis.processor import AnalysisError, iter_frames
+
+    for k in range(3):
+        iio.imwrite(tmp_path / f"f{k}.png", np.zeros((8, 8, 3), np.uint8))
+    monkeypatch.setenv("FACSIM_MAX_FRAMES", "2")
+    with pytest.raises(AnalysisError, match="makes 3 frames.*FACSIM_MAX_FRAMES"):
+        iter_frames(tmp_path)
+    with pytest.raises(AnalysisError, match=r"five\.mp4.*FACSIM_MAX_FRAMES") as caught:
+        list(iter_frames(tiny_video)[0])
+    one_bounded_line(caught.value)
+    monkeypatch.setenv("FACSIM_MAX_FRAMES", "100")
+    monkeypatch.setenv("FACSIM_MAX_IMAGE_PIXELS", "1000")
+    with pytest.raises(AnalysisError, match=r"frame of video five\.mp4 is 32x32 pixels.*FACSIM_MAX_IMAGE_PIXELS"):
+        iter_frames(tiny_video)
+    monkeypatch.setenv("FACSIM_MAX_IMAGE_PIXELS", "1024")
+    assert len(list(iter_frames(tiny_video)[0])) == 5
+    assert len(list(iter_frames(tmp_path)[0])) == 3
+
+
+def test_batch_specs_expanding_past_the_item_limit_are_refused(monkeypatch):
+    from facsim.batch.items import expand
+    from facsim.batch.spec import SpecError, spec_from_dict
+
+    data = {"characters": ["ava", "liam"], "views": ["front", "profile-left"],
+            "blocks": [{"name": "b", "aus": [1, 2, 4], "intensities": [0.5, 1.0],
+                        "outputs": {"stills": [1], "video": True, "glb": True}}]}
+    files = 2 * (3 * 2 * 2 * (1 + 1) + 3 * 2)   # characters x (conditions x (still + video) + glbs)
+    assert len(expand(spec_from_dict(data))) == files
+    monkeypatch.setenv("FACSIM_MAX_ITEMS", str(files - 1))
+    with pytest.raises(SpecError, match=f"expands to {files} output files.*FACSIM_MAX_ITEMS") as caught:
+        spec_from_dict(data)
+    one_bounded_line(caught.value)
+    monkeypatch.setenv("FACSIM_MAX_ITEMS", str(files))
+    assert len(expand(spec_from_dict(data))) == files

@@ -215,9 +215,14 @@ def format_levels(levels: dict, rigid: dict, *, threshold: float = PRESENT, rigi
 def _read_image(path: Path) -> np.ndarray:
     from PIL import Image, ImageOps
 
+    from facsim.limits import check_image_size
+
     try:
         with Image.open(path) as im:
+            check_image_size(*im.size, f"image {path.name}")  # before decoding: the header gives the size
             return np.asarray(ImageOps.exif_transpose(im).convert("RGB"))
+    except ValueError as exc:
+        raise AnalysisError(str(exc)) from None
     except Exception as exc:
         raise AnalysisError(f"cannot read image {path}: {exc}") from None
 
@@ -242,9 +247,16 @@ def input_kind(source) -> str:
 
 def iter_frames(source):
     """(frames iterator of (name, RGB array), fps, count or None) for any input kind."""
+    from facsim.limits import check_frames, check_image_size, limit, override_hint
+
     kind = input_kind(source)
     if kind == "array":
         array = np.asarray(source)
+        if array.ndim >= 2:
+            try:
+                check_image_size(array.shape[1], array.shape[0], "the image array")
+            except ValueError as exc:
+                raise AnalysisError(str(exc)) from None
         return iter([("", array)]), 1.0, 1
     path = Path(source)
     if kind == "image":
@@ -253,6 +265,10 @@ def iter_frames(source):
         files = sorted(p for p in path.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES)
         if not files:
             raise AnalysisError(f"no images ({', '.join(IMAGE_SUFFIXES)}) in folder {path}")
+        try:
+            check_frames(len(files), f"folder {path}")
+        except ValueError as exc:
+            raise AnalysisError(str(exc)) from None
         return ((p.name, _read_image(p)) for p in files), 1.0, len(files)
     import imageio.v2 as imageio
 
@@ -263,11 +279,22 @@ def iter_frames(source):
         raise AnalysisError(f"cannot read video {path}: {exc}") from None
     fps = float(meta.get("fps") or 30.0)
     duration = meta.get("duration")
-    count = int(round(duration * fps)) if duration else None
+    count = int(round(duration * fps)) if duration and math.isfinite(duration * fps) else None
+    try:
+        if meta.get("size"):
+            check_image_size(*meta["size"], f"a frame of video {path.name}")
+        if count is not None:
+            check_frames(count, f"video {path.name}")
+    except ValueError as exc:
+        reader.close()
+        raise AnalysisError(str(exc)) from None
 
     def frames():
         try:
-            for frame in reader:
+            for done, frame in enumerate(reader):
+                if done >= limit("max_frames"):  # a container that understates its length
+                    raise AnalysisError(f"video {path.name} has more than {limit('max_frames'):,} frames "
+                                        f"{override_hint('max_frames')}")
                 yield "", np.asarray(frame)[..., :3]
         finally:
             reader.close()

@@ -424,6 +424,22 @@ def _background(value: str) -> tuple[float, float, float]:
         raise SpecError(str(exc), location=("background",)) from None
 
 
+def _check_item_count(blocks: Sequence[Block], counterbalance: str, lists: int) -> None:
+    """Refuse a spec that expands to more output files than the limit, before expanding it:
+    a few lines of YAML can cross factors into millions of files."""
+    from facsim.limits import limit, override_hint
+
+    total = 0
+    for block in blocks:
+        glbs = len(block.stimuli) * len(block.intensities) * len(block.engines) * bool(block.outputs.glb)
+        conds = len(block.stimuli) * len(block.intensities) * len(block.engines) * len(block.views) * len(block.sizes)
+        files = conds * (len(block.outputs.stills) + (block.outputs.video is not None)) + glbs  # one glb per view and size
+        total += files * (len(block.characters) if counterbalance == "full" else lists)
+    if total > limit("max_items"):
+        raise SpecError(f"the spec expands to {total:,} output files, too many for one set "
+                        f"{override_hint('max_items')}", location=("blocks",))
+
+
 def spec_from_dict(data: Any, *, base_dir: str | os.PathLike | None = None) -> StimulusSet:
     """Check parsed YAML/JSON and build the :class:`StimulusSet`.
 
@@ -474,6 +490,7 @@ def spec_from_dict(data: Any, *, base_dir: str | os.PathLike | None = None) -> S
         if lists > fewest:
             raise SpecError(f"{lists} lists need at least {lists} characters in every block, "
                             f"but a block has {fewest}", location=("counterbalance", "latin_square", "lists"))
+    _check_item_count(blocks, counterbalance, lists)
     naming = data.get("naming", "readable")
     key_file = "key.csv"
     if isinstance(naming, Mapping):
