@@ -42,9 +42,9 @@ LID_HEIGHT = 0.03
 ROUNDS = 4
 #: Rounds of the untangling step; the patch fitted around a folded triangle widens by a ring
 #: every WIDEN_EVERY rounds it stays folded, up to MAX_RINGS.
-UNTANGLE_ROUNDS = 32
+UNTANGLE_ROUNDS = 64
 WIDEN_EVERY = 8
-MAX_RINGS = 4
+MAX_RINGS = 6
 #: Furthest (dm) the untangling moves any vertex: 1.5 mm.
 MAX_CORRECTION = 0.03
 #: Rest triangles smaller than this (twice the area, dm²) have no reliable orientation.

@@ -171,14 +171,37 @@ class RegisterEngine:
             self._columns[col] = offsets
         return self._columns[col]
 
+    @cached_property
+    def lids(self) -> dict:
+        """(target, side) -> :class:`~facsim.engines.lids.EyeLids` for the closing targets
+        (``lid_closing`` in the table)."""
+        from facsim.engines.lids import EyeLids
+
+        skin = self.head.skin_vertex_count
+        anchors = np.unique(self.head.lash_anchors)
+        out = {}
+        for pattern in register_table().get("lid_closing", ()):
+            for side in ("left", "right"):
+                centre, radius = self.head.eye_pivot(self.base_positions, side)
+                margin = anchors[np.linalg.norm(self.neutral[anchors] - centre, axis=1) < 2 * radius]
+                out[pattern, side] = EyeLids(self.neutral[:skin], self.column(Column(pattern, side))[:skin],
+                                             centre, radius, margin)
+        return out
+
     def deform(self, act: Activations) -> Deformation:
         """The expression ``act``: targets weighted by Eq. 1, then the eyes and the head moved rigidly."""
         if not act:
             return Deformation(self.neutral)
         base = self.base_positions[self.head.base_index]  # a copy (fancy indexing)
+        closing = {}
         for col, weight in register_weights(act).items():
             if weight:
                 base += weight * self.column(col)
+                if (col.pattern, col.side) in self.lids:
+                    closing[col.pattern, col.side] = weight * self.column(col)
+        skin = self.head.skin_vertex_count
+        for key, share in closing.items():  # the upper lid stops on the lower one
+            self.lids[key].close_on_lower(base[:skin], share[:skin])
         morphed = np.array(self.base_positions, copy=True)
         morphed[self.head.base_index] = base
         positions = self.head.positions(morphed, neutral_base=self.base_positions,

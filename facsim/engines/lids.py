@@ -1,0 +1,115 @@
+"""Closing lids fitted to the character: the upper lid stops where it meets the lower lid.
+
+The Face Units' eyeBlink target was authored on MakeHuman's base mesh. On a
+character its upper lid margin travels a fixed distance, which takes it 6–10°
+of eyeball arc (2–3 mm) PAST the lower lid margin: the closed upper lid runs
+over the lower lid's skin and, near the corners where the two margins meet,
+turns it inside out. A real lid stops when its margin meets the lower one.
+
+:meth:`EyeLids.close_on_lower` is a contact between the two margins, applied
+to every expression after the targets are summed: where the closing targets'
+share of the motion takes the upper margin past the lower margin (as the other
+AUs have left it: a cheek raised by 6 lifts it), that share is scaled down per
+direction around the eye (azimuth) until the margins just meet, and the skin
+above follows by the same smooth factor (no new folds). The lower lid keeps its
+motion. Angles are measured about the eyeball's centre, so the contact holds
+for any eye size or lid shape the character's sliders give.
+
+Examples
+--------
+>>> lids = EyeLids(rest, blink_offsets, centre, radius, margin)   # doctest: +SKIP
+>>> lids.close_on_lower(positions, blink_share)                   # doctest: +SKIP
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from facsim.head.surface import smoothstep
+
+#: An upper-margin point whose elevation falls by more than this (degrees) at full weight
+#: belongs to the closing upper lid; the others are the lower lid's margin.
+UPPER_MOVES = 3.0
+#: The upper margin comes to rest this far (degrees of arc, ~0.1 mm) below the lower margin's
+#: elevation, so that no sliver of eye shows between them.
+OVERLAP = -0.5
+#: Skin from this far below the lower margin (degrees) up to this far above it blends from
+#: the lower lid's motion (unchanged) to the upper lid's (rescaled).
+BLEND = (0.0, 3.0)
+#: Only skin within this many eyeball radii of the centre belongs to the lids.
+REACH = 2.5
+#: Bisection steps when solving for the weight at which a margin point meets the lower margin.
+STEPS = 30
+
+
+def spherical(points: np.ndarray, centre: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Azimuth (toward +X, degrees from straight ahead) and elevation (degrees) about ``centre``."""
+    q = np.asarray(points, float) - centre
+    r = np.maximum(np.linalg.norm(q, axis=-1), 1e-12)
+    return np.degrees(np.arctan2(q[..., 0], q[..., 2])), np.degrees(np.arcsin(np.clip(q[..., 1] / r, -1, 1)))
+
+
+class EyeLids:
+    """One eye's lids, found from a closing target on a character's neutral skin.
+
+    Parameters
+    ----------
+    rest : (N, 3) array
+        The character's neutral skin positions.
+    closing : (N, 3) array
+        A target that closes this eye (its offsets at full weight): it tells the upper
+        margin (which it moves down) from the lower.
+    centre, radius
+        The eyeball.
+    margin : (K,) int array
+        Skin vertices along both lid margins of this eye (the lashes' roots).
+    """
+
+    def __init__(self, rest, closing, centre, radius: float, margin):
+        rest = np.asarray(rest, float)
+        closing = np.asarray(closing, float)
+        self.centre = np.asarray(centre, float)
+        margin = np.asarray(margin)
+        lam0, phi0 = spherical(rest[margin], self.centre)
+        lam1, phi1 = spherical(rest[margin] + closing[margin], self.centre)
+        upper = phi0 - phi1 > UPPER_MOVES
+        self.ok = upper.sum() >= 2 and (~upper).sum() >= 2
+        self.upper = margin[upper][np.argsort(lam0[upper])]
+        self.lower = margin[~upper]
+        self.upper_lam = np.sort(lam0[upper])
+        order = np.argsort(lam0[~upper])
+        lower_lam, lower_phi = lam0[~upper][order], phi0[~upper][order]
+        # The lid skin: near the eye; above the lower margin it is the upper lid's.
+        self.lid = np.flatnonzero(np.linalg.norm(rest - self.centre, axis=1) < REACH * radius)
+        lam, phi = spherical(rest[self.lid], self.centre)
+        self.lid_lam = lam
+        self.upper_share = smoothstep(BLEND[0], BLEND[1], phi - np.interp(lam, lower_lam, lower_phi))
+
+    def close_on_lower(self, positions: np.ndarray, closing: np.ndarray) -> None:
+        """Hold the upper lid where it meets the lower one (in place).
+
+        ``positions`` (N, 3) include ``closing`` (N, 3), the closing targets' share of the
+        motion; where that share takes the upper margin below the lower margin (as the
+        other AUs have left it), the upper lid's share is scaled down, per azimuth, until
+        the margins just meet. Nothing changes while the lids are apart.
+        """
+        if not self.ok:
+            return
+        lam, phi = spherical(positions[self.lower], self.centre)
+        order = np.argsort(lam)
+        lower_lam, lower_phi = lam[order], phi[order]
+
+        def through(share):
+            lam, phi = spherical(positions[self.upper] - (1.0 - share)[:, None] * closing[self.upper], self.centre)
+            return phi < np.interp(lam, lower_lam, lower_phi) - OVERLAP
+
+        if not through(np.ones(len(self.upper))).any():
+            return
+        lo, hi = np.zeros(len(self.upper)), np.ones(len(self.upper))
+        for _ in range(STEPS):
+            mid = 0.5 * (lo + hi)
+            below = through(mid)
+            hi = np.where(below, mid, hi)
+            lo = np.where(below, lo, mid)
+        share = np.where(through(np.ones(len(self.upper))), lo, 1.0)
+        keep = 1.0 - (1.0 - np.interp(self.lid_lam, self.upper_lam, share)) * self.upper_share
+        positions[self.lid] -= ((1.0 - keep)[:, None] * closing[self.lid]).astype(positions.dtype)
