@@ -34,6 +34,9 @@ import scipy.sparse as sp
 
 #: Least share of its rest area a skin triangle keeps along its rest normal.
 MIN_AREA_SHARE = 0.05
+#: ... and below the jaw: head motion (51-58) blends into the neck there AFTER this step, and
+#: shears any pleat an open jaw (27) leaves under the chin through itself unless it keeps room.
+NECK_AREA_SHARE = 0.25
 #: Skin within this height (dm) over an eyeball at rest keeps its rest height over it when an
 #: expression moves it there (the lid slides over the eye keeping its thickness); skin further
 #: out is kept at least this high. 3 mm: a lid's thickness at its margin and a little more.
@@ -63,9 +66,11 @@ class SkinGuard:
     eye_centres : sequence of (3,) arrays
         The eyeball centres (at rest: the step runs before rigid head motion).
     eye_radius : float
+    neck_below : float, optional
+        Height (dm) of the jaw joint: skin triangles below it keep :data:`NECK_AREA_SHARE`.
     """
 
-    def __init__(self, head, rest, eye_centres, eye_radius: float):
+    def __init__(self, head, rest, eye_centres, eye_radius: float, neck_below: float | None = None):
         rest = np.asarray(rest, float)
         self.skin = int(head.skin_vertex_count)
         tris = np.asarray(head.triangles)
@@ -77,6 +82,9 @@ class SkinGuard:
         self.rest_area2 = area2[sound]
         self.rest_normal = cross[sound] / area2[sound, None]
         self.rest = rest[: self.skin]
+        self.min_share = np.full(len(self.triangles), MIN_AREA_SHARE)
+        if neck_below is not None:
+            self.min_share[rest[self.triangles, 1].mean(axis=1) < neck_below] = NECK_AREA_SHARE
         edges = np.concatenate([self.triangles[:, [0, 1]], self.triangles[:, [1, 2]], self.triangles[:, [2, 0]]])
         n = self.skin
         adj = sp.coo_matrix((np.ones(2 * len(edges)), (np.r_[edges[:, 0], edges[:, 1]], np.r_[edges[:, 1], edges[:, 0]])),
@@ -121,11 +129,12 @@ class SkinGuard:
         return count
 
     def folded(self, skin: np.ndarray) -> np.ndarray:
-        """Indices of skin triangles below :data:`MIN_AREA_SHARE` of their rest area along the rest normal."""
+        """Indices of skin triangles below :data:`MIN_AREA_SHARE` (:data:`NECK_AREA_SHARE` under the jaw)
+        of their rest area along the rest normal."""
         t = self.triangles
         cross = np.cross(skin[t[:, 1]] - skin[t[:, 0]], skin[t[:, 2]] - skin[t[:, 0]])
         share = (cross * self.rest_normal).sum(axis=1) / self.rest_area2
-        return np.flatnonzero(share < MIN_AREA_SHARE)
+        return np.flatnonzero(share < self.min_share)
 
     def _patches(self, bad: np.ndarray, rings: int) -> tuple[np.ndarray, np.ndarray]:
         """Patches of ``rings`` rings around triangles ``bad`` (built on first use, then kept)."""

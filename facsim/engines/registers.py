@@ -239,7 +239,8 @@ class RegisterEngine:
     def guard(self) -> SkinGuard:
         """The physical last step: skin off the eyeballs, no skin turned inside out."""
         centres = [self.head.eye_pivot(self.base_positions, side)[0] for side in ("left", "right")]
-        return SkinGuard(self.head, self.neutral, centres, self.head.eye_pivot(self.base_positions, "left")[1])
+        return SkinGuard(self.head, self.neutral, centres, self.head.eye_pivot(self.base_positions, "left")[1],
+                         neck_below=float(self.head.joint(self.base_positions, "joint-jaw")[1]))
 
     def reset(self) -> None:
         """Nothing to do: the register engine keeps no state between frames."""
