@@ -309,6 +309,7 @@ def tiny_video(tmp_path_factory):
 
 def test_analysed_images_over_the_pixel_limit_are_refused_before_decoding(tmp_path, monkeypatch):
     import imageio.v3 as iio
+
     from facsim.analysis.processor import AnalysisError, iter_frames
 
     path = tmp_path / "frame.png"
@@ -325,6 +326,7 @@ def test_analysed_images_over_the_pixel_limit_are_refused_before_decoding(tmp_pa
 
 def test_analysed_folders_and_videos_over_the_frame_limit_are_refused(tmp_path, monkeypatch, tiny_video):
     import imageio.v3 as iio
+
     from facsim.analysis.processor import AnalysisError, iter_frames
 
     for k in range(3):

@@ -279,7 +279,7 @@ def iter_frames(source):
         raise AnalysisError(f"cannot read video {path}: {exc}") from None
     fps = float(meta.get("fps") or 30.0)
     duration = meta.get("duration")
-    count = int(round(duration * fps)) if duration and math.isfinite(duration * fps) else None
+    count = round(duration * fps) if duration and math.isfinite(duration * fps) else None
     try:
         if meta.get("size"):
             check_image_size(*meta["size"], f"a frame of video {path.name}")

@@ -70,7 +70,7 @@ class EyeLids:
         self.centre = np.asarray(centre, float)
         margin = np.asarray(margin)
         lam0, phi0 = spherical(rest[margin], self.centre)
-        lam1, phi1 = spherical(rest[margin] + closing[margin], self.centre)
+        _, phi1 = spherical(rest[margin] + closing[margin], self.centre)
         upper = phi0 - phi1 > UPPER_MOVES
         self.ok = upper.sum() >= 2 and (~upper).sum() >= 2
         self.upper = margin[upper][np.argsort(lam0[upper])]
