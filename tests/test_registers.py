@@ -254,32 +254,6 @@ def test_closed_lids_cover_the_eye(face_of, head, character):
     assert min(rest.values()) > 0 and seen["5E"]["left"] > rest["left"], (rest, seen)
 
 
-def _pupil(local: np.ndarray) -> np.ndarray:
-    """The eyeball's points within 8 degrees of its gaze (the pupil)."""
-    return local[:, 2] > np.cos(np.radians(8))
-
-
-def test_the_relaxed_upper_lid_rests_lower_over_the_iris(face_of, head):
-    """Issue 13: every character's rest carries relaxed lids (rest_pose.yaml): the upper lid's
-    margin 1-2.5 mm lower than the base mesh's staring one, the lower lid where it was, the pupil
-    still in view; the engines start from it."""
-    from facsim.engines.lids import spherical
-    from facsim.head.character import apply_targets, character_weights
-
-    face = face_of("ava")
-    staring = apply_targets(face.data.base_vertices, face.data,
-                            character_weights(face.character, set(face.data.target_names)))
-    for side in ("left", "right"):
-        lids = face.engine.lids["faceunits/eyeBlink{Side}", side]
-        ahead = np.abs(spherical(face.neutral[lids.upper], lids.centre)[0]) < 12
-        drop = staring[head.base_index[lids.upper], 1] - face.base_positions[head.base_index[lids.upper], 1]
-        assert 0.01 < np.median(drop[ahead]) < 0.025, (side, drop[ahead])
-        lower = np.abs(staring[head.base_index[lids.lower]] - face.base_positions[head.base_index[lids.lower]])
-        assert lower.max() < 0.003, side
-        assert _eye_seen(head, face.neutral, side, _pupil) > 0, side
-    assert np.allclose(face.engine.neutral, face.neutral)
-
-
 def test_skin_guard_unfolds_a_fold_and_lifts_skin_off_the_eye(engine, head, marks, geometry_check):
     """The guard itself: a lid point pushed into the eyeball and a folded triangle are repaired."""
     p = engine.neutral.copy()

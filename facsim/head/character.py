@@ -241,29 +241,11 @@ def apply_targets(base: np.ndarray, data, weights: Mapping[str, float]) -> np.nd
 
 def character_positions(character: Character, data) -> np.ndarray:
     """Morphed base vertices (19158, 3) for ``character``, its mouth's parts at rest
-    (:func:`facsim.head.mouth.rest_mouth`) and its lids relaxed (:func:`relax`)."""
+    (:func:`facsim.head.mouth.rest_mouth`)."""
     from facsim.head.mouth import rest_mouth
 
-    return relax(rest_mouth(apply_targets(data.base_vertices, data, character_weights(character, set(data.target_names))),
-                            data, age=character.age), data)
-
-
-#: Only the left half of a left-sided target is used at rest (the authored eyeBlinkLeft also
-#: moves the right eye's socket a little); base vertices this far (dm) left of the midline.
-REST_SIDE = 0.05
-
-
-def relax(positions: np.ndarray, data) -> np.ndarray:
-    """``positions`` (19158, 3) with the relaxed lids of ``rest_pose.yaml`` (a float32 copy):
-    the left eye's share of the target, and its mirror image on the right."""
-    spec = load_yaml("rest_pose.yaml")["lids"]
-    idx, delta = data.target(spec["target"])
-    left = data.base_vertices[idx, 0] > REST_SIDE
-    idx, delta = idx[left], float(spec["weight"]) * delta[left]
-    out = np.array(positions, np.float32, copy=True)
-    out[idx] += delta
-    out[np.asarray(data.mirror)[idx]] += delta * np.array([-1.0, 1.0, 1.0], np.float32)
-    return out
+    return rest_mouth(apply_targets(data.base_vertices, data, character_weights(character, set(data.target_names))), data,
+                      age=character.age)
 
 
 # ------------------------------------------------------------------ presets

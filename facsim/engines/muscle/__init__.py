@@ -155,7 +155,8 @@ class MuscleEngine:
         self.rigid = RigidMotion(head, base_positions)
         self.state = solver.rest_state(self.model)
         # The solver keeps its contact points off the eyes; this last step checks every skin point.
-        self.guard = SkinGuard(head, self.neutral, list(self.model.net.eye_centre), self.model.net.eye_radius)
+        self.guard = SkinGuard(head, self.neutral, list(self.model.net.eye_centre), self.model.net.eye_radius,
+                               neck_below=float(head.joint(base_positions, "joint-jaw")[1]))
 
     # -- the Engine protocol
     def deform(self, act: Activations) -> Deformation:
