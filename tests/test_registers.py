@@ -114,11 +114,22 @@ def test_eyes_turn_left_on_61(engine, head):
 
 def test_eq1_sums_shared_registers_and_clamps_to_the_smallest_max():
     assert combine_registers([(0.2, 0.6), (0.3, 1.0)]) == pytest.approx(0.42)
-    assert combine_registers([(1.0, 0.6), (1.0, 1.0)]) == pytest.approx(0.6)
-    weights = register_weights(Activations({(9, "left"): 1.0, (4, "left"): 1.0}))
+    assert combine_registers([(0.5, 0.6), (0.4, 0.8)]) == pytest.approx(0.6)  # 0.62 clamped to 0.6
+    weights = register_weights(Activations({(9, "left"): 0.2, (4, "left"): 0.2}))
     shared = [w for c, w in weights.items() if c.target == "faceunits/browDownLeft"]
     assert len(weights) > 3
-    assert shared == [pytest.approx(0.35)]  # 1·1.0 + 1·0.35 clamped to min(1.0, 0.35)
+    assert shared == [pytest.approx(0.27)]  # 0.2·1.0 + 0.2·0.35, under min(1.0, 0.35)
+
+
+def test_eq1_never_undoes_the_strongest_au():
+    # Literal Eq. 1 would clamp 4's brow lowering to 9's max (0.35) and 26's jaw drop to 25's.
+    assert combine_registers([(1.0, 0.6), (1.0, 1.0)]) == pytest.approx(1.0)
+    for combo, alone, target in (("4+9", "4", "faceunits/browDown"), ("25+26", "26", "faceunits/jawOpen")):
+        both = register_weights(activations(parse(combo)))
+        single = register_weights(activations(parse(alone)))
+        for column, weight in single.items():
+            if column.target.startswith(target):
+                assert both[column] >= weight - 1e-12, (combo, column)
 
 
 def test_every_register_names_a_real_target(face_of):

@@ -48,15 +48,26 @@ def simulated_codes() -> set[int]:
 
 
 def combine_registers(contributions: Iterable[tuple[float, float]]) -> float:
-    """HapFACS Eq. 1: sum of ``intensity × max`` over AUs, clamped to the smallest max.
+    """HapFACS Eq. 1: sum of ``intensity × max`` over AUs, clamped to the smallest max —
+    but never below what the strongest AU gives the register on its own.
 
     ``contributions`` holds one ``(intensity, max)`` pair per active AU sharing the register.
+    Eq. 1 taken literally lets a weak partner undo a strong AU: 25 (lips part, jaw max 0.06)
+    added to 26 (jaw drop) would close the jaw to 25's 0.06, and 9 added to 4 would lift
+    the brows. The clamp is there to stop sums beyond what the face can do, and a value
+    one AU reaches alone is within that, so it stays.
+
+    >>> combine_registers([(0.2, 0.6), (0.3, 1.0)])  # within the smallest max: the sum
+    0.42
+    >>> combine_registers([(1.0, 0.06), (1.0, 0.4)])  # 25 + 26 keeps 26's jaw drop
+    0.4
     """
     pairs = list(contributions)
     if not pairs:
         return 0.0
     total = sum(level * vmax for level, vmax in pairs)
-    return min(total, min(vmax for _, vmax in pairs))
+    strongest = max(level * vmax for level, vmax in pairs)
+    return max(min(total, min(vmax for _, vmax in pairs)), strongest)
 
 
 @dataclass(frozen=True)
