@@ -110,7 +110,14 @@ void main() {
     float s1 = max(1.0 - th1 * th1, 1e-6);   // sin^2
     float s2 = max(1.0 - th2 * th2, 1e-6);
     float sparkle = smoothstep(0.45, 0.75, fine);
-    vec3 spec = u_key_col * gate * (0.09 * exp2(70.0 * log2(s1))
+    // The primary lobe follows the line where strands turn across the half vector; a narrow
+    // white lobe there draws one thin grey-white arc over the cards (it reads as a light
+    // outline, not a sheen). Broader, fainter, tinted toward the hair colour and carried by
+    // the strands (bright strands take it, gaps between strands and clumps do not), it
+    // reads as hair's highlight band.
+    float strands = smoothstep(0.3, 0.7, fine) * smoothstep(0.3, 0.65, tex.r) * mix(0.5, 1.0, clump);
+    vec3 tint = mix(vec3(1.0), u_color / max(max(u_color.r, u_color.g), max(u_color.b, 1e-4)), 0.6);
+    vec3 spec = u_key_col * gate * (0.06 * strands * tint * exp2(20.0 * log2(s1))
                                     + 0.5 * sparkle * u_color * exp2(12.0 * log2(s2)));
 #else
     vec3 spec = vec3(0.0);
