@@ -28,7 +28,7 @@ from importlib import resources
 import numpy as np
 import scipy.sparse as sp
 import yaml
-from scipy.sparse.csgraph import connected_components
+from scipy.sparse.csgraph import connected_components, dijkstra
 from scipy.spatial import cKDTree
 
 from facsim.head.landmarks import landmarks
@@ -318,10 +318,18 @@ def _lip_halves(points, edges, kind, lips_mask):
     upper_rim = rim_ids[(y >= line) & (np.abs(x) < corner - 0.02)]
     lower_rim = rim_ids[(y < line) & (np.abs(x) < corner - 0.02)]
     lips = np.flatnonzero((lips_mask > 0.3) & ~lining)
-    tree = cKDTree(points[rim_ids])
-    _, nearest = tree.query(points[lips])
-    ref = np.interp(points[lips, 0], np.sort(x), line[np.argsort(x)])
-    half[lips] = np.where(points[lips, 1] >= ref, 1, -1)
+    # Which lip a vertex belongs to is which rim it is nearer to over the skin (not through the
+    # mouth): the upper lip's red curls down below the mouth line before it turns in to its rim,
+    # and a height test gave that curl to the jaw, which then dragged the upper lip down on 26/27.
+    if len(upper_rim) and len(lower_rim):
+        i, j = edges[~lining[edges[:, 0]] & ~lining[edges[:, 1]]].T
+        length = np.linalg.norm(points[i] - points[j], axis=1)
+        graph = sp.csr_matrix((np.r_[length, length], (np.r_[i, j], np.r_[j, i])), shape=(len(kind), len(kind)))
+        to_upper, to_lower = (dijkstra(graph, indices=rim_half, min_only=True) for rim_half in (upper_rim, lower_rim))
+        half[lips] = np.where(to_upper[lips] <= to_lower[lips], 1, -1)
+    else:
+        ref = np.interp(points[lips, 0], np.sort(x), line[np.argsort(x)])
+        half[lips] = np.where(points[lips, 1] >= ref, 1, -1)
     half[upper_rim], half[lower_rim] = 1, -1
     if len(lower_rim):
         _, j = cKDTree(points[lower_rim]).query(points[upper_rim])
@@ -566,6 +574,9 @@ def build_net(head, base_positions, *, anat: Anatomy | None = None, spec: dict |
     lining, outer = np.flatnonzero(anat.kind == MOUTH), anat.outer
     dist, near = cKDTree(rest[outer]).query(rest[lining])
     close = dist < constants["lining_tie"] * scale
+    # Only to skin on the same bone: a tie from the lower lining to the upper lip's rim held the
+    # lips together as the jaw opened (issue 13: 26 parted the lips 4 mm for 13 mm of chin drop).
+    close &= np.abs(anat.jaw_weight[lining] - anat.jaw_weight[outer[near]]) < 0.5
     if close.any():
         i, j = lining[close], outer[near[close]]
         parts.append(Arcs(i, j, dist[close], np.full(close.sum(), 0.5), np.zeros(close.sum()), np.ones(close.sum())))

@@ -1,0 +1,75 @@
+"""Print how far the jaw, lips and brows move in each engine (mm), side by side.
+
+Measured on the deformed mesh, against the character's neutral face:
+chin and lower-lip drop, lower-teeth (jaw) drop, the lips' inner gap at the
+midline, inner and outer brow rise (mean of both sides), and the change of the
+distance between the inner brows (negative: drawn together, AU 4).
+
+Usage::
+
+    python3 scripts/engine_amplitudes.py [--character ava] [--engines registers muscle] [EXPR ...]
+"""
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+
+#: What the table shows by default: the jaw and lip parting, the brows, and the emotions using them.
+EXPRESSIONS = ["25", "26", "27", "25+26", "1", "2", "4", "1+2", "1+4", "1+2+4",
+               "surprise", "fear", "sadness"]
+MM = 100.0
+COLUMNS = ("chin", "lo-lip", "jaw", "gap", "in-brow", "out-brow", "brow-dx")
+
+
+def amplitudes(face, expression) -> dict[str, float]:
+    """Motion figures (mm) of ``face`` showing ``expression``."""
+    from facsim.facs.emotions import emotion, emotion_names
+    from facsim.head.landmarks import landmarks
+    from facsim.speech.mouth import mouth_shape
+
+    marks = landmarks(face.head)
+    rest = np.asarray(face.neutral, float)
+    if expression in emotion_names():
+        expression = emotion(expression)
+    p = np.asarray(face.deform(expression).positions, float)
+    shape = mouth_shape(face, positions=p)
+    rest_gap = mouth_shape(face, positions=rest).gap
+
+    def rise(name):
+        return MM * np.mean([p[marks[f"{name}_{s}"], 1] - rest[marks[f"{name}_{s}"], 1] for s in ("left", "right")])
+
+    def spread(q):
+        return q[marks["inner_brow_left"], 0] - q[marks["inner_brow_right"], 0]
+
+    return {
+        "chin": MM * (rest[marks["chin"], 1] - p[marks["chin"], 1]),
+        "lo-lip": MM * (rest[marks["lower_lip"], 1] - p[marks["lower_lip"], 1]),
+        "jaw": shape.jaw_drop,
+        "gap": shape.gap - rest_gap,
+        "in-brow": rise("inner_brow"),
+        "out-brow": rise("outer_brow"),
+        "brow-dx": MM * (spread(p) - spread(rest)),
+    }
+
+
+def main(argv=None) -> None:
+    from facsim.face import Face
+
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("expressions", nargs="*", default=EXPRESSIONS)
+    parser.add_argument("--character", default="ava")
+    parser.add_argument("--engines", nargs="+", default=["registers", "muscle"])
+    args = parser.parse_args(argv)
+
+    faces = {name: Face(args.character, engine=name) for name in args.engines}
+    print(f"{args.character}: motion from neutral in mm (gap: change of the lips' inner gap)")
+    print(f"{'expression':<12}{'engine':<10}" + "".join(f"{c:>9}" for c in COLUMNS))
+    for expr in args.expressions:
+        for name, face in faces.items():
+            row = amplitudes(face, expr)
+            print(f"{expr:<12}{name:<10}" + "".join(f"{row[c]:9.1f}" for c in COLUMNS))
+
+
+if __name__ == "__main__":
+    main()
