@@ -489,6 +489,11 @@ def jaw_pose(layer: MuscleLayer, muscle: np.ndarray, jaw_spec: dict, *, clench_f
                        p["max"] * np.tanh(gen[:, 1] * p["compliance"] / p["max"]),
                        p["retrusion"] * np.tanh(gen[:, 1] * p["compliance"] / p["retrusion"]))
     lateral = lat["max"] * np.tanh(gen[:, 2] * lat["compliance"] / lat["max"])
+    # Beyond the first degrees of opening the condyles glide forward down the articular eminence,
+    # so a wide-open jaw swings its chin less far back than a pure hinge would.
+    glide = jaw_spec.get("glide")
+    if glide:
+        forward = forward + glide["forward_per_degree"] * np.maximum(np.degrees(opening) - glide["onset_degrees"], 0.0)
     return np.stack([opening, forward, lateral], axis=1)
 
 
