@@ -160,8 +160,8 @@ def test_unilateral_aus_move_only_their_side(engine, code):
 def test_masking_cheek_raiser_after_smile_lifts_the_corner_less(engine, marks):
     """Masking is a property of the equilibrium: solved nearer to it than a rendered face is.
 
-    The default static solve (20 iterations an increment) leaves a smile about a quarter short
-    of equilibrium (corner 7.8 of 10.5 mm up on noah), and whether 6 then still lifts the corner
+    The default static solve (20 iterations an increment) leaves a smile short
+    of equilibrium (corner 14.9 mm up on noah, 17.2 mm at 60), and whether 6 then still lifts the corner
     swung with changes anywhere in the net (its L-BFGS path is global): 60 iterations settle it.
     """
     corner = marks["lip_corner_left"]
