@@ -303,6 +303,10 @@ def _tissue_fields(spec, points, kind, eye_side, eye_centre, eye_radius, lips_ma
     return fields
 
 
+#: Share of the mouth's half-width (from the midline) where lip halves follow the rims over the skin.
+CENTRAL_LIPS = 0.6
+
+
 def _lip_halves(points, edges, kind, lips_mask):
     """Upper (+1) and lower (-1) lip vertices, and facing rim pairs across the mouth line."""
     lining = kind == MOUTH
@@ -321,15 +325,17 @@ def _lip_halves(points, edges, kind, lips_mask):
     # Which lip a vertex belongs to is which rim it is nearer to over the skin (not through the
     # mouth): the upper lip's red curls down below the mouth line before it turns in to its rim,
     # and a height test gave that curl to the jaw, which then dragged the upper lip down on 26/27.
+    # Toward the corners, where both rims are near, the height test stays (there it held the
+    # corners as AU 14 and 20 need them).
+    ref = np.interp(points[lips, 0], np.sort(x), line[np.argsort(x)])
+    half[lips] = np.where(points[lips, 1] >= ref, 1, -1)
     if len(upper_rim) and len(lower_rim):
         i, j = edges[~lining[edges[:, 0]] & ~lining[edges[:, 1]]].T
         length = np.linalg.norm(points[i] - points[j], axis=1)
         graph = sp.csr_matrix((np.r_[length, length], (np.r_[i, j], np.r_[j, i])), shape=(len(kind), len(kind)))
         to_upper, to_lower = (dijkstra(graph, indices=rim_half, min_only=True) for rim_half in (upper_rim, lower_rim))
-        half[lips] = np.where(to_upper[lips] <= to_lower[lips], 1, -1)
-    else:
-        ref = np.interp(points[lips, 0], np.sort(x), line[np.argsort(x)])
-        half[lips] = np.where(points[lips, 1] >= ref, 1, -1)
+        central = lips[np.abs(points[lips, 0]) < CENTRAL_LIPS * corner]
+        half[central] = np.where(to_upper[central] <= to_lower[central], 1, -1)
     half[upper_rim], half[lower_rim] = 1, -1
     if len(lower_rim):
         _, j = cKDTree(points[lower_rim]).query(points[upper_rim])
