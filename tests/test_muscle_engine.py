@@ -158,16 +158,9 @@ def test_unilateral_aus_move_only_their_side(engine, code):
 
 
 def test_masking_cheek_raiser_after_smile_lifts_the_corner_less(engine, marks):
-    """Masking is a property of the equilibrium: solved nearer to it than a rendered face is.
-
-    The default static solve (20 iterations an increment) leaves a smile short
-    of equilibrium (corner 14.9 mm up on noah, 17.2 mm at 60), and whether 6 then still lifts the corner
-    swung with changes anywhere in the net (its L-BFGS path is global): 60 iterations settle it.
-    """
     corner = marks["lip_corner_left"]
     neutral, six, twelve, both = engine.solve_many(
-        [Activations(), activations(parse("6")), activations(parse("12")), activations(parse("12+6"))],
-        iterations=60)
+        [Activations(), activations(parse("6")), activations(parse("12")), activations(parse("12+6"))])
     alone = six[corner, Y] - neutral[corner, Y]
     after = both[corner, Y] - twelve[corner, Y]
     assert alone > MOVES  # the cheek raiser lifts the corner ...

@@ -303,8 +303,9 @@ def _tissue_fields(spec, points, kind, eye_side, eye_centre, eye_radius, lips_ma
     return fields
 
 
-#: Share of the mouth's half-width (from the midline) where lip halves follow the rims over the skin.
-CENTRAL_LIPS = 0.6
+#: Share of the mouth's half-width (from the midline) where lip halves follow the rims over the skin
+#: (at 0.6 the tongue of AU 19 pushed the lower lip up and back instead of down).
+CENTRAL_LIPS = 0.3
 
 
 def _lip_halves(points, edges, kind, lips_mask):
