@@ -10,7 +10,7 @@ Examples
 >>> sorted(load_yaml("rigid.yaml"))[:2]
 ['eye_rotations', 'head_motions']
 >>> require(load_yaml("rigid.yaml"), "rigid.yaml", "neck_blend", dict)["full_above"]
-0.55
+0.4
 """
 from __future__ import annotations
 

@@ -63,7 +63,10 @@ def test_weights_are_the_registers_faceunits_targets():
     both = arkit_weights(Activations({(6, "left"): 1.0, (7, "left"): 1.0}))
     maxima = [reg["max"] for code in (6, 7) for reg in register_table()["action_units"][code]["registers"]
               if reg["target"] == "faceunits/eyeSquint{Side}"]
-    assert len(maxima) == 2 and both["eyeSquintLeft"] == pytest.approx(min(maxima))  # Eq. 1 clamps to the smaller max
+    # Eq. 1 clamps the sum to the smaller max, but never below the stronger AU alone (7's 1.0).
+    assert len(maxima) == 2 and both["eyeSquintLeft"] == pytest.approx(max(maxima))
+    weak = arkit_weights(Activations({(6, "left"): 0.4, (7, "left"): 0.3}))
+    assert weak["eyeSquintLeft"] == pytest.approx(min(0.4 * maxima[0] + 0.3 * maxima[1], min(maxima)))
 
 
 def test_inverse_map_is_unambiguous():

@@ -120,7 +120,7 @@ def combination_scales(act: Activations, code: int, side: str) -> dict[str, floa
     face moves smoothly as an AU fades in.
 
     >>> round(combination_scales(Activations({(1, "left"): 1.0, (4, "left"): 1.0}), 4, "left")["faceunits/browDown{Side}"], 6)
-    0.2
+    0.45
     >>> combination_scales(Activations({(4, "left"): 1.0}), 4, "left")
     {}
     """
