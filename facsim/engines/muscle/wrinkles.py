@@ -30,8 +30,6 @@ from facsim.engines.muscle.net import OUTER, Anatomy, TensionNet, resolve_vertex
 
 #: Weight holding the forehead's phase to its ramp, against a vertex's ~6 unit-weight edges.
 LEVEL_HOLD = 50.0
-#: Extra passes of neighbour averaging of the forehead's squeeze, and the gain that keeps its peak.
-LEVEL_SPREAD, LEVEL_SPREAD_GAIN = 12, 1.6
 
 
 @dataclass(frozen=True, eq=False)
@@ -205,13 +203,6 @@ def wrinkle_field(model: WrinkleModel, positions: np.ndarray) -> tuple[np.ndarra
         fields = model.smooth @ fields
     v_dir = _principal_axis(fields[:, :9].reshape(-1, 3, 3))             # main compression direction
     v_squeeze = fields[:, 9]
-    # Raised brows crease the whole forehead, in several lines, not just where the squeeze peaks:
-    # there the squeeze is spread wider (the frontalis is one sheet) before it gates the lines.
-    wide = v_squeeze
-    for _ in range(LEVEL_SPREAD):
-        wide = model.smooth @ wide
-    hold = model.level / LEVEL_HOLD
-    v_squeeze = v_squeeze + hold * (np.maximum(wide * LEVEL_SPREAD_GAIN, v_squeeze) - v_squeeze)
     strength = np.clip((v_squeeze - model.threshold) / (1.0 - model.threshold), 0.0, None) ** model.exponent
 
     # On the forehead and glabella the lines run straight across or straight up (their skin is
