@@ -28,10 +28,6 @@ import scipy.sparse.linalg as spla
 from facsim.engines.muscle.net import OUTER, Anatomy, TensionNet, resolve_vertex
 
 
-#: Weight holding the forehead's phase to its ramp, against a vertex's ~6 unit-weight edges.
-LEVEL_HOLD = 50.0
-
-
 @dataclass(frozen=True, eq=False)
 class WrinkleModel:
     """Constant data for the wrinkle field of one character (see :func:`build_wrinkles`)."""
@@ -45,9 +41,6 @@ class WrinkleModel:
     zone_gain: np.ndarray       # (N,) how readily the skin creases there (deep forehead lines, fine crow's feet)
     across_gain: np.ndarray     # (N,) the same for vertical furrows (skin squeezed sideways) where zones differ
     straight: np.ndarray        # (N,) 1 where lines run straight across the face (forehead, glabella)
-    level: np.ndarray           # (N,) how firmly the phase is held to ``level_phase`` (the forehead)
-    level_bow: float            # how far those lines rise toward the midline (dm per dm² of x²)
-    level_wavelength: float     # and their spacing (dm)
     on_face: np.ndarray         # (N,) 1 on the outer skin, 0 inside the lips and lids
     crease: np.ndarray          # (N,) extra depth along anatomical folds (0 = none, 1 = twice as deep)
     gain: float
@@ -115,19 +108,12 @@ def build_wrinkles(anat: Anatomy, net: TensionNet, spec: dict) -> WrinkleModel:
     m = len(edges)
     incidence = sp.csr_matrix((np.r_[-np.ones(m), np.ones(m)], (np.r_[np.arange(m), np.arange(m)],
                                                                  np.r_[edges[:, 0], edges[:, 1]])), shape=(m, n))
-    # The forehead's phase is held to its ramp (weights ≫ a vertex's few edges), so the lines there run
-    # across whatever the rest of the field does; elsewhere ε pins the free constant. The matrix never
-    # changes, so it is factorised once.
-    lines = w["level_lines"]  # the forehead's: straight across, ``bow`` dm higher per dm² of x² at the midline
-    reach = ((base - np.asarray(lines["centre"], float)) / np.asarray(lines["radii"], float)) ** 2
-    level = np.clip(3.0 * (1.0 - reach.sum(1)), 0.0, 1.0) * on_face   # flat inside, fading at the rim
-    held = LEVEL_HOLD * level + 1e-4
-    integrate = spla.factorized((incidence.T @ incidence + sp.diags(held)).tocsc())
+    # The graph Laplacian never changes, so it is factorised once; ε pins the free constant.
+    integrate = spla.factorized((incidence.T @ incidence + 1e-4 * sp.identity(n)).tocsc())
     return WrinkleModel(
         triangles=tri, rest_inverse=inv, rest_frame=frame, to_vertex=to_vertex.tocsr(), rest=rest,
         wavelength=wavelength, zone_gain=zone_gain, across_gain=across_gain, straight=np.clip(straight * 2.0, 0.0, 1.0), crease=crease,
-        level=LEVEL_HOLD * level, level_bow=float(lines["bow"]),
-        level_wavelength=float(lines["wavelength"]) * net.scale, on_face=on_face,
+        on_face=on_face,
         gain=float(w["gain"]), threshold=float(w["threshold"]), exponent=float(w["exponent"]),
         smooth=smooth.tocsr(), passes=int(w.get("smoothing", 2)),
         edges=edges, incidence=incidence, integrate=integrate,
@@ -209,7 +195,7 @@ def wrinkle_field(model: WrinkleModel, positions: np.ndarray) -> tuple[np.ndarra
     # held flat by the bone beneath): the direction snaps to the nearer of height and width.
     snapped = np.where(np.abs(v_dir[:, 1:2]) >= np.abs(v_dir[:, 0:1]), [[0.0, 1.0, 0.0]], [[1.0, 0.0, 0.0]])
     along = (1 - model.straight)[:, None] * v_dir + model.straight[:, None] * snapped
-    phase = _furrow_phase(model, along, positions)
+    phase = _furrow_phase(model, along)
     # Squeezed sideways the skin makes vertical furrows; zones may crease less that way (the
     # forehead's deep lines are horizontal: drawn together, brows furrow the glabella, not the brow).
     sideways = along[:, 0] ** 2 / np.maximum((along ** 2).sum(1), 1e-12)
@@ -218,7 +204,7 @@ def wrinkle_field(model: WrinkleModel, positions: np.ndarray) -> tuple[np.ndarra
     return np.clip(out, 0.0, 2.0).astype(np.float32), phase.astype(np.float32)
 
 
-def _furrow_phase(model: WrinkleModel, along: np.ndarray, positions: np.ndarray) -> np.ndarray:
+def _furrow_phase(model: WrinkleModel, along: np.ndarray) -> np.ndarray:
     """The phase whose gradient is ``along / wavelength`` as nearly as can be (least squares
     over the skin edges): furrows then keep their spacing where the direction turns, which
     measuring each point from one origin would not (a small turn there moves far points by
@@ -235,11 +221,4 @@ def _furrow_phase(model: WrinkleModel, along: np.ndarray, positions: np.ndarray)
     agree = (along[i] * along[j]).sum(1) > 0
     step = (model.rest[j] - model.rest[i]) * mean
     diff = np.where(agree, step.sum(1) * 2.0 / (model.wavelength[i] + model.wavelength[j]), 0.0)
-    # The forehead's lines run across it, a little higher at the midline, wherever the brows
-    # squeeze it: the frontalis lifts the whole sheet and its furrows follow the bone, not the
-    # local squeeze, whose direction turns with each brow target's shape (integrated, that
-    # folded the forehead's phase into one V-shaped line). The squeeze says how deep they are.
-    # Measured on the skin as it is now: a brow target lifts the midline less than the brows,
-    # and lines straight on the rest skin would dip into a notch there.
-    level_phase = (positions[:, 1] + model.level_bow * positions[:, 0] ** 2) / model.level_wavelength
-    return model.integrate(model.incidence.T @ diff + model.level * level_phase)
+    return model.integrate(model.incidence.T @ diff)
