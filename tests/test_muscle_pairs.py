@@ -113,3 +113,20 @@ def _one(drive, b):
     from facsim.engines.muscle.muscles import Drive
 
     return Drive(drive.muscle[b:b + 1], drive.pressure[b:b + 1], drive.lip_pressure[b:b + 1], drive.tongue[b:b + 1])
+
+
+@pytest.mark.parametrize("character", ["ava", "kwame", "george", "noah"])
+def test_open_mouth_with_head_motion_keeps_the_neck_unfolded(face_of, head, character):
+    """25/26/27 × 51-58 at E: the head motion's blend into the neck turns a pleat that the open jaw
+    leaves under the chin (once 14-24 triangles inside out under 27E+54E on kwame, george, noah)."""
+    from facsim.engines.checks import GeometryCheck
+
+    engine = face_of(character, "muscle").engine
+    check = GeometryCheck(head, engine.neutral)
+    texts = [f"{a}E+{b}E" for a in (25, 26, 27) for b in range(51, 59)]
+    problems = []
+    for text, deformation in zip(texts, engine.deform_many([activations(parse(t)) for t in texts])):
+        report = check(deformation.positions)
+        if report.flipped or report.inside:
+            problems.append(f"{text}: {report.flipped} triangles inside out, {report.inside} skin points in an eye")
+    assert not problems, "\n".join(problems)

@@ -48,8 +48,11 @@ ROUNDS = 4
 UNTANGLE_ROUNDS = 64
 WIDEN_EVERY = 8
 MAX_RINGS = 6
-#: Furthest (dm) the untangling moves any vertex: 1.5 mm.
+#: Furthest (dm) the untangling moves any vertex: 3 mm.
 MAX_CORRECTION = 0.03
+#: ... and after head motion, in the neck's blend (:meth:`SkinGuard.after_head_motion`): a pleat
+#: under an open jaw sheared by a bent neck needs a little more (4.5 mm; george's 27E+54E).
+NECK_CORRECTION = 0.045
 #: Rest triangles smaller than this (twice the area, dm²) have no reliable orientation.
 DEGENERATE_AREA2 = 1e-10
 
@@ -128,13 +131,14 @@ class SkinGuard:
                 count += int(inside.sum())
         return count
 
-    def folded(self, skin: np.ndarray) -> np.ndarray:
+    def folded(self, skin: np.ndarray, rest_normal=None, min_share=None) -> np.ndarray:
         """Indices of skin triangles below :data:`MIN_AREA_SHARE` (:data:`NECK_AREA_SHARE` under the jaw)
-        of their rest area along the rest normal."""
+        of their rest area along the rest normal (or along ``rest_normal``, against ``min_share``)."""
         t = self.triangles
+        normal = self.rest_normal if rest_normal is None else rest_normal
         cross = np.cross(skin[t[:, 1]] - skin[t[:, 0]], skin[t[:, 2]] - skin[t[:, 0]])
-        share = (cross * self.rest_normal).sum(axis=1) / self.rest_area2
-        return np.flatnonzero(share < self.min_share)
+        share = (cross * normal).sum(axis=1) / self.rest_area2
+        return np.flatnonzero(share < (self.min_share if min_share is None else min_share))
 
     def _patches(self, bad: np.ndarray, rings: int) -> tuple[np.ndarray, np.ndarray]:
         """Patches of ``rings`` rings around triangles ``bad`` (built on first use, then kept)."""
@@ -151,7 +155,30 @@ class SkinGuard:
         weight = (np.arange(width)[None, :] < np.array([len(r) for r in rows])[:, None]).astype(float)
         return patch, weight
 
-    def untangle(self, skin: np.ndarray) -> int:
+    def after_head_motion(self, positions: np.ndarray, turn: np.ndarray, blend: np.ndarray) -> np.ndarray:
+        """Untangle the neck once more after head motion (51-58) moved ``positions``.
+
+        The head's turn fades into the neck, each point turning by its rest weight in
+        the blend. An open jaw (25-27) leaves the skin under the chin and down the
+        throat compressed along that fade, so a head bent forward (54) turns the upper
+        edge of the pleat further than its lower edge and shears it through itself.
+        Here the triangles with a corner in the blend (``blend``: (N_geo,) weights,
+        strictly between 0 and 1 there) are checked against their rest normals turned
+        as the head turned (``turn``, 3×3) and untangled as before; elsewhere the
+        motion is rigid and nothing changes.
+        """
+        out = np.array(positions, dtype=np.float32, copy=True)
+        t = self.triangles
+        zone = ((blend[t] > 0.0) & (blend[t] < 1.0)).any(axis=1)
+        skin = out[: self.skin].astype(float)
+        self.untangle(skin, rest_normal=self.rest_normal @ np.asarray(turn, float).T,
+                      min_share=np.where(zone, self.min_share, -np.inf), eyes=False,  # the eyes have moved
+                      most=NECK_CORRECTION)
+        out[: self.skin] = skin
+        return out
+
+    def untangle(self, skin: np.ndarray, *, rest_normal=None, min_share=None, eyes: bool = True,
+                 most: float = MAX_CORRECTION) -> int:
         """Unfold folded triangles (in place); returns how many were folded at first.
 
         The corners of each folded triangle are drawn toward their rest shape,
@@ -161,7 +188,8 @@ class SkinGuard:
         closing lid still closes). Only the corners move, and none further
         than :data:`MAX_CORRECTION` in all.
         """
-        bad = self.folded(skin)
+        folded = lambda: self.folded(skin, rest_normal, min_share)  # noqa: E731
+        bad = folded()
         first = len(bad)
         start = skin.copy()
         for it in range(UNTANGLE_ROUNDS):
@@ -180,10 +208,11 @@ class SkinGuard:
             # margin rolling under as the eye closes): leave it rather than reshape the lid.
             shift = skin - start
             length = np.linalg.norm(shift, axis=1)
-            far = length > MAX_CORRECTION
-            skin[far] = start[far] + shift[far] * (MAX_CORRECTION / length[far])[:, None]
-            self.off_eyes(skin)
-            bad = self.folded(skin)
+            far = length > most
+            skin[far] = start[far] + shift[far] * (most / length[far])[:, None]
+            if eyes:
+                self.off_eyes(skin)
+            bad = folded()
         return first
 
 

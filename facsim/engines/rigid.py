@@ -134,6 +134,13 @@ class RigidMotion:
 
         return {side: Rotation.from_rotvec(v).as_matrix() for side, v in eye_motion(act.level).items()}
 
+    @staticmethod
+    def head_turn(act) -> np.ndarray:
+        """The head's rotation (3, 3) from codes 51-58 (identity for none)."""
+        from scipy.spatial.transform import Rotation
+
+        return Rotation.from_rotvec(head_motion(act.level)[0]).as_matrix()
+
     def move_head(self, positions: np.ndarray, act) -> np.ndarray:
         """Rigid head motion (51–58) blended smoothly into the neck; float32 positions."""
         from scipy.spatial.transform import Rotation

@@ -238,7 +238,11 @@ class MuscleEngine:
         skin = self.guard(state.points(index)[: net.count])
         out = self.parts.place(skin, rot[0], shift[0], net.hinge, (r[0], t[0]), model.tongue,
                                self.rigid.eye_rotations(act))
-        return self.rigid.move_head(out.astype(np.float32), act).astype(np.float32)
+        out = out.astype(np.float32, copy=False)
+        moved = self.rigid.move_head(out, act)
+        if moved is out:   # no head motion
+            return out
+        return self.guard.after_head_motion(moved, self.rigid.head_turn(act), self.rigid.weight[:, 0])
 
 
 def solve_static(model, target, *, steps: int, iterations: int) -> solver.State:
