@@ -17,14 +17,11 @@ from __future__ import annotations
 
 import argparse
 import os
-import resource
-import shutil
 import statistics
-import subprocess
 import sys
-import tempfile
-import time
 from pathlib import Path
+
+from baseline import baseline_tree, timed
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_BASELINE = "bd62f19"  # main before issue 13 (bald heads, painted brows)
@@ -38,17 +35,6 @@ def cli_module(tree: Path) -> str:
     return "facsim"
 
 
-def timed(command: list[str], tree: Path) -> tuple[float, float]:
-    """(wall seconds, CPU seconds of the child: every thread, user + system)."""
-    env = dict(os.environ, PYTHONPATH=str(tree))
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    start = time.perf_counter()
-    subprocess.run(command, cwd=tree, env=env, check=True, capture_output=True)
-    wall = time.perf_counter() - start
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-
-
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--repeats", type=int, default=5)
@@ -58,11 +44,7 @@ def main(argv=None) -> int:
     parser.add_argument("--baseline-rev", default=DEFAULT_BASELINE)
     args = parser.parse_args(argv)
 
-    tmp = Path(tempfile.mkdtemp(prefix="bench-looks-"))
-    base_tree = tmp / "before"
-    subprocess.run(["git", "worktree", "add", "--detach", str(base_tree), args.baseline_rev],
-                   cwd=ROOT, check=True, capture_output=True)
-    try:
+    with baseline_tree(args.baseline_rev, "bench-looks-") as (tmp, base_tree):
         def command(tree: Path, *extra: str) -> list[str]:
             return [sys.executable, "-m", cli_module(tree), "emotion", args.emotion, "-o", str(tmp / "x.mp4"),
                     "--size", str(args.size), "--character", args.character, "--quiet", *extra]
@@ -88,9 +70,6 @@ def main(argv=None) -> int:
             cpu = statistics.median(c for _, c in values)
             print(f"  {name:20s} wall {wall:6.2f} s ({wall / VIDEO_SECONDS:.2f}x real time; {wall / wall0:.2f}x before)"
                   f"   CPU {cpu:6.2f} s ({cpu / cpu0:.2f}x before)")
-    finally:
-        subprocess.run(["git", "worktree", "remove", "--force", str(base_tree)], cwd=ROOT, capture_output=True)
-        shutil.rmtree(tmp, ignore_errors=True)
     return 0
 
 

@@ -12,12 +12,12 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import shutil
 import statistics
 import subprocess
 import sys
-import tempfile
 from pathlib import Path
+
+from baseline import baseline_tree
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_BASELINE = "a14687f"  # main before the mouth work
@@ -54,18 +54,12 @@ def main(argv=None) -> int:
     parser.add_argument("--frames", type=int, default=12)
     parser.add_argument("--baseline-rev", default=DEFAULT_BASELINE)
     args = parser.parse_args(argv)
-    base = Path(tempfile.mkdtemp(prefix="facsim-mouth-base-")) / "tree"
-    subprocess.run(["git", "worktree", "add", "--detach", str(base), args.baseline_rev], cwd=ROOT, check=True,
-                   capture_output=True)
-    try:
+    with baseline_tree(args.baseline_rev, "facsim-mouth-base-") as (_, base):
         runs = {"before": [], "after": []}
         for _ in range(args.repeats):
             for name, tree in (("before", base), ("after", ROOT)):
                 wall, cpu = frame_times(tree, args.frames)
                 runs[name].append((statistics.median(wall), statistics.median(cpu)))
-    finally:
-        subprocess.run(["git", "worktree", "remove", "--force", str(base)], cwd=ROOT, capture_output=True, check=False)
-        shutil.rmtree(base.parent, ignore_errors=True)
     print(f"open-mouth frames, 512² FXAA, ava, {len(EXPRESSIONS)} expressions, "
           f"median of {args.repeats} runs × {args.frames} frames (wall / CPU of all threads)")
     for i, what in enumerate(("wall", "CPU")):

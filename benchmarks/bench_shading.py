@@ -19,12 +19,12 @@ from __future__ import annotations
 
 import argparse
 import os
-import shutil
 import statistics
 import subprocess
 import sys
-import tempfile
 from pathlib import Path
+
+from baseline import baseline_tree
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_BASELINE = "a14687f"  # main before the skin/hair shading work of session 10
@@ -72,11 +72,7 @@ def main(argv=None) -> int:
     parser.add_argument("--baseline-rev", default=DEFAULT_BASELINE)
     args = parser.parse_args(argv)
 
-    tmp = Path(tempfile.mkdtemp(prefix="bench-shading-"))
-    base_tree = tmp / "before"
-    subprocess.run(["git", "worktree", "add", "--detach", str(base_tree), args.baseline_rev],
-                   cwd=ROOT, check=True, capture_output=True)
-    try:
+    with baseline_tree(args.baseline_rev, "bench-shading-") as (tmp, base_tree):
         trees = {"before": base_tree, "after": ROOT}
         results = {name: [] for name in trees}
         for _ in range(args.repeats):
@@ -91,9 +87,6 @@ def main(argv=None) -> int:
                 after = statistics.median(r[k][j] for r in results["after"])
                 print(f"  {label:24s} {kind:4s} before {before:7.1f} ms   after {after:7.1f} ms   "
                       f"({after / before:.2f}x)")
-    finally:
-        subprocess.run(["git", "worktree", "remove", "--force", str(base_tree)], cwd=ROOT, capture_output=True)
-        shutil.rmtree(tmp, ignore_errors=True)
     return 0
 
 

@@ -39,6 +39,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from baseline import baseline_tree, timed
+
 START = (time.perf_counter(), time.process_time())
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_BASELINE = "a14687f"  # main before the speed work of issue 13 item 8
@@ -47,18 +49,6 @@ FPS = 30.0
 
 
 NICE = 0  # --nice: the runs' scheduling priority (negative: ahead of other work; needs root)
-
-
-def timed(command: list[str], tree: Path, env: dict | None = None) -> tuple[float, float]:
-    """(wall seconds, CPU seconds of the command and everything it waited for: user + system)."""
-    env = dict(os.environ, PYTHONPATH=str(tree), **(env or {}))
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    start = time.perf_counter()
-    subprocess.run(command, cwd=tree, env=env, check=True, capture_output=True,
-                   preexec_fn=(lambda: os.nice(NICE)) if NICE else None)
-    wall = time.perf_counter() - start
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
 def stages(args) -> dict:
@@ -140,11 +130,7 @@ def main(argv=None) -> int:
         print(json.dumps(stages(args)))
         return 0
 
-    tmp = Path(tempfile.mkdtemp(prefix="bench-video-"))
-    base_tree = tmp / "before"
-    subprocess.run(["git", "worktree", "add", "--detach", str(base_tree), args.baseline_rev],
-                   cwd=ROOT, check=True, capture_output=True)
-    try:
+    with baseline_tree(args.baseline_rev, "bench-video-") as (tmp, base_tree):
         def command(tree: Path, *extra: str) -> list[str]:
             return [sys.executable, "-m", "facsim", "emotion", args.emotion, "-o", str(tmp / "x.mp4"), "--overwrite",
                     "--size", str(args.size), "--character", args.character, "--quiet", *extra]
@@ -156,12 +142,12 @@ def main(argv=None) -> int:
             "now, --hair none": (ROOT, command(ROOT, "--hair", "none"), None),
         }
         for tree, cmd, env in configs.values():  # warm caches (face data, occlusion bakes, proxies)
-            timed(cmd, tree, env)
+            timed(cmd, tree, env, nice=NICE)
         loads = [os.getloadavg()[0]]
         times: dict[str, list[tuple[float, float]]] = {name: [] for name in configs}
         for _ in range(args.repeats):
             for name, (tree, cmd, env) in configs.items():
-                times[name].append(timed(cmd, tree, env))
+                times[name].append(timed(cmd, tree, env, nice=NICE))
             loads.append(os.getloadavg()[0])
         wall0 = statistics.median(w for w, _ in times["before"])
         cpu0 = statistics.median(c for _, c in times["before"])
@@ -174,9 +160,6 @@ def main(argv=None) -> int:
             cpu = statistics.median(c for _, c in values)
             print(f"  {name:18s} wall {wall:6.2f} s ({wall / VIDEO_SECONDS:4.2f}x real time; {wall / wall0:.2f}x before)"
                   f"   CPU {cpu:6.2f} s ({cpu / VIDEO_SECONDS:4.2f} CPU-s per video-s; {cpu / cpu0:.2f}x before)")
-    finally:
-        subprocess.run(["git", "worktree", "remove", "--force", str(base_tree)], cwd=ROOT, capture_output=True)
-        shutil.rmtree(tmp, ignore_errors=True)
 
     if args.no_stages:
         return 0
