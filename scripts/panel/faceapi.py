@@ -20,8 +20,6 @@ Labels: neutral, happy, sad, angry, fearful, disgusted, surprised.
 """
 from __future__ import annotations
 
-import base64
-import hashlib
 import io
 import json
 import os
@@ -38,6 +36,7 @@ from rater import (  # the sibling module in scripts/panel
 )
 
 from facsim.atomic import atomic_write
+from facsim.wheel import sri_digest
 
 VERSION = "1.7.15"
 TARBALL = f"https://registry.npmjs.org/@vladmandic/face-api/-/face-api-{VERSION}.tgz"
@@ -76,9 +75,8 @@ def install_model(*, tarball=None) -> Path:
         except OSError as exc:
             raise FaceApiError(f"could not download {TARBALL} ({exc}); on an offline machine fetch it elsewhere "
                                f"(`npm pack @vladmandic/face-api@{VERSION}`) and set {ENV}=/path/to/it") from None
-    algorithm, _, expected = INTEGRITY.partition("-")
-    digest = base64.b64encode(hashlib.new(algorithm, data).digest()).decode()
-    if digest != expected:
+    algorithm = INTEGRITY.partition("-")[0]
+    if sri_digest(data, algorithm) != INTEGRITY:
         raise FaceApiError(f"face-api-{VERSION}.tgz failed its {algorithm} check; the file is corrupt or not "
                            f"@vladmandic/face-api {VERSION} — download it again")
     folder = model_dir()
