@@ -130,37 +130,51 @@ def deformations(face, frames) -> Iterator[Iterator]:
 
     ctx = multiprocessing.get_context("fork")
     queue = ctx.Queue(maxsize=LOOKAHEAD)
-    child = ctx.Process(target=_deform_frames, args=(face, frames, queue), daemon=True, name="facsim-deform")
-    child.start()
-    try:
+    child = ctx.Process(target=_deform_frames, args=(face, frames, queue, os.getpid()), daemon=True,
+                        name="facsim-deform")
+    try:  # a signal may arrive while the child starts: it is then cleaned up here too
+        child.start()
         yield _received(queue, len(frames), child)
     finally:
-        if child.is_alive():  # stopped early (an error, a signal), or finishing: nothing to keep
-            child.join(timeout=0.5)
-            if child.is_alive():
-                child.kill()
-        child.join()
+        if child.pid is not None:
+            if child.is_alive():  # stopped early (an error, a signal), or finishing: nothing to keep
+                child.join(timeout=0.5)
+                if child.is_alive():
+                    child.kill()
+            child.join()
         queue.close()
         queue.cancel_join_thread()
 
 
-def _deform_frames(face, frames, queue) -> None:
+def _deform_frames(face, frames, queue, parent: int) -> None:
     """The forked child: put each frame's (positions, wrinkle, crease_phase), then None or an error.
 
     Signals get their default actions back: the parent's handlers (the CLI's, which report and
     clean up) are the parent's business, and Ctrl-C in a terminal reaches both processes.
+    A child whose parent is gone exits instead of waiting on a full queue (it would keep the
+    parent's stdout and stderr open, and whoever waits on them would wait for ever).
     """
+    import queue as queues
     import signal
 
     for name in ("SIGINT", "SIGTERM", "SIGHUP"):
         if hasattr(signal, name):
             signal.signal(getattr(signal, name), signal.SIG_DFL)
+
+    def put(item) -> None:
+        while True:
+            try:
+                return queue.put(item, timeout=1.0)
+            except queues.Full:
+                if os.getppid() != parent:
+                    os._exit(0)
+
     try:
         engine = face.start_animation()
         for act in frames:
             d = engine.step(act)
-            queue.put((d.positions, d.wrinkle, d.crease_phase))
-        queue.put(None)
+            put((d.positions, d.wrinkle, d.crease_phase))
+        put(None)
     except BaseException as exc:  # noqa: BLE001 — handed to the parent, which raises it
         import pickle
 
@@ -168,7 +182,7 @@ def _deform_frames(face, frames, queue) -> None:
             pickle.dumps(exc)
         except Exception:  # noqa: BLE001 — an exception that does not pickle: its type and message
             exc = RuntimeError(f"{type(exc).__name__}: {exc}")
-        queue.put(("error", exc))
+        put(("error", exc))
 
 
 def _received(queue, count: int, child) -> Iterator:
