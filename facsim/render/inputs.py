@@ -61,14 +61,18 @@ class Lighting:
     world-down facing surfaces. ``exposure`` scales everything before tone mapping.
     """
 
-    key_direction: tuple[float, float, float] = (-0.6, 0.55, 0.6)
-    key_color: tuple[float, float, float] = (1.42, 1.35, 1.25)
-    fill_direction: tuple[float, float, float] = (0.8, -0.05, 0.6)
-    fill_color: tuple[float, float, float] = (0.17, 0.165, 0.175)
+    # A portrait studio's even, soft light (as stimulus sets such as KDEF and Radboud are
+    # photographed): a large key above the camera, a little to its left, so the nose and
+    # chin cast soft shadows down and the face is modelled but never dramatic; a fill from
+    # the right at about a quarter of the key; a faint rim from behind; a bright room.
+    key_direction: tuple[float, float, float] = (-0.4, 0.5, 0.85)
+    key_color: tuple[float, float, float] = (1.22, 1.17, 1.1)
+    fill_direction: tuple[float, float, float] = (0.8, 0.05, 0.65)
+    fill_color: tuple[float, float, float] = (0.3, 0.295, 0.3)
     rim_direction: tuple[float, float, float] = (0.35, 0.55, -0.75)
-    rim_color: tuple[float, float, float] = (0.55, 0.55, 0.58)
-    sky: tuple[float, float, float] = (0.18, 0.18, 0.19)
-    ground: tuple[float, float, float] = (0.095, 0.07, 0.057)
+    rim_color: tuple[float, float, float] = (0.38, 0.38, 0.4)
+    sky: tuple[float, float, float] = (0.2, 0.2, 0.21)
+    ground: tuple[float, float, float] = (0.11, 0.085, 0.07)
     exposure: float = 1.0
 
     def world_uniforms(self, camera: Camera) -> dict[str, tuple[float, ...]]:

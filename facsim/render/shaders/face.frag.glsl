@@ -154,29 +154,46 @@ void main() {
     vec4 paint = texture(u_paint, v_uv);
     vec4 detail = texture(u_detail, v_uv);
     vec4 tone = texture(u_tone, v_uv);   // periorbital, translucency, pores, sun
-    // Mottling at two scales so large areas are not a flat plastic colour; stronger with age.
-    // The fine scale is skin grain a few pixels across at 512² (pores and fine lines,
-    // averaged), faded to its mean where it would be finer than a pixel; it also breaks up
-    // the sheen below. (hm08's paint box is twice as long in v as in u, hence the 1:2
-    // frequencies: round cells.)
+    // Albedo varies at three scales, as photographed skin does, so no area is a flat plastic
+    // colour: tone patches a couple of centimetres across (blood and melanin are never even),
+    // blotches of a few millimetres, and grain about a millimetre across (pores and fine
+    // lines, averaged; faded to its mean where it would be finer than a pixel; it also breaks
+    // up the sheen below). All of it grows with age. (hm08's paint box is twice as long in v
+    // as in u, hence the 1:2 frequencies: round cells.)
     vec2 grain_uv = v_uv * vec2(350.0, 700.0);
     float grain = mix(0.5, value_noise(grain_uv, 0),
                       clamp(2.0 - 1.2 * max(fwidth(grain_uv.x), fwidth(grain_uv.y)), 0.0, 1.0));
     float blotch = value_noise(v_uv * vec2(150.0, 300.0), 0);
+    float patches = value_noise(v_uv * vec2(24.0, 48.0) + 17.0, 0);
     float mottle = 0.6 * blotch + 0.4 * grain;
-    vec3 albedo = u_skin * (1.0 + vec3(0.08, 0.1, 0.11) * (1.0 + 1.5 * u_age) * (mottle - 0.5));
-    // Regional colour: redder nose, cheeks and ears (blood close to the surface); darker,
-    // cooler skin around the eyes (thin skin over vessels and muscle), more so with age;
-    // a shaved beard's blue-grey shadow.
-    albedo *= mix(vec3(1.0), vec3(1.05, 0.80, 0.77), 0.7 * detail.r);
-    albedo *= mix(vec3(1.0), vec3(0.80, 0.72, 0.76), tone.r * (0.55 + 0.45 * u_age));
+    vec3 albedo = u_skin * (1.0 + vec3(0.10, 0.12, 0.13) * (1.0 + 1.5 * u_age) * (mottle - 0.5));
+    albedo *= mix(vec3(1.04, 0.97, 0.96), vec3(0.975, 1.0, 1.02), patches);
+    // Regional colour: redder nose, cheeks and ears (blood close to the surface), in broken
+    // capillary patches rather than an airbrushed blob; darker, cooler skin around the eyes
+    // (thin skin over vessels and muscle), more so with age; a shaved beard's blue-grey shadow.
+    float red = detail.r * mix(0.45, 1.35, smoothstep(0.2, 0.8, 0.55 * blotch + 0.45 * patches));
+    albedo *= mix(vec3(1.0), vec3(1.05, 0.80, 0.77), 0.7 * red);
+    albedo *= mix(vec3(1.0), vec3(0.78, 0.70, 0.75), tone.r * (0.6 + 0.5 * u_age));
     albedo = mix(albedo, albedo * vec3(0.70, 0.72, 0.78), u_beard * detail.g * (1.0 - paint.g));
     // Age spots: sparse, soft tan patches where the sun reaches, growing with age.
     float spot = smoothstep(0.72, 0.9, blotch) * tone.a * u_age;
     albedo *= mix(vec3(1.0), vec3(0.86, 0.76, 0.66), spot);
     albedo = mix(albedo, u_cheek, paint.a);
     albedo = mix(albedo, u_eyelid, paint.b);
-    albedo = mix(albedo, u_lips, paint.g);
+    // Lips: the red is not a flat paint. Fine vertical furrows run across it (every 1.5 mm
+    // or so along the lip, v; wavy along u), deeper with age and toward the middle of the
+    // red; the colour is mottled; the vermilion border is a thin paler ridge (the "white
+    // roll") where the red meets the skin, not a painted edge.
+    float lips = paint.g;
+    float lip_s = v_uv.y * 560.0 + 0.35 * value_noise(v_uv * vec2(110.0, 60.0), 0);
+    float lip_line = pow(0.5 + 0.5 * cos(2.0 * PI * lip_s), 8.0)
+                   * (0.25 + 0.75 * value_noise(vec2(lip_s, v_uv.x * 40.0), 0));   // uneven furrows
+    lip_line = mix(0.1, lip_line, clamp(1.6 - 3.0 * fwidth(lip_s), 0.0, 1.0));
+    float lip_core = smoothstep(0.45, 0.95, lips);
+    float border = lips * (1.0 - lips) * 4.0;
+    vec3 lip_col = u_lips * (0.92 + 0.16 * blotch) * (1.0 - (0.3 + 0.2 * u_age) * lip_line * lip_core);
+    albedo = mix(albedo, lip_col, smoothstep(0.0, 1.0, lips));
+    albedo *= 1.0 + 0.07 * border * (1.0 - u_age);
 #ifdef USE_BROWS
     vec2 brow = brow_hair(v_uv, paint.r);
 #else
@@ -207,14 +224,20 @@ void main() {
 #else
     vec3 bumped = n;
 #endif
+    // Contact shadows: the baked visibility is close to 1 on the open face and falls only in
+    // the nostrils, the lip line, the eye sockets and under the jaw; squaring it deepens
+    // those small shadows (a soft studio key still reaches into them partly).
+    float contact = occ * occ;
     // Subsurface look: light wraps past the terminator, red furthest, so the shadow edge is
     // soft and warm (less with age: thinner skin). Red scatters furthest under the skin, so it
     // sees the smooth normal; green and blue see the pores' relief (normal blending).
     vec3 wrap = vec3(0.42, 0.2, 0.14) * (1.0 - hair) * (1.0 - 0.3 * u_age);
-    vec3 lit = diffuse_light(n, wrap, occ);
+    vec3 lit = diffuse_light(n, wrap, contact);
 #ifdef USE_PORES
-    lit.gb = mix(lit.gb, diffuse_light(bumped, 0.5 * wrap, occ).gb, 0.6);
+    lit.gb = mix(lit.gb, diffuse_light(bumped, 0.5 * wrap, contact).gb, 0.6);
 #endif
+    // Light that scatters out of the skin's shadowed side is redder than the light going in.
+    lit *= mix(vec3(1.0), vec3(1.06, 0.97, 0.95), (1.0 - contact) * (1.0 - hair));
     vec3 diffuse = lit * albedo;
     // Translucency: thin ears and nose wings glow red where the rim light comes from behind
     // them.
@@ -222,19 +245,22 @@ void main() {
     vec3 glow = back_rim * back_rim * u_rim_col * occ;
     diffuse += tone.g * 0.55 * glow * u_skin * vec3(1.0, 0.42, 0.3);
     // Specular in two lobes, as skin has: a broad one from the rough horny layer and a tight
-    // one from the oil film, which the T-zone (detail.b) has most and the cheeks little; the
-    // lips are wet and glossy; brow hair has none. Pores break up the sheen (bumped normal).
+    // one from the oil film. The film is patchy: the T-zone (detail.b) has most, in patches,
+    // the cheeks little (matte), the lips are wet but broken by their furrows; brow hair has
+    // none. Micro-relief (grain) breaks the sheen into a speckle instead of a plastic glaze,
+    // and the rough surface keeps the grazing-angle Fresnel sheen low.
     float ndv = max(dot(n, v), 0.0);
-    float fres = schlick(0.028, ndv);
-    float lips = paint.g;
-    float oil = detail.b * (1.0 - 0.35 * u_age);
+    float fres = mix(0.028, schlick(0.028, ndv), 0.55);
+    float oil = detail.b * (1.0 - 0.35 * u_age) * mix(0.55, 1.3, patches) * (1.0 - lips);
+    float wet = lips * (1.0 - 0.5 * lip_line);
     // (The fill is too weak to show in a broad lobe: key and rim only.)
-    float broad_shine = mix(10.0, 16.0, oil);
+    float broad_shine = mix(8.0, 14.0, oil);
     vec3 broad = (blinn(bumped, u_key_dir, v, broad_shine) * u_key_col
-                  + blinn(bumped, u_rim_dir, v, broad_shine) * u_rim_col) * mix(0.35, 0.8, oil);
-    vec3 tight = blinn(bumped, u_key_dir, v, mix(45.0, 90.0, lips)) * u_key_col * mix(mix(0.08, 1.3, oil * oil), 1.8, lips);
-    vec3 spec = (broad + tight) * fres * (1.0 - hair) * (0.5 + grain);
-    radiance = (diffuse + spec * occ) * cavity;
+                  + blinn(bumped, u_rim_dir, v, broad_shine) * u_rim_col) * mix(0.2, 0.75, oil);
+    vec3 tight = blinn(bumped, u_key_dir, v, mix(32.0, 70.0, wet)) * u_key_col
+               * (mix(0.05, 1.1, oil * oil) + 1.3 * wet);
+    vec3 spec = (broad + tight) * fres * (1.0 - hair) * (0.25 + 1.5 * grain * mix(1.0, grain, 0.5));
+    radiance = (diffuse + spec * contact) * cavity;
 #endif
 
 #ifdef REGION_EYEBALL
