@@ -64,15 +64,15 @@ class Lighting:
     # A portrait studio's even, soft light (as stimulus sets such as KDEF and Radboud are
     # photographed): a large key above the camera, a little to its left, so the nose and
     # chin cast soft shadows down and the face is modelled but never dramatic; a fill from
-    # the right at about a quarter of the key; a faint rim from behind; a bright room.
-    key_direction: tuple[float, float, float] = (-0.4, 0.5, 0.85)
-    key_color: tuple[float, float, float] = (1.22, 1.17, 1.1)
+    # the right at about a sixth of the key; a faint rim from behind; a bright room.
+    key_direction: tuple[float, float, float] = (-0.42, 0.55, 0.78)
+    key_color: tuple[float, float, float] = (1.27, 1.21, 1.13)
     fill_direction: tuple[float, float, float] = (0.8, 0.05, 0.65)
-    fill_color: tuple[float, float, float] = (0.3, 0.295, 0.3)
+    fill_color: tuple[float, float, float] = (0.21, 0.205, 0.21)
     rim_direction: tuple[float, float, float] = (0.35, 0.55, -0.75)
     rim_color: tuple[float, float, float] = (0.38, 0.38, 0.4)
-    sky: tuple[float, float, float] = (0.2, 0.2, 0.21)
-    ground: tuple[float, float, float] = (0.11, 0.085, 0.07)
+    sky: tuple[float, float, float] = (0.145, 0.145, 0.155)
+    ground: tuple[float, float, float] = (0.075, 0.058, 0.047)
     exposure: float = 1.0
 
     def world_uniforms(self, camera: Camera) -> dict[str, tuple[float, ...]]:

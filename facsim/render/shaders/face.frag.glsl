@@ -172,7 +172,7 @@ void main() {
     // capillary patches rather than an airbrushed blob; darker, cooler skin around the eyes
     // (thin skin over vessels and muscle), more so with age; a shaved beard's blue-grey shadow.
     float red = detail.r * mix(0.45, 1.35, smoothstep(0.2, 0.8, 0.55 * blotch + 0.45 * patches));
-    albedo *= mix(vec3(1.0), vec3(1.05, 0.80, 0.77), 0.7 * red);
+    albedo *= mix(vec3(1.0), vec3(1.05, 0.80, 0.77), (0.7 + 0.3 * u_age) * red);   // older: broken veins
     albedo *= mix(vec3(1.0), vec3(0.78, 0.70, 0.75), tone.r * (0.6 + 0.5 * u_age));
     albedo = mix(albedo, albedo * vec3(0.70, 0.72, 0.78), u_beard * detail.g * (1.0 - paint.g));
     // Age spots: sparse, soft tan patches where the sun reaches, growing with age.
@@ -222,7 +222,16 @@ void main() {
     vec3 bumped = normalize(abs(det) * n - (0.0006 + 0.0003 * u_age) * pore_amount * grad);
     cavity *= 1.0 - 0.07 * pit * pore_amount;
 #else
-    vec3 bumped = n;
+    // Micro-relief at small sizes: the skin's millimetre-scale unevenness (the mottle as a
+    // height, surface gradient from screen derivatives: its cells span several pixels, so
+    // the 2x2-quad derivative is smooth) tilts the normal a little, which breaks the sheen
+    // into the irregular highlights of real skin instead of a plastic glaze.
+    vec3 dpdx = dFdx(v_pos), dpdy = dFdy(v_pos);
+    vec3 r1 = cross(dpdy, n), r2 = cross(n, dpdx);
+    float det = dot(dpdx, r1);
+    vec3 grad = sign(det) * (dFdx(mottle) * r1 + dFdy(mottle) * r2);
+    float relief = (0.0012 + 0.0008 * u_age) * (0.5 + tone.b) * (1.0 - paint.g) * (1.0 - hair);
+    vec3 bumped = normalize(abs(det) * n - relief * grad);
 #endif
     // Contact shadows: the baked visibility is close to 1 on the open face and falls only in
     // the nostrils, the lip line, the eye sockets and under the jaw; squaring it deepens
@@ -235,6 +244,11 @@ void main() {
     vec3 lit = diffuse_light(n, wrap, contact);
 #ifdef USE_PORES
     lit.gb = mix(lit.gb, diffuse_light(bumped, 0.5 * wrap, contact).gb, 0.6);
+#endif
+#ifndef USE_PORES
+    // The relief shades the key light too (first order in the tilt: cheap), mostly in green
+    // and blue; red, scattered further under the skin, sees the smooth surface.
+    lit += u_key_col * vec3(0.35, 1.0, 1.0) * (dot(bumped, u_key_dir) - dot(n, u_key_dir));
 #endif
     // Light that scatters out of the skin's shadowed side is redder than the light going in.
     lit *= mix(vec3(1.0), vec3(1.06, 0.97, 0.95), (1.0 - contact) * (1.0 - hair));
