@@ -106,3 +106,27 @@ def test_hair_shadows_the_forehead_under_a_fringe_not_the_chin(face_of, head, ma
     assert (shade[upper_forehead] < no_cast[upper_forehead] - 0.05).mean() > 0.3  # the fringe's shadow
     near_chin = np.linalg.norm(skin - chin, axis=1) < 0.2
     assert np.all(shade[near_chin] == 1.0)
+
+
+def test_studio_rig_lights_the_face_evenly_but_still_models_it(face_of, marks):
+    # Stimulus sets (KDEF, Radboud) are photographed in soft, even light: the key side and
+    # the fill side of the face differ, but not dramatically.
+    face = face_of("ava")
+    image, camera = render(face, face.appearance)
+    key_side = patch(image, camera, face.neutral[marks["cheek_right"]]).sum()
+    fill_side = patch(image, camera, face.neutral[marks["cheek_left"]]).sum()
+    assert 0.72 < min(key_side, fill_side) / max(key_side, fill_side) < 0.95
+
+
+def test_lips_show_vertical_furrows_not_a_flat_paint(face_of, marks):
+    face = face_of("ava")
+    size = 512
+    camera = face.camera(size=(size, size))
+    image = face.renderer(size=size).render(face.neutral, appearance=face.appearance, camera=camera,
+                                            occlusion=face.shading_occlusion)[..., :3].astype(float).mean(-1)
+    (x, y), = project(camera, [face.neutral[marks["lower_lip"]]], size)[0]
+    x, y = int(x), int(y)
+    lip = image[y - 8:y + 1, x - 24:x + 25]           # the middle of the lower lip's red
+    across = np.abs(np.diff(lip, axis=1)).mean()      # along the lip: crosses the furrows
+    along = np.abs(np.diff(lip, axis=0)).mean()       # up the lip: runs along them
+    assert across > 1.2 * along and across > 2.0

@@ -166,7 +166,7 @@ void main() {
     float blotch = value_noise(v_uv * vec2(150.0, 300.0), 0);
     float patches = value_noise(v_uv * vec2(24.0, 48.0) + 17.0, 0);
     float mottle = 0.6 * blotch + 0.4 * grain;
-    vec3 albedo = u_skin * (1.0 + vec3(0.10, 0.12, 0.13) * (1.0 + 1.5 * u_age) * (mottle - 0.5));
+    vec3 albedo = u_skin * (1.0 + vec3(0.10, 0.12, 0.13) * (1.0 + 1.2 * u_age) * (mottle - 0.5));
     albedo *= mix(vec3(1.04, 0.97, 0.96), vec3(0.975, 1.0, 1.02), patches);
     // Regional colour: redder nose, cheeks and ears (blood close to the surface), in broken
     // capillary patches rather than an airbrushed blob; darker, cooler skin around the eyes
@@ -272,7 +272,7 @@ void main() {
     vec3 broad = (blinn(bumped, u_key_dir, v, broad_shine) * u_key_col
                   + blinn(bumped, u_rim_dir, v, broad_shine) * u_rim_col) * mix(0.2, 0.75, oil);
     vec3 tight = blinn(bumped, u_key_dir, v, mix(32.0, 70.0, wet)) * u_key_col
-               * (mix(0.05, 1.1, oil * oil) + 1.3 * wet);
+               * (mix(0.08, 2.6, oil * oil) + 1.6 * wet);
     vec3 spec = (broad + tight) * fres * (1.0 - hair) * (0.25 + 1.5 * grain * mix(1.0, grain, 0.5));
     radiance = (diffuse + spec * contact) * cavity;
 #endif
