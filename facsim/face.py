@@ -154,11 +154,17 @@ class Face:
 
     @cached_property
     def shading_occlusion(self) -> np.ndarray:
-        """:attr:`occlusion` with the skin under the hair shadowed by it and the mouth darkening with depth."""
+        """:attr:`occlusion` with contact shadows in the skin's small folds, the skin under the hair
+        shadowed by it and the mouth darkening with depth."""
         from facsim.head.mouth import mouth_depth_visibility
         from facsim.head.proxies import hair_shadow
 
+        from facsim.head.skin import CONTACT_DEPTH, contact_shadow
+
         occlusion = np.array(self.occlusion, np.float32, copy=True)
+        skin = self.head.skin
+        # Contact shadows in folds too narrow for the bake, placed on the base mesh's anatomy.
+        occlusion[skin] *= 1.0 - CONTACT_DEPTH * contact_shadow(self.head.base_vertices[self.head.base_index[skin]])
         interior, visibility = mouth_depth_visibility(self.head, self.neutral)
         occlusion[interior] = visibility
         for bound in self.proxies:

@@ -108,3 +108,34 @@ def sun_density(positions: np.ndarray) -> np.ndarray:
            + 0.7 * blob(positions, (0.0, 7.8, 1.4), (0.45, 0.25, 0.35))
            + 0.6 * blob(positions, (0.6, 7.55, 1.0), (0.15, 0.2, 0.25)))
     return np.clip(sun * _front(positions, 0.7, 1.0), 0, 1).astype(np.float32)
+
+
+#: How much a full contact shadow takes off the ambient visibility.
+CONTACT_DEPTH = 0.4
+#: Where skin meets skin in small folds too narrow for the baked occlusion's depth maps:
+#: (centre, radius, strength) on the base mesh, decimetres, mirrored in x.
+CONTACT_SHADOWS = (
+    ((0.165, 6.855, 1.47), (0.028, 0.05, 0.06), 1.0),    # alar crease: nose wing against cheek
+    ((0.075, 6.825, 1.575), (0.04, 0.02, 0.05), 0.8),    # nostril openings, under the wing
+    ((0.0, 6.795, 1.62), (0.035, 0.02, 0.05), 0.6),      # subnasale: columella meets upper lip
+    ((0.0, 6.642, 1.56), (0.2, 0.011, 0.12), 0.9),       # lip line (stomion)
+    ((0.248, 6.647, 1.356), (0.03, 0.03, 0.06), 0.9),    # mouth corners
+    ((0.0, 6.46, 1.53), (0.13, 0.028, 0.08), 0.45),      # mentolabial sulcus under the lower lip
+    ((0.205, 7.3, 1.375), (0.035, 0.045, 0.05), 0.7),    # inner eye corner against the nose
+    ((0.31, 7.405, 1.385), (0.13, 0.022, 0.08), 0.5),    # upper lid crease under the brow
+)
+
+
+def contact_shadow(positions: np.ndarray) -> np.ndarray:
+    """(N,) float32 in [0, 1]: how deep in a small skin fold each base-mesh point lies.
+
+    Per-vertex ambient occlusion from depth maps misses folds narrower than its texels
+    (the nostrils, the lip line, the alar crease, the inner eye corner); photographs show
+    soft dark contact lines there. :meth:`facsim.face.Face.shading_occlusion` darkens the
+    occlusion with this.
+    """
+    positions = np.asarray(positions, np.float64)
+    dark = np.zeros(len(positions))
+    for centre, radius, strength in CONTACT_SHADOWS:
+        dark = np.maximum(dark, strength * blob(positions, centre, radius))
+    return np.clip(dark, 0, 1).astype(np.float32)
