@@ -272,8 +272,8 @@ void main() {
     vec3 broad = (blinn(bumped, u_key_dir, v, broad_shine) * u_key_col
                   + blinn(bumped, u_rim_dir, v, broad_shine) * u_rim_col) * mix(0.2, 0.75, oil);
     vec3 tight = blinn(bumped, u_key_dir, v, mix(32.0, 70.0, wet)) * u_key_col
-               * (mix(0.08, 2.6, oil * oil) + 1.6 * wet);
-    vec3 spec = (broad + tight) * fres * (1.0 - hair) * (0.25 + 1.5 * grain * mix(1.0, grain, 0.5));
+               * (mix(0.08, 2.2, oil * oil) + 1.6 * wet);
+    vec3 spec = (broad + tight) * fres * (1.0 - hair) * (0.4 + 1.2 * grain);
     radiance = (diffuse + spec * contact) * cavity;
 #endif
 
