@@ -185,13 +185,16 @@ void main() {
     // red; the colour is mottled; the vermilion border is a thin paler ridge (the "white
     // roll") where the red meets the skin, not a painted edge.
     float lips = paint.g;
-    float lip_s = v_uv.y * 560.0 + 0.35 * value_noise(v_uv * vec2(110.0, 60.0), 0);
-    float lip_line = pow(0.5 + 0.5 * cos(2.0 * PI * lip_s), 8.0)
-                   * (0.25 + 0.75 * value_noise(vec2(lip_s, v_uv.x * 40.0), 0));   // uneven furrows
+    // (The blotches bend the furrows; each furrow gets its own depth from one hash, which
+    // changes where the furrow pattern is zero, between furrows: no seam.)
+    float lip_s = v_uv.y * 560.0 + 0.8 * blotch;
+    float lip_line = pow(0.5 + 0.5 * cos(2.0 * PI * lip_s), 5.0)
+                   * (0.25 + 0.75 * hash2(ivec2(int(floor(lip_s + 0.5)), 7)))    // uneven furrows,
+                   * (0.3 + 0.7 * grain);                                         // broken along their length
     lip_line = mix(0.1, lip_line, clamp(1.6 - 3.0 * fwidth(lip_s), 0.0, 1.0));
     float lip_core = smoothstep(0.45, 0.95, lips);
     float border = lips * (1.0 - lips) * 4.0;
-    vec3 lip_col = u_lips * (0.92 + 0.16 * blotch) * (1.0 - (0.3 + 0.2 * u_age) * lip_line * lip_core);
+    vec3 lip_col = u_lips * (0.92 + 0.16 * blotch) * (1.0 - (0.28 + 0.2 * u_age) * lip_line * lip_core);
     albedo = mix(albedo, lip_col, smoothstep(0.0, 1.0, lips));
     albedo *= 1.0 + 0.07 * border * (1.0 - u_age);
 #ifdef USE_BROWS
