@@ -14,6 +14,8 @@ character's maps sit on the same features. Channels (0 … 1):
   temples); the renderer shows spots there in proportion to the character's age.
 
 The maps depend on the base mesh only, so they are computed once and cached on disk.
+:func:`contact_shadow` places, per vertex, the soft dark lines of small skin folds (nostrils,
+lip line, alar crease, inner eye corners) that the baked ambient occlusion is too coarse to see.
 """
 from __future__ import annotations
 
