@@ -115,10 +115,10 @@ def test_eyes_turn_left_on_61(engine, head):
 def test_eq1_sums_shared_registers_and_clamps_to_the_smallest_max():
     assert combine_registers([(0.2, 0.6), (0.3, 1.0)]) == pytest.approx(0.42)
     assert combine_registers([(0.5, 0.6), (0.4, 0.8)]) == pytest.approx(0.6)  # 0.62 clamped to 0.6
-    weights = register_weights(Activations({(9, "left"): 0.2, (4, "left"): 0.2}))
+    weights = register_weights(Activations({(42, "left"): 0.2, (4, "left"): 0.2}))
     shared = [w for c, w in weights.items() if c.target == "faceunits/browDownLeft"]
-    assert len(weights) > 3
-    assert shared == [pytest.approx(0.27)]  # 0.2·1.0 + 0.2·0.35, under min(1.0, 0.35)
+    assert len(weights) == 2  # browDown shared, eyebrows-down summed as well
+    assert shared == [pytest.approx(0.32)]  # 0.2·1.0 + 0.2·0.6, under min(1.0, 0.6)
 
 
 def test_eq1_never_undoes_the_strongest_au():

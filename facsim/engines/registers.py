@@ -115,24 +115,35 @@ def register_weights(act: Activations) -> dict[Column, float]:
 def combination_scales(act: Activations, code: int, side: str) -> dict[str, float]:
     """Target → factor on AU ``code``'s maxima on ``side`` from the table's ``combinations``.
 
-    A rule applies when every AU it names acts on that side; its factor then
-    scales by the weaker of them (at half intensity, half the change), so the
-    face moves smoothly as an AU fades in.
+    A rule applies when every AU it names acts on that side. Its factor applies in
+    full when the other AUs of the rule act at least as strongly as ``code`` and
+    fades with their share of ``code``'s intensity, so the face moves smoothly as a
+    partner AU fades in. The whole expression at half intensity (HapFACS's 50 %
+    emotions) keeps the combination's appearance: both AUs are halved, the conflict
+    between them is the same, so is the rule (fear at 50 % keeps raised inner brows).
 
     >>> round(combination_scales(Activations({(1, "left"): 1.0, (4, "left"): 1.0}), 4, "left")["faceunits/browDown{Side}"], 6)
     0.45
+    >>> round(combination_scales(Activations({(1, "left"): 0.5, (4, "left"): 0.5}), 4, "left")["faceunits/browDown{Side}"], 6)
+    0.45
+    >>> round(combination_scales(Activations({(1, "left"): 0.5, (4, "left"): 1.0}), 4, "left")["faceunits/browDown{Side}"], 6)
+    0.725
     >>> combination_scales(Activations({(4, "left"): 1.0}), 4, "left")
     {}
     """
     out: dict[str, float] = {}
+    level = act[code, side]
+    if level <= 0.0:
+        return out
     for rule in register_table().get("combinations") or []:
         scale = rule["scale"]
         if scale["au"] != code:
             continue
-        weakest = min(act[c, side] for c in rule["when"])
-        if weakest <= 0.0:
+        partners = [act[c, side] for c in rule["when"] if c != code]
+        share = min(1.0, min(partners, default=level) / level)
+        if share <= 0.0:
             continue
-        factor = 1.0 - weakest * (1.0 - float(scale["by"]))
+        factor = 1.0 - share * (1.0 - float(scale["by"]))
         for target in scale["targets"]:
             out[target] = out.get(target, 1.0) * factor
     return out
