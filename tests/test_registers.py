@@ -282,13 +282,15 @@ def test_skin_guard_unfolds_a_fold_and_lifts_skin_off_the_eye(engine, head, mark
     assert after.ok, after
 
 
+@pytest.mark.parametrize("level", [1.0, 0.5])
 @pytest.mark.parametrize("name", ["sadness", "fear"])
-def test_sad_and_fearful_inner_brows_are_raised(engine, marks, name):
-    """Issue 13: in 1+4 the inner brows rise and are drawn together (a combination rule)."""
+def test_sad_and_fearful_inner_brows_are_raised(engine, marks, name, level):
+    """Issue 13: in 1+4 the inner brows rise and are drawn together (a combination rule),
+    at half intensity by half as much (the rule holds while 1 and 4 keep their ratio)."""
     from facsim.facs.emotions import emotion
 
-    delta = engine.deform(activations(emotion(name))).positions - engine.neutral
-    assert delta[marks["inner_brow_left"], 1] > 0.03
+    delta = engine.deform(activations(emotion(name, intensity=level))).positions - engine.neutral
+    assert delta[marks["inner_brow_left"], 1] > 0.03 * level
     both = _moved(engine, "1+4")[marks["inner_brow_left"]]
     assert both[1] > 0.03 and both[0] < -0.005
 
@@ -298,3 +300,24 @@ def test_pressed_lips_keep_their_corners(engine, marks):
     delta = _moved(engine, "24")
     assert abs(delta[marks["lip_corner_left"], 1]) < 0.015
     assert delta[marks["upper_lip"], 1] < -0.02 and delta[marks["lower_lip"], 1] > 0.02
+
+
+def _emotion_moved(engine, name, level=1.0):
+    from facsim.facs.emotions import emotion
+
+    return engine.deform(activations(emotion(name, intensity=level))).positions - engine.neutral
+
+
+@pytest.mark.parametrize("level", [1.0, 0.5])
+def test_anger_glares_under_knitted_brows(engine, marks, level):
+    """Issue 13 (HapFACS anger read as disgust): the eyes of 5+7 under lowered brows are not
+    narrower than at rest, and the brows are drawn together more than in disgust (9 without 4)."""
+    anger = _emotion_moved(engine, "anger", level)
+    aperture = anger[marks["upper_lid_left"], 1] - anger[marks["lower_lid_left"], 1]
+    assert aperture >= 0.0
+    disgust = _emotion_moved(engine, "disgust", level)
+
+    def knit(delta):
+        return delta[marks["inner_brow_left"], 0] - delta[marks["inner_brow_right"], 0]
+
+    assert knit(anger) < knit(disgust) < 0.0
