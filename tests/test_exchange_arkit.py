@@ -59,7 +59,9 @@ def test_weights_are_the_registers_faceunits_targets():
                 assert weights[name] >= min(reg["max"], 1.0) - 1e-9, (code, name)
     weights = arkit_weights(Activations({(12, "left"): 0.5}))
     assert weights["mouthSmileLeft"] == pytest.approx(0.5) and weights["mouthSmileRight"] == 0.0
-    assert weights["cheekSquintLeft"] == pytest.approx(0.1)          # 12's second register: max 0.2
+    squint = [r["max"] for r in register_table()["action_units"][12]["registers"]
+              if r["target"] == "faceunits/cheekSquint{Side}"]
+    assert weights["cheekSquintLeft"] == pytest.approx(0.5 * squint[0])  # 12's cheek raise at half
     both = arkit_weights(Activations({(6, "left"): 1.0, (7, "left"): 1.0}))
     maxima = [reg["max"] for code in (6, 7) for reg in register_table()["action_units"][code]["registers"]
               if reg["target"] == "faceunits/eyeSquint{Side}"]
