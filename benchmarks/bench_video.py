@@ -4,13 +4,16 @@
    video default), runs interleaved so a shared machine slows them alike, medians of
    ``--repeats``:
 
-   - ``now``: this checkout (engine in a forked child a frame ahead of the drawing; still
-     hair kept as pixels);
+   - ``now``: this checkout (frames that repeat an earlier frame's activations written again,
+     not drawn; engine in a forked child up to 64 frames ahead of the drawing; still hair kept
+     as pixels);
    - ``now, serial``: this checkout with ``FACSIM_SERIAL_FRAMES=1`` (frames deformed in the
      drawing process, as before);
    - ``now, --hair none``: this checkout without hair (brows and lashes kept);
    - ``before``: the code at ``--baseline-rev`` (default: main before this work), checked out
-     into a temporary git worktree.
+     into a temporary git worktree;
+   - with ``--muscle``, ``before, muscle`` and ``now, muscle``: the muscle engine's video (it keeps
+     state between frames, so every frame is drawn), its ratios against ``before, muscle``.
 
    Wall seconds (and × real time: 1.0 = as long as the video), CPU seconds of every process
    and thread (facsim, llvmpipe's threads, the deformation child, ffmpeg; steadier than wall
@@ -23,7 +26,7 @@
    and encoding (the pipe to ffmpeg), plus start-up (imports, face build, first frame's
    shaders) and ffmpeg's finish.
 
-    python benchmarks/bench_video.py [--repeats 5] [--character ava] [--baseline-rev REV] [--nice -20]
+    python benchmarks/bench_video.py [--repeats 5] [--character ava] [--baseline-rev REV] [--muscle] [--nice -20]
 """
 from __future__ import annotations
 
@@ -128,6 +131,8 @@ def main(argv=None) -> int:
     parser.add_argument("--nice", type=int, default=0,
                         help="run the videos at this niceness (e.g. -20 as root: a shared machine's other work "
                              "then yields, and wall times approach an idle machine's)")
+    parser.add_argument("--muscle", action="store_true",
+                        help="also the muscle engine's video, before and now (its ratio is against its own before)")
     parser.add_argument("--stages-only", action="store_true", help="only the per-stage figures (JSON; internal)")
     parser.add_argument("--no-stages", action="store_true", help="only the end-to-end figures")
     args = parser.parse_args(argv)
@@ -148,6 +153,9 @@ def main(argv=None) -> int:
             "now, serial": (ROOT, command(ROOT), {"FACSIM_SERIAL_FRAMES": "1"}),
             "now, --hair none": (ROOT, command(ROOT, "--hair", "none"), None),
         }
+        if args.muscle:
+            configs["before, muscle"] = (base_tree, command(base_tree, "--engine", "muscle"), None)
+            configs["now, muscle"] = (ROOT, command(ROOT, "--engine", "muscle"), None)
         for tree, cmd, env in configs.values():  # warm caches (face data, occlusion bakes, proxies)
             timed(cmd, tree, env, nice=NICE)
         loads = [os.getloadavg()[0]]
@@ -163,6 +171,9 @@ def main(argv=None) -> int:
               f"{min(loads):.1f}-{max(loads):.1f} during the runs{f', nice {NICE}' if NICE else ''} "
               f"(CPU = every process and thread, user + system):")
         for name, values in times.items():
+            if name == "before, muscle":
+                wall0 = statistics.median(w for w, _ in values)
+                cpu0 = statistics.median(c for _, c in values)
             wall = statistics.median(w for w, _ in values)
             cpu = statistics.median(c for _, c in values)
             print(f"  {name:18s} wall {wall:6.2f} s ({wall / VIDEO_SECONDS:4.2f}x real time; {wall / wall0:.2f}x before)"
