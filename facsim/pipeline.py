@@ -131,9 +131,10 @@ def frame_sources(face, frames, *, frame_bytes: int = 512 * 512 * 4, budget: int
     [0, 1, 1, 0]
     """
     if face is not None:
-        from facsim.engines import engine_class
+        from facsim.engines import ENGINES, engine_class
 
-        if not getattr(engine_class(face.engine_name), "stateless", False):
+        name = getattr(face, "engine_name", None)
+        if name not in ENGINES or not getattr(engine_class(name), "stateless", False):
             return list(range(len(frames)))
     budget = KEPT_FRAMES_BYTES if budget is None else budget
     keys = [tuple(act.levels.items()) for act in frames]
