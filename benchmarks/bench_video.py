@@ -4,13 +4,16 @@
    video default), runs interleaved so a shared machine slows them alike, medians of
    ``--repeats``:
 
-   - ``now``: this checkout (engine in a forked child a frame ahead of the drawing; still
-     hair kept as pixels);
+   - ``now``: this checkout (frames that repeat an earlier frame's activations written again,
+     not drawn; engine in a forked child up to 64 frames ahead of the drawing; still hair kept
+     as pixels);
    - ``now, serial``: this checkout with ``FACSIM_SERIAL_FRAMES=1`` (frames deformed in the
      drawing process, as before);
    - ``now, --hair none``: this checkout without hair (brows and lashes kept);
    - ``before``: the code at ``--baseline-rev`` (default: main before this work), checked out
-     into a temporary git worktree.
+     into a temporary git worktree;
+   - with ``--muscle``, ``before, muscle`` and ``now, muscle``: the muscle engine's video (it keeps
+     state between frames, so every frame is drawn), its ratios against ``before, muscle``.
 
    Wall seconds (and × real time: 1.0 = as long as the video), CPU seconds of every process
    and thread (facsim, llvmpipe's threads, the deformation child, ffmpeg; steadier than wall
@@ -23,7 +26,7 @@
    and encoding (the pipe to ffmpeg), plus start-up (imports, face build, first frame's
    shaders) and ffmpeg's finish.
 
-    python benchmarks/bench_video.py [--repeats 5] [--character ava] [--baseline-rev REV] [--nice -20]
+    python benchmarks/bench_video.py [--repeats 5] [--character ava] [--baseline-rev REV] [--muscle] [--nice -20]
 """
 from __future__ import annotations
 
@@ -65,7 +68,7 @@ def stages(args) -> dict:
     from facsim.face import Face
     from facsim.head.character import resolve_character
     from facsim.media.video import VideoWriter
-    from facsim.pipeline import deformations
+    from facsim.pipeline import _frames_drawn, deformations, frame_sources
     from facsim.timeline.builders import stimulus_timeline
     from facsim.timeline.sampling import sample_frames
     lap("start-up: imports")
@@ -75,6 +78,8 @@ def stages(args) -> dict:
     face = Face(character)
     timeline = stimulus_timeline(args.emotion, 1.0, 1.0, 1.0, FPS)
     frames = sample_frames(timeline, FPS)
+    sources = frame_sources(face, frames, frame_bytes=args.size * args.size * 4)
+    drawn = [act for i, act in enumerate(frames) if sources[i] == i]
     options = dict(size=args.size, antialias="fxaa")
     renderer = face.renderer(**options)
     lap("start-up: face, timeline")
@@ -82,14 +87,16 @@ def stages(args) -> dict:
     os.environ["FACSIM_SERIAL_FRAMES"] = "1"
     first = True
     try:
-        with VideoWriter(out, FPS) as writer, deformations(face, frames) as stream:
+        with VideoWriter(out, FPS) as writer, deformations(face, drawn) as stream:
             lap("start-up: face, timeline")
-            for deformation in stream:
+
+            def draw(deformation):
+                nonlocal first
                 deformation.wrinkle  # noqa: B018 — an engine's lazy creases count as deformation
                 lap("deformation")
                 renderer.timings = {}
                 image = face.render(deformation=deformation, **options)
-                drawn = sum(w for w, _ in renderer.timings.values()), sum(c for _, c in renderer.timings.values())
+                gl = sum(w for w, _ in renderer.timings.values()), sum(c for _, c in renderer.timings.values())
                 lap("render")
                 for stage, (w, c) in renderer.timings.items():
                     name = "start-up: first frame (shaders)" if first else stage
@@ -98,8 +105,11 @@ def stages(args) -> dict:
                 rw, rc = laps.pop("render")
                 laps["face: proxy fitting, per-frame"] = tuple(
                     a + b for a, b in zip(laps.get("face: proxy fitting, per-frame", (0.0, 0.0)),
-                                          (rw - drawn[0], rc - drawn[1])))
+                                          (rw - gl[0], rc - gl[1])))
                 first = False
+                return image
+
+            for image in _frames_drawn(sources, stream, draw):  # repeated frames as the video repeats them
                 writer.append(image)
                 lap("encode (pipe to ffmpeg)")
             mark[:] = (time.perf_counter(), time.process_time())
@@ -107,7 +117,7 @@ def stages(args) -> dict:
     finally:
         shutil.rmtree(out.parent, ignore_errors=True)
     children = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return {"frames": len(frames), "laps": laps, "ffmpeg_cpu": children.ru_utime + children.ru_stime}
+    return {"frames": len(frames), "drawn": len(drawn), "laps": laps, "ffmpeg_cpu": children.ru_utime + children.ru_stime}
 
 
 def main(argv=None) -> int:
@@ -121,6 +131,8 @@ def main(argv=None) -> int:
     parser.add_argument("--nice", type=int, default=0,
                         help="run the videos at this niceness (e.g. -20 as root: a shared machine's other work "
                              "then yields, and wall times approach an idle machine's)")
+    parser.add_argument("--muscle", action="store_true",
+                        help="also the muscle engine's video, before and now (its ratio is against its own before)")
     parser.add_argument("--stages-only", action="store_true", help="only the per-stage figures (JSON; internal)")
     parser.add_argument("--no-stages", action="store_true", help="only the end-to-end figures")
     args = parser.parse_args(argv)
@@ -141,6 +153,9 @@ def main(argv=None) -> int:
             "now, serial": (ROOT, command(ROOT), {"FACSIM_SERIAL_FRAMES": "1"}),
             "now, --hair none": (ROOT, command(ROOT, "--hair", "none"), None),
         }
+        if args.muscle:
+            configs["before, muscle"] = (base_tree, command(base_tree, "--engine", "muscle"), None)
+            configs["now, muscle"] = (ROOT, command(ROOT, "--engine", "muscle"), None)
         for tree, cmd, env in configs.values():  # warm caches (face data, occlusion bakes, proxies)
             timed(cmd, tree, env, nice=NICE)
         loads = [os.getloadavg()[0]]
@@ -156,6 +171,9 @@ def main(argv=None) -> int:
               f"{min(loads):.1f}-{max(loads):.1f} during the runs{f', nice {NICE}' if NICE else ''} "
               f"(CPU = every process and thread, user + system):")
         for name, values in times.items():
+            if name == "before, muscle":
+                wall0 = statistics.median(w for w, _ in values)
+                cpu0 = statistics.median(c for _, c in values)
             wall = statistics.median(w for w, _ in values)
             cpu = statistics.median(c for _, c in values)
             print(f"  {name:18s} wall {wall:6.2f} s ({wall / VIDEO_SECONDS:4.2f}x real time; {wall / wall0:.2f}x before)"
@@ -170,16 +188,18 @@ def main(argv=None) -> int:
         done = subprocess.run(cmd, cwd=ROOT, env=dict(os.environ, PYTHONPATH=str(ROOT)), check=True,
                               capture_output=True, text=True)
         runs.append(json.loads(done.stdout.strip().splitlines()[-1]))
-    frames = runs[0]["frames"]
+    frames, drawn = runs[0]["frames"], runs[0]["drawn"]
     print(f"Per stage, serial, each stage waiting for its GL work (median of {len(runs)} fresh processes; "
-          f"per frame over {frames} frames, start-up and finish in total):")
+          f"{drawn} of the {frames} frames drawn, the others repeat them; per drawn frame, encoding per "
+          f"written frame, start-up and finish in total):")
     for stage in runs[0]["laps"]:
         wall = statistics.median(r["laps"][stage][0] for r in runs)
         cpu = statistics.median(r["laps"][stage][1] for r in runs)
         if stage.startswith("start-up") or stage == "ffmpeg finish":
             print(f"  {stage:34s} CPU {cpu * 1000:7.0f} ms        wall {wall * 1000:7.0f} ms")
         else:
-            print(f"  {stage:34s} CPU {cpu / frames * 1000:7.1f} ms/frame  wall {wall / frames * 1000:7.1f} ms/frame")
+            n = frames if stage.startswith("encode") else drawn
+            print(f"  {stage:34s} CPU {cpu / n * 1000:7.1f} ms/frame  wall {wall / n * 1000:7.1f} ms/frame")
     total = statistics.median(sum(c for _, c in r["laps"].values()) for r in runs)
     ffmpeg = statistics.median(r["ffmpeg_cpu"] for r in runs)
     print(f"  {'ffmpeg (its own process)':34s} CPU {ffmpeg * 1000:7.0f} ms")

@@ -25,6 +25,8 @@ import numpy as np
 FORKED_MIN_FRAMES = 8
 #: Frames the forked engine may run ahead of the drawing (a 512² frame's geometry is ~0.25 MB).
 LOOKAHEAD = 64
+#: Most bytes of finished frames kept to be written again later in the video (see :func:`frame_sources`).
+KEPT_FRAMES_BYTES = 256 * 2**20
 
 
 def render_frame(face, expression=None, **render_options) -> np.ndarray:
@@ -57,9 +59,12 @@ def animate(timeline, path, *, face=None, character=None, engine=None, fps: floa
     -------
     Path of the finished file.
 
-    Speed: the engine runs a few frames ahead in a forked child where that is safe (see
-    :func:`deformations`), and the renderer keeps hair that holds still as pixels for the
-    length of the video (see :meth:`Renderer.sequence <facsim.render.renderer.Renderer.sequence>`).
+    Speed: a frame that shows what an earlier frame showed is that frame again, not drawn
+    anew, where the engine keeps no state between frames (see :func:`frame_sources`: a
+    stimulus video's apex holds one picture, and its offset replays its onset); the engine
+    runs a few frames ahead in a forked child where that is safe (see :func:`deformations`),
+    and the renderer keeps hair that holds still as pixels for the length of the video (see
+    :meth:`Renderer.sequence <facsim.render.renderer.Renderer.sequence>`).
     ``benchmarks/bench_video.py`` measures the 3-s stimulus video end to end and per stage.
 
     A timeline with speech tracks gets their sound (unless ``audio`` is given):
@@ -79,14 +84,18 @@ def animate(timeline, path, *, face=None, character=None, engine=None, fps: floa
         face = Face(character or timeline.character or "ava", engine=engine or timeline.engine or "registers")
     fps = fps or timeline.fps
     frames = sample_frames(timeline, fps)
+    width, height = _frame_size(face, render_options)
+    sources = frame_sources(face, frames, frame_bytes=width * height * 4)
     speech = None if audio is not None else _speech_audio(timeline, fps)
     try:
         if speech is not None and video_format(path) in ("mp4", "webm"):
             audio = speech.name
         with VideoWriter(path, fps, audio=audio, cut_audio=speech is None) as writer, \
-                deformations(face, frames) as stream, face.renderer(**render_options).sequence():
-            for i, deformation in enumerate(stream):
-                writer.append(face.render(deformation=deformation, **render_options))
+                deformations(face, [act for i, act in enumerate(frames) if sources[i] == i]) as stream, \
+                face.renderer(**render_options).sequence():
+            for i, image in enumerate(_frames_drawn(sources, stream, lambda d: face.render(deformation=d,
+                                                                                            **render_options))):
+                writer.append(image)
                 if on_frame is not None:
                     on_frame(i + 1, len(frames))
         if speech is not None and writer.format == "png":     # PNG frames: the sound goes beside them
@@ -101,6 +110,79 @@ def animate(timeline, path, *, face=None, character=None, engine=None, fps: floa
             face.close()
         if speech is not None:
             speech.close()
+
+
+def frame_sources(face, frames, *, frame_bytes: int = 512 * 512 * 4, budget: int | None = None) -> list[int]:
+    """For each frame of ``frames`` (Activations), the frame whose picture it shows: itself,
+    or an earlier frame with the same activations whose image is kept to be written again.
+
+    Only for an engine that keeps no state between frames (its class says ``stateless =
+    True``, as the register engine's does): each of its frames depends on that frame's
+    activations alone, so equal activations give the same deformation, bit for bit, and the
+    same picture. A stateful engine (the muscle engine keeps relaxing a held expression) gets
+    every frame drawn. Images are kept only while ``budget`` bytes (default
+    :data:`KEPT_FRAMES_BYTES`) hold them, ``frame_bytes`` each; beyond it a frame is drawn again.
+
+    Examples
+    --------
+    >>> from facsim.facs.activations import Activations
+    >>> smile = Activations({(12, "left"): 0.5})
+    >>> frame_sources(None, [Activations(), smile, smile, Activations()], budget=2**30)
+    [0, 1, 1, 0]
+    """
+    if face is not None:
+        from facsim.engines import ENGINES, engine_class
+
+        name = getattr(face, "engine_name", None)
+        if name not in ENGINES or not getattr(engine_class(name), "stateless", False):
+            return list(range(len(frames)))
+    budget = KEPT_FRAMES_BYTES if budget is None else budget
+    keys = [tuple(act.levels.items()) for act in frames]
+    last = {key: i for i, key in enumerate(keys)}
+    held: dict = {}  # key -> the frame whose image is kept for it
+    kept = 0
+    sources = []
+    for i, key in enumerate(keys):
+        if key in held:
+            sources.append(held[key])
+            if last[key] == i:  # its last use: the image is dropped
+                del held[key]
+                kept -= frame_bytes
+            continue
+        sources.append(i)
+        if last[key] > i and kept + frame_bytes <= budget:
+            held[key] = i
+            kept += frame_bytes
+    return sources
+
+
+def _frames_drawn(sources: list[int], deformations, draw) -> Iterator[np.ndarray]:
+    """The video's images in order: ``draw(deformation)`` for each frame that is its own source
+    (``deformations`` yields theirs in order), a kept image for the others (see :func:`frame_sources`)."""
+    uses: dict[int, int] = {}
+    for source in sources:
+        uses[source] = uses.get(source, 0) + 1
+    kept: dict[int, np.ndarray] = {}
+    for i, source in enumerate(sources):
+        if source == i:
+            image = draw(next(deformations))
+            if uses[i] > 1:
+                kept[i] = image
+        else:
+            image = kept[source]
+        uses[source] -= 1
+        if not uses[source]:
+            kept.pop(source, None)
+        yield image
+
+
+def _frame_size(face, render_options) -> tuple[int, int]:
+    """(width, height) of the frames ``face.render(**render_options)`` draws."""
+    from facsim.render.options import RenderOptions
+
+    values = dict(render_options)
+    options = values.pop("options", None) or RenderOptions()
+    return (options.replace(**values) if values else options).size
 
 
 @contextmanager

@@ -117,3 +117,41 @@ def test_forked_engine_gives_the_serial_frames_and_its_errors():
     done = subprocess.run([sys.executable, "-c", FORKED], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr[-2000:]
     assert done.stdout.strip().endswith("ok")
+
+
+def test_repeated_activations_reuse_a_frame_within_the_budget_and_only_for_stateless_engines(face_of):
+    from facsim.facs.activations import Activations
+    from facsim.pipeline import frame_sources
+    from facsim.timeline.builders import stimulus_timeline
+    from facsim.timeline.sampling import sample_frames
+
+    frames = sample_frames(stimulus_timeline("happiness", 1.0, 1.0, 1.0, 30), 30)
+    sources = frame_sources(face_of("ava"), frames)  # registers: each frame its activations alone
+    assert len(set(sources)) == 31, "onset drawn, apex held, offset replaying the onset"
+    assert sources[45] == 30 and sources[61] == 29 and sources[89] == 1
+    assert all(frames[s].levels == frames[i].levels and s <= i for i, s in enumerate(sources))
+    a, b = Activations({(12, "left"): 0.5}), Activations({(12, "right"): 0.5})
+    # Room for one kept image: b is drawn again, as it is not kept while a is.
+    assert frame_sources(None, [a, b, a, b], frame_bytes=10, budget=10) == [0, 1, 0, 3]
+    assert frame_sources(None, [a, b, a, b], frame_bytes=10, budget=0) == [0, 1, 2, 3]
+    muscle = type("MuscleFace", (), {"engine_name": "muscle"})()
+    assert frame_sources(muscle, [a, a, a]) == [0, 1, 2], "a stateful engine draws every frame"
+
+
+def test_a_video_with_repeats_gives_the_frames_drawing_every_frame_gives(tmp_path, face_of, monkeypatch):
+    from PIL import Image
+
+    import facsim.pipeline as pipeline
+    from facsim.timeline.builders import stimulus_timeline
+
+    face = face_of("ava")
+    clip = stimulus_timeline("12+26", onset=0.2, apex=0.2, offset=0.2, fps=10)
+    reused = pipeline.animate(clip, tmp_path / "reused", face=face, size=64)
+    monkeypatch.setattr(pipeline, "frame_sources", lambda face, frames, **kw: list(range(len(frames))))
+    every = pipeline.animate(clip, tmp_path / "every", face=face, size=64)
+    a = [np.asarray(Image.open(p), int) for p in sorted(reused.glob("*.png"))]
+    b = [np.asarray(Image.open(p), int) for p in sorted(every.glob("*.png"))]
+    assert len(a) == len(b) == 6
+    assert np.array_equal(a[3], a[2]) and np.array_equal(a[4], a[2]) and np.array_equal(a[5], a[1])
+    # Drawn again, a repeated frame differs at most by the kept hair's level or two (see the test above).
+    assert max(np.abs(x - y).max() for x, y in zip(a, b)) <= 3

@@ -157,6 +157,8 @@ class RegisterEngine:
     """
 
     name = "registers"
+    #: Each frame depends on its activations alone (a video may reuse a frame's picture).
+    stateless = True
 
     def __init__(self, head, data, character, base_positions):
         self.head = head

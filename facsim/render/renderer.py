@@ -815,11 +815,12 @@ class Renderer:
         ctx = self._ctx
         if self._downsample is not None:
             box = self._content_box if self.aa_method == "fxaa" else None
+            self._out_fbo.use()
             if box is not None:
                 # FXAA leaves a pixel as it is where its neighbours match it: everywhere
-                # further than a pixel from what was drawn. Copy the frame, filter only the box.
-                ctx.copy_framebuffer(self._out_fbo, self._scene_fbo)
-            self._out_fbo.use()
+                # further than a pixel from what was drawn, which is the background there.
+                # Clear to it (cheaper than copying the frame on llvmpipe), filter only the box.
+                self._clear(self._out_fbo)
             ctx.disable(ctx.DEPTH_TEST)
             self._out_fbo.scissor = box
             self._scene_tex.use(0)
