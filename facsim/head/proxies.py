@@ -384,11 +384,14 @@ class BoundProxy:
 
     @cached_property
     def depth(self) -> np.ndarray:
-        """(V,) per-vertex shading coordinate for the renderer. Hair and lashes: 0 at the
-        skin … 1 at the outermost strands / lash tips (self-shadowing, tapering). Brows:
+        """(V,) per-vertex shading coordinate for the renderer. Hair: 0 under the other
+        layers … 1 in the open (:func:`hair_exposure`, self-shadowing). Lashes: 0 at the
+        lid … 1 at the tips (tapering). Brows:
         0 at each brow's head … 1 at its tail (:func:`along_brow`), where the hairs thin."""
         if self.proxy.kind == "eyebrows" and self.neutral is not None:
             return along_brow(self.neutral)
+        if self.proxy.kind == "hair" and self.neutral is not None:
+            return hair_exposure(self.neutral, self.proxy.corner_vertex[self.proxy.triangles])
         reach = np.linalg.norm(self.binding.offsets, axis=1)
         depth = reach / (np.percentile(reach, 95) + 1e-6)
         if self.proxy.kind == "eyelashes" and self.neutral is not None:
@@ -424,6 +427,44 @@ def bind_character_proxies(character, head, base_positions, neutral_geometry, *,
             out.append(BoundProxy(proxy, binding, COLOR_KEY[kind], density[kind],
                                   binding.positions(neutral_geometry)))
     return out
+
+
+def hair_exposure(points: np.ndarray, triangles: np.ndarray, *, reach: float = 0.3,
+                  steps: int = 8, radius: float = 0.035) -> np.ndarray:
+    """(V,) how open each hair vertex lies: 1 on the outermost layer … 0 under other cards.
+
+    Hair cards are layered: a card near the scalp lies under the outer ones and gets little
+    light, whatever its distance from the skin (the crown's outer cards lie close to the
+    scalp, the long hair's under-layers far from it). For each vertex this marches outward
+    from the hairstyle's centre (``steps`` points up to ``reach`` dm) and counts the points
+    that pass within ``radius`` of a card (cards sampled densely over their triangles).
+
+    Parameters
+    ----------
+    points : (V, 3) float
+        Hair vertices on the neutral face (dm).
+    triangles : (T, 3) int
+        Triangles over those vertices.
+    """
+    from scipy.spatial import cKDTree
+
+    points = np.asarray(points, np.float64)
+    tri = points[np.asarray(triangles)]
+    k = 5  # barycentric grid per triangle: cards are a few cm, the radius a few mm
+    a, b = np.meshgrid(np.arange(k + 1), np.arange(k + 1), indexing="ij")
+    keep = a + b <= k
+    bary = np.stack([a[keep], b[keep], k - a[keep] - b[keep]], axis=1) / k
+    samples = np.einsum("sk,tkd->tsd", bary, tri).reshape(-1, 3)
+    tree = cKDTree(samples)
+    top = points[points[:, 1] >= np.percentile(points[:, 1], 50)]
+    centre = top.mean(axis=0) - np.array([0.0, 0.25 * np.ptp(top[:, 1]), 0.0])
+    out = points - centre
+    out /= np.linalg.norm(out, axis=1, keepdims=True) + 1e-12
+    blocked = np.zeros(len(points))
+    for d in np.linspace(2.0 * radius, reach, steps):
+        near = tree.query(points + d * out, k=1)[0]
+        blocked += np.clip((2.0 * radius - near) / radius, 0.0, 1.0)
+    return np.clip(1.0 - blocked / 2.5, 0.0, 1.0).astype(np.float32)
 
 
 def hair_shadow(skin_positions: np.ndarray, hair_positions: np.ndarray, *, strength: float = 0.6,

@@ -88,7 +88,7 @@ class ProxyDraw:
     density: float = 1.0
 
 
-def shade_texture(texture: np.ndarray, *, directions: bool = False) -> np.ndarray:
+def shade_texture(texture: np.ndarray, *, directions: bool = False, strands_only: bool = False) -> np.ndarray:
     """RGBA for upload: R = brightness relative to the mean strand (0.5 = mean), GB = the
     strands' direction in UV (:func:`strand_directions`, as 0.5 + 0.5 (u, v); with
     ``directions=False``, along v everywhere), A kept.
@@ -96,26 +96,65 @@ def shade_texture(texture: np.ndarray, *, directions: bool = False) -> np.ndarra
     MakeHuman's hair textures are near-black strands; the colour comes from the character,
     so only the relative brightness (strand-to-strand variation) is kept. Rows are flipped
     to GL order (row 0 = v = 0).
+
+    ``strands_only`` keeps only the strand- and clump-scale variation: the textures also
+    carry painted light (a highlight arc near the roots, tips darker than roots), which on
+    overlapping cards stacks into bands that change from card to card (the "helmet of
+    cards" look). Dividing by the alpha-weighted local mean removes it; the shader lights
+    the hair as one volume instead. For textures whose strands run along v the mean is taken
+    across the strands (wide in u, short in v), so clumps side by side survive.
     """
     rgb = texture[..., :3].astype(np.float32)
     alpha = texture[..., 3]
     lum = rgb @ np.array([0.2126, 0.7152, 0.0722], np.float32)
     solid = alpha > 128
-    mean = float(lum[solid].mean()) if solid.any() else float(lum.mean())
-    rel = np.clip(lum / max(mean, 1.0), 0.4, 1.6) * 0.5
+    half = None
+    if directions:  # the field is smooth: found at half resolution (4x cheaper), then repeated
+        half = strand_directions(lum[::-1][::2, ::2], sigma=3.0)
+    if strands_only:
+        lum = strand_detail(lum, alpha, along_v=half is None or _runs_along_v(half, solid[::-1][::2, ::2]))
+        mean = float(lum[solid].mean()) if solid.any() else float(lum.mean())
+        rel = np.clip(lum / max(mean, 1e-3), 0.3, 1.7) * 0.5
+    else:
+        mean = float(lum[solid].mean()) if solid.any() else float(lum.mean())
+        rel = np.clip(lum / max(mean, 1.0), 0.4, 1.6) * 0.5
     # Transparent texels' colour is arbitrary (often white): toward the edge of the strands,
     # fade to the mean, so filtering never draws light outlines around the cards.
     rel = 0.5 + (rel - 0.5) * (alpha.astype(np.float32) / 255.0)
     out = np.empty(texture.shape, np.uint8)
     out[..., 0] = np.clip(rel * 255 + 0.5, 0, 255).astype(np.uint8)
-    if directions:  # the field is smooth: found at half resolution (4x cheaper), then repeated
-        half = strand_directions(lum[::-1][::2, ::2], sigma=3.0)
+    if half is not None:
         direction = np.repeat(np.repeat(half, 2, axis=0), 2, axis=1)[: lum.shape[0], : lum.shape[1]][::-1]
     else:
         direction = np.broadcast_to(np.array([0.0, 1.0], np.float32), (*lum.shape, 2))
     out[..., 1:3] = np.clip((0.5 + 0.5 * direction) * 255 + 0.5, 0, 255).astype(np.uint8)
     out[..., 3] = alpha
     return np.ascontiguousarray(out[::-1])
+
+
+def _runs_along_v(direction: np.ndarray, solid: np.ndarray) -> bool:
+    """Whether most solid texels' strands run along v (|dv| > 0.9)."""
+    dv = np.abs(direction[..., 1][solid]) if solid.any() else np.ones(1)
+    return bool(np.median(dv) >= 0.9)
+
+
+def strand_detail(luminance: np.ndarray, alpha: np.ndarray, *, along_v: bool = True) -> np.ndarray:
+    """Luminance (H, W) divided by its alpha-weighted local mean: strand- and clump-scale
+    variation around 1 with the painted low-frequency light removed (see :func:`shade_texture`).
+
+    The local mean is wide across the strands and short along them when they run along v
+    (image rows are v), round otherwise (coily hair, a ponytail's radiating crown).
+    """
+    from scipy.ndimage import gaussian_filter
+
+    w = alpha.astype(np.float32) / 255.0
+    sigma = (3.0, 14.0) if along_v else (7.0, 7.0)  # (rows = v, columns = u), texels
+    num = gaussian_filter(np.asarray(luminance, np.float32) * w, sigma, mode="nearest")
+    den = gaussian_filter(w, sigma, mode="nearest")
+    local = num / np.maximum(den, 1e-3)
+    # Near-black texels (the darkest strands of a black texture) keep a floor, so dividing
+    # does not blow noise up into speckle.
+    return np.asarray(luminance, np.float32) / np.maximum(local, 0.02 * float(luminance.max()) + 1.0)
 
 
 def strand_directions(luminance: np.ndarray, *, sigma: float = 6.0) -> np.ndarray:
@@ -153,13 +192,30 @@ def triangle_strand_directions(mesh: "ProxyMesh", shaded: np.ndarray) -> np.ndar
     return d / (np.linalg.norm(d, axis=1, keepdims=True) + 1e-12)
 
 
+#: Radius (dm) of the rounded top of the hair volume (about a head's half width).
+VOLUME_RADIUS = 0.9
+
+
 def volume_normals(points: np.ndarray, card_normals: np.ndarray, *, card_weight: float = 0.3) -> np.ndarray:
     """Hair normals from the volume, not the cards: mostly the direction out from the
-    head's centre, a little of each card's own (turned outward), so a hairstyle is shaded
-    as one smooth mass instead of a patchwork of flat cards."""
-    top = points[points[:, 1] >= np.percentile(points[:, 1], 50)]
-    centre = top.mean(axis=0) - np.array([0.0, 0.25 * np.ptp(top[:, 1]), 0.0], np.float32)
-    out = points - centre
+    hair's volume, a little of each card's own (turned outward), so a hairstyle is shaded as
+    one smooth mass instead of a patchwork of flat cards.
+
+    The volume is a capsule: a dome of :data:`VOLUME_RADIUS` under the crown and a vertical
+    axis below it, so hair hanging past the jaw faces sideways and back like a sheet, not
+    down like the bottom of a ball. The axis comes from the crown (the highest tenth of the
+    points) alone: cards bound to moving skin (sideburns over a smiling cheek) never move it,
+    so still cards keep their shading exactly (the renderer keeps still hair as pixels
+    between the frames of a video).
+    """
+    y = points[:, 1]
+    crown = points[y >= np.percentile(y, 90)]
+    axis = crown.mean(axis=0)
+    axis_y = float(y.max()) - VOLUME_RADIUS
+    q = np.empty_like(points)
+    q[:, 0], q[:, 2] = axis[0], axis[2]
+    q[:, 1] = np.minimum(y, axis_y)
+    out = points - q
     out /= np.linalg.norm(out, axis=1, keepdims=True) + 1e-12
     card = np.where((np.einsum("ij,ij->i", card_normals, out) < 0)[:, None], -card_normals, card_normals)
     n = (1.0 - card_weight) * out + card_weight * card
@@ -199,6 +255,30 @@ def strand_tangents(positions: np.ndarray, mesh: ProxyMesh, operator=None, direc
     return out.astype(np.float32)
 
 
+def card_outline(triangles: np.ndarray) -> np.ndarray:
+    """(V,) float32: 1 at vertices on the outline of a card (an edge with one triangle), else 0.
+
+    ``triangles`` (T, 3) index proxy vertices (not render corners), so UV seams inside a
+    card do not count as outline.
+    """
+    t = np.asarray(triangles, np.int64)
+    n = int(t.max()) + 1 if len(t) else 0
+    edges = np.sort(np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]]), axis=1)
+    unique, count = np.unique(edges, axis=0, return_counts=True)
+    out = np.zeros(n, np.float32)
+    out[unique[count == 1].ravel()] = 1.0
+    # Cards of one or two quads (afro01's tufts) are all outline: fraying them would erase
+    # them, and their texture already draws loose strands. Only cards with an inside fray.
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    _, card = connected_components(coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(n, n)),
+                                   directed=False)
+    inside = np.bincount(card, weights=1.0 - out, minlength=card.max() + 1) > 0
+    out[~inside[card]] = 0.0
+    return out
+
+
 def _weld_operator(corner_vertex: np.ndarray):
     """Sparse (V, R) matrix summing corners onto their proxy vertex; None if no vertex is split."""
     from scipy.sparse import csr_matrix
@@ -225,14 +305,18 @@ class ProxyLayer:
         self._weld = _weld_operator(mesh.corner_vertex)
         depth = np.ones(mesh.vertex_count, np.float32) if mesh.depth is None else np.asarray(mesh.depth, np.float32)
         self._depth = depth[mesh.corner_vertex]
-        self._buffer = np.zeros((self._n_corners, 10), np.float32)  # pos, normal, tangent, depth
+        self._buffer = np.zeros((self._n_corners, 11), np.float32)  # pos, normal, tangent, depth, edge
+        # Hair: 1 on a card's outline, 0 inside (the shader frays the cards' edges into strands).
+        self._buffer[:, 10] = (card_outline(np.asarray(mesh.corner_vertex)[self._triangles])[mesh.corner_vertex]
+                               if mesh.kind == "hair" else 0.0)
         self._vbo = track(ctx.buffer(reserve=self._buffer.nbytes, dynamic=True))
         self._uv = track(ctx.buffer(np.ascontiguousarray(mesh.uv, np.float32).tobytes()))
         # Two orders of the same triangles: front to back for the alpha-tested pass (hidden
         # layers then fail the depth test before they are shaded), back to front for blending.
         self._ibo = {"OPAQUE": track(ctx.buffer(self._triangles.tobytes(), dynamic=True)),
                      "BLEND": track(ctx.buffer(self._triangles.tobytes(), dynamic=True))}
-        tex = shade_texture(np.asarray(mesh.texture), directions=mesh.kind == "hair")
+        tex = shade_texture(np.asarray(mesh.texture), directions=mesh.kind == "hair",
+                            strands_only=mesh.kind == "hair")
         # Strand direction in UV: most styles' textures run along v throughout (their
         # root bands' cross-wise features would only mislead the texture's own direction
         # field); where they do not (a ponytail's radiating crown), the field steers the
@@ -248,6 +332,10 @@ class ProxyLayer:
         self.texture = track(ctx.texture((tex.shape[1], tex.shape[0]), 4, tex.tobytes()))
         self.texture.build_mipmaps()  # an input texture, never rendered into
         self.texture.filter = (ctx.LINEAR_MIPMAP_LINEAR, ctx.LINEAR)
+        if mesh.kind == "hair":
+            # Cards seen at a slant (the crown from the front) squeeze the strands across the
+            # screen: anisotropic filtering keeps them instead of blurring them into blotches.
+            self.texture.anisotropy = 8.0
         self.programs, self.vaos = {}, {}
         self._last = None  # (camera position, vertex positions) of the last upload
         self.look: tuple = ()  # (linear colour, sheen, density) of this frame
@@ -264,11 +352,11 @@ class ProxyLayer:
             _set_uniform(prog, "u_along_v", self._along_v)
             self.programs[stage] = prog
             self.vaos[stage] = track(ctx.vertex_array(
-                prog, [(self._vbo, "3f 3f 3f 1f", "in_pos", "in_normal", "in_tangent", "in_depth"),
+                prog, [(self._vbo, "3f 3f 3f 1f 1f", "in_pos", "in_normal", "in_tangent", "in_depth", "in_edge"),
                        (self._uv, "2f", "in_uv")],
                 index_buffer=self._ibo[stage], index_element_size=4, skip_errors=True))
         self.vaos["SUBSET"] = track(ctx.vertex_array(
-            self.programs["OPAQUE"], [(self._vbo, "3f 3f 3f 1f", "in_pos", "in_normal", "in_tangent", "in_depth"),
+            self.programs["OPAQUE"], [(self._vbo, "3f 3f 3f 1f 1f", "in_pos", "in_normal", "in_tangent", "in_depth", "in_edge"),
                                       (self._uv, "2f", "in_uv")],
             index_buffer=self._ibo["SUBSET"], index_element_size=4, skip_errors=True))
 

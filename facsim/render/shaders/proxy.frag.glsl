@@ -8,6 +8,7 @@ in vec3 v_pos;
 in vec3 v_normal;
 in vec3 v_tangent;
 in float v_depth;
+in float v_edge;
 in vec2 v_uv;
 
 uniform sampler2D u_texture;  // R: strand brightness (0.5 = mean), GB: strand direction in UV, A: coverage
@@ -47,6 +48,30 @@ void main() {
 #endif
     if (alpha < 0.01) discard;
 #else
+#ifdef KIND_HAIR
+    // Strand coordinates: across the strands (u) many, along them (v) few. Each noise fades
+    // to its mean where it would be finer than a pixel, so small images do not shimmer.
+    // Most of MakeHuman's hair textures run along v; where a texture's own strands turn away
+    // (tex.gb from its structure tensor, e.g. a ponytail's crown) the breakup fades out
+    // rather than cross the strands (u_along_v = 1 for textures running along v throughout).
+    float along_v = max(u_along_v, smoothstep(0.75, 0.92, abs(tex.b * 2.0 - 1.0)));
+    vec2 mp = v_uv * vec2(150.0, 2.5) + 3.0;
+    float mid = mix(0.5, value_noise(mp, 0), along_v * clamp(2.0 - 1.4 * fwidth(mp.x), 0.0, 1.0));
+    vec2 cp = v_uv * vec2(45.0, 1.2) + 7.0;
+    float clump = mix(0.5, value_noise(cp, 0), along_v * clamp(2.0 - 1.5 * fwidth(cp.x), 0.0, 1.0));
+    vec3 n = normalize(v_normal);
+    vec3 v = normalize(u_cam_pos - v_pos);
+    // The hair's outline: where the volume turns away from the eye, its outer strands stand
+    // apart, so the outline breaks into strands and clumps with the background between them
+    // instead of ending in the cards' cut edge. Inside the mass the cards' own alpha rules.
+    float outline = 1.0 - smoothstep(0.02, 0.28, dot(n, v));
+    float strand_mask = smoothstep(0.3, 0.7, 0.6 * mid + 0.4 * clump);
+    alpha *= 1.0 - outline * (1.0 - strand_mask) * 0.9;
+    // A card's own outline frays the same way: strands end at different lengths across the
+    // last triangle before the cut edge, so layers overlap as strand tips, not as steps.
+    float rag = 0.55 * mid + 0.45 * clump;
+    alpha *= 1.0 - smoothstep(0.45, 0.75, v_edge + 0.7 * (0.5 - rag));
+#endif
 #ifdef PASS_OPAQUE
     if (alpha < ALPHA_CUTOFF) discard;
     alpha = 1.0;
@@ -55,70 +80,62 @@ void main() {
     alpha = alpha / ALPHA_CUTOFF;  // the fringe fades out fully at its edge
 #endif
 #endif
+#ifndef KIND_HAIR
     vec3 n = normalize(v_normal);
     vec3 v = normalize(u_cam_pos - v_pos);
-#ifndef KIND_HAIR
     if (dot(n, v) < 0.0) n = -n;   // hair normals come from the volume and face outward already
 #endif
     vec3 albedo = u_color * (0.6 + 0.8 * tex.r);
 
 #ifdef KIND_HAIR
     vec3 t = normalize(v_tangent);
-    // Strand breakup: fine strands and coarser clumps along the texture's v, each faded to
-    // its mean where it would be finer than a pixel, so small images do not shimmer. Most of
-    // MakeHuman's hair textures run along v; where a texture's own strands turn away from v
-    // (tex.gb, from its structure tensor; e.g. a ponytail's crown), the breakup fades out
-    // rather than cross the strands (proxies.py sets u_along_v = 1 for textures running
-    // along v throughout).
 #ifdef PASS_OPAQUE
-    float along_v = max(u_along_v, smoothstep(0.75, 0.92, abs(tex.b * 2.0 - 1.0)));
     vec2 sp = v_uv * vec2(420.0, 5.0);
     float fine = mix(0.5, value_noise(sp, 0), along_v * clamp(1.8 - 1.6 * fwidth(sp.x), 0.0, 1.0));
-    vec2 cp = v_uv * vec2(60.0, 1.2) + 7.0;
-    float clump = mix(0.5, value_noise(cp, 0), along_v * clamp(2.0 - 1.5 * fwidth(cp.x), 0.0, 1.0));
 #else
-    float fine = 0.5, clump = 0.5;   // the thin fringe: too sparse for the breakup to show
+    float fine = 0.5;   // the thin fringe: too sparse for the finest breakup to show
 #endif
-    // The texture's strand brightness with more contrast than the 512² source gives alone.
-    albedo = u_color * (0.45 + 1.1 * tex.r) * (0.72 + 0.56 * fine) * (0.8 + 0.4 * clump);
-    // Self-shadowing: layers near the scalp lie under the outer ones, the gaps between clumps
-    // are darker, and thin strands at a card's edge let the darker layers beneath show.
-    float self_shadow = mix(0.5, 1.0, smoothstep(0.0, 0.9, v_depth)) * mix(0.68, 1.0, clump)
-                      * mix(0.8, 1.0, smoothstep(ALPHA_CUTOFF, 1.0, tex.a));
-    float jitter = 0.25 * (tex.r - 0.5) + 0.12 * (fine - 0.5) + 0.1 * (clump - 0.5);  // breaks up the highlight
+    // Strand-scale brightness: the texture's own strands (tex.r: its painted light removed,
+    // see shade_texture) and three scales of procedural strands, so neighbouring strands and
+    // clumps differ the way real hair does, the same on every card.
+    float strand = (0.45 + 1.1 * tex.r) * (0.7 + 0.6 * fine) * (0.78 + 0.44 * mid) * (0.86 + 0.28 * clump);
+    albedo = u_color * strand;
+    // Depth in the volume: layers near the scalp lie under the outer ones and get little
+    // light (roots and the under-layers darker), the gaps between clumps are darker still.
+    float layer = smoothstep(0.0, 0.95, v_depth);
+    float self_shadow = mix(0.32, 1.0, layer * layer * (1.5 - 0.5 * layer)) * mix(0.8, 1.0, clump)
+                      * mix(0.8, 1.0, mid);
+    float jitter = 0.22 * (tex.r - 0.5) + 0.12 * (fine - 0.5) + 0.18 * (mid - 0.5) + 0.1 * (clump - 0.5);
     // Key light: strand diffuse blended with a squared half-Lambert, which keeps the volume
     // readable without the flat look of a plain wrap.
     float kl = clamp(dot(n, u_key_dir) * 0.5 + 0.5, 0.0, 1.0);
     float dk = mix(strand_diffuse(t, u_key_dir), 1.0, 0.3) * kl * kl * 1.25;
     float df = clamp(dot(n, u_fill_dir) * 0.5 + 0.5, 0.0, 1.0);
     float dr = clamp(dot(n, u_rim_dir) * 0.5 + 0.5, 0.0, 1.0);
-    vec3 lit = dk * u_key_col + df * u_fill_col + dr * dr * u_rim_col * 0.8 + hemisphere(n) * 0.85;
+    vec3 lit = dk * u_key_col + df * u_fill_col + dr * dr * u_rim_col * 0.8 + hemisphere(n) * 0.8;
 #ifdef PASS_OPAQUE
-    // Two Kajiya-Kay lobes of the key light, shifted along the normal: a white primary
-    // and a hair-coloured, sparkly secondary (Marschner's R and TRT, as Scheuermann
-    // approximates them). The blended fringe (thin wisps) skips them: they barely show there
-    // and cost time.
+    // Two Kajiya-Kay lobes of the key light, shifted along the normal (Marschner's R and TRT
+    // as Scheuermann approximates them): a primary tinted a little toward the hair colour and
+    // a hair-coloured, sparkly secondary. Each strand shifts them by its own jitter, so the
+    // highlight band breaks into strands instead of drawing one smooth arc across the cards.
+    // The blended fringe (thin wisps) skips them: they barely show there and cost time.
     vec3 h = normalize(u_key_dir + v);
-    // Roots at the parting lie in the outer strands' shadow: little highlight there, so the
-    // two sides' different strand directions do not draw a line along it.
+    // Roots and under-layers lie in the outer strands' shadow: little highlight there, so the
+    // two sides' different strand directions do not draw a line along a parting.
     // Where a card's corner tangents disagree (opposite signs), the interpolated tangent
     // shrinks and its direction means nothing: no highlight there (else a bright outline).
-    float gate = smoothstep(0.3, 0.6, kl) * mix(0.35, 1.0, smoothstep(0.0, 0.5, v_depth))
+    float gate = smoothstep(0.3, 0.6, kl) * mix(0.2, 1.0, smoothstep(0.2, 0.8, v_depth))
                * smoothstep(0.6, 0.9, length(v_tangent));
-    float th1 = dot(normalize(t + (0.08 + jitter) * n), h);
-    float th2 = dot(normalize(t + (-0.12 + jitter) * n), h);
+    float th1 = dot(normalize(t + (0.06 + jitter) * n), h);
+    float th2 = dot(normalize(t + (-0.1 + jitter) * n), h);
     float s1 = max(1.0 - th1 * th1, 1e-6);   // sin^2
     float s2 = max(1.0 - th2 * th2, 1e-6);
-    float sparkle = smoothstep(0.45, 0.75, fine);
-    // The primary lobe follows the line where strands turn across the half vector; a narrow
-    // white lobe there draws one thin grey-white arc over the cards (it reads as a light
-    // outline, not a sheen). Broader, fainter, tinted toward the hair colour and carried by
-    // the strands (bright strands take it, gaps between strands and clumps do not), it
-    // reads as hair's highlight band.
-    float strands = smoothstep(0.3, 0.7, fine) * smoothstep(0.3, 0.65, tex.r) * mix(0.5, 1.0, clump);
-    vec3 tint = mix(vec3(1.0), u_color / max(max(u_color.r, u_color.g), max(u_color.b, 1e-4)), 0.6);
-    vec3 spec = u_key_col * gate * (0.06 * strands * tint * exp2(20.0 * log2(s1))
-                                    + 0.5 * sparkle * u_color * exp2(12.0 * log2(s2)));
+    float strands = smoothstep(0.25, 0.7, fine) * smoothstep(0.3, 0.65, tex.r) * smoothstep(0.2, 0.7, mid)
+                  * mix(0.5, 1.0, clump);
+    float sparkle = smoothstep(0.45, 0.75, fine) * smoothstep(0.4, 0.7, mid);
+    vec3 tint = mix(vec3(1.0), u_color / max(max(u_color.r, u_color.g), max(u_color.b, 1e-4)), 0.5);
+    vec3 spec = u_key_col * gate * (0.16 * strands * tint * exp2(40.0 * log2(s1))
+                                    + 0.55 * sparkle * u_color * exp2(10.0 * log2(s2)));
 #else
     vec3 spec = vec3(0.0);
 #endif

@@ -2,7 +2,8 @@
 in vec3 in_pos;
 in vec3 in_normal;
 in vec3 in_tangent;   // strand direction (dP/dv)
-in float in_depth;    // 0 at the scalp .. 1 at the outer strands
+in float in_depth;    // hair: 0 under other layers .. 1 in the open
+in float in_edge;     // hair: 1 on a card's outline, 0 inside
 in vec2 in_uv;
 
 uniform mat4 u_view_proj;
@@ -11,6 +12,7 @@ out vec3 v_pos;
 out vec3 v_normal;
 out vec3 v_tangent;
 out float v_depth;
+out float v_edge;
 out vec2 v_uv;
 
 void main() {
@@ -18,6 +20,7 @@ void main() {
     v_normal = in_normal;
     v_tangent = in_tangent;
     v_depth = in_depth;
+    v_edge = in_edge;
     v_uv = in_uv;
     gl_Position = u_view_proj * vec4(in_pos, 1.0);
 }
