@@ -113,7 +113,7 @@ class Face:
         from facsim.render.proxies import ProxyDraw
 
         return [ProxyDraw(mesh, bound.binding.positions(positions), tuple(self.colors[bound.color_key]), bound.sheen,
-                          bound.density)
+                          bound.density, bound.coil)
                 for bound, mesh in zip(self.proxies, self.proxy_meshes)]
 
     @cached_property
@@ -171,7 +171,8 @@ class Face:
             if bound.proxy.kind == "hair":
                 skin = self.head.skin
                 hair = bound.binding.positions(self.neutral)
-                occlusion[skin] *= hair_shadow(self.neutral[skin], hair)
+                occlusion[skin] *= hair_shadow(self.neutral[skin], hair,
+                                               triangles=bound.proxy.corner_vertex[bound.proxy.triangles])
         return occlusion
 
     @cached_property

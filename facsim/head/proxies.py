@@ -406,6 +406,11 @@ class BoundProxy:
         """Strength of the strand highlights (``sheen:`` in ``facsim/data/hair.yaml``, default 1)."""
         return float(hair_table().get("sheen", {}).get(self.proxy.name, 1.0))
 
+    @property
+    def coil(self) -> float:
+        """How coily the hair is, 0 straight … 1 coily (``coil:`` in ``facsim/data/hair.yaml``, default 0)."""
+        return float(hair_table().get("coil", {}).get(self.proxy.name, 0.0))
+
 
 COLOR_KEY = {"hair": "hair", "eyebrows": "brows", "eyelashes": "lashes"}
 
@@ -429,6 +434,17 @@ def bind_character_proxies(character, head, base_positions, neutral_geometry, *,
     return out
 
 
+def card_samples(points: np.ndarray, triangles: np.ndarray, *, k: int = 4) -> np.ndarray:
+    """Points spread over the cards (a barycentric grid of ``k`` steps per triangle), so
+    distances to the hair are distances to its cards, not to its sparse vertices (cards
+    are a few centimetres across)."""
+    tri = np.asarray(points, np.float64)[np.asarray(triangles)]
+    a, b = np.meshgrid(np.arange(k + 1), np.arange(k + 1), indexing="ij")
+    keep = a + b <= k
+    bary = np.stack([a[keep], b[keep], k - a[keep] - b[keep]], axis=1) / k
+    return np.einsum("sk,tkd->tsd", bary, tri).reshape(-1, 3)
+
+
 def hair_exposure(points: np.ndarray, triangles: np.ndarray, *, reach: float = 0.3,
                   steps: int = 8, radius: float = 0.035) -> np.ndarray:
     """(V,) how open each hair vertex lies: 1 on the outermost layer … 0 under other cards.
@@ -449,26 +465,20 @@ def hair_exposure(points: np.ndarray, triangles: np.ndarray, *, reach: float = 0
     from scipy.spatial import cKDTree
 
     points = np.asarray(points, np.float64)
-    tri = points[np.asarray(triangles)]
-    k = 5  # barycentric grid per triangle: cards are a few cm, the radius a few mm
-    a, b = np.meshgrid(np.arange(k + 1), np.arange(k + 1), indexing="ij")
-    keep = a + b <= k
-    bary = np.stack([a[keep], b[keep], k - a[keep] - b[keep]], axis=1) / k
-    samples = np.einsum("sk,tkd->tsd", bary, tri).reshape(-1, 3)
-    tree = cKDTree(samples)
+    tree = cKDTree(card_samples(points, triangles))
     top = points[points[:, 1] >= np.percentile(points[:, 1], 50)]
     centre = top.mean(axis=0) - np.array([0.0, 0.25 * np.ptp(top[:, 1]), 0.0])
     out = points - centre
     out /= np.linalg.norm(out, axis=1, keepdims=True) + 1e-12
     blocked = np.zeros(len(points))
     for d in np.linspace(2.0 * radius, reach, steps):
-        near = tree.query(points + d * out, k=1)[0]
+        near = tree.query(points + d * out, k=1, distance_upper_bound=2.0 * radius)[0]
         blocked += np.clip((2.0 * radius - near) / radius, 0.0, 1.0)
     return np.clip(1.0 - blocked / 2.5, 0.0, 1.0).astype(np.float32)
 
 
 def hair_shadow(skin_positions: np.ndarray, hair_positions: np.ndarray, *, strength: float = 0.6,
-                cast: float = 0.45) -> np.ndarray:
+                cast: float = 0.55, triangles: np.ndarray | None = None) -> np.ndarray:
     """Ambient visibility factor (1 open … 1 - strength) per skin vertex under the hair.
 
     Skin within a few millimetres of hair cards is shadowed by them: the scalp shows
@@ -481,8 +491,10 @@ def hair_shadow(skin_positions: np.ndarray, hair_positions: np.ndarray, *, stren
 
     from facsim.head.surface import smoothstep
 
-    tree = cKDTree(hair_positions)
-    distance = tree.query(skin_positions, k=4)[0].mean(axis=1)
+    distance = cKDTree(hair_positions).query(skin_positions, k=4)[0].mean(axis=1)
+    # The cast shadow needs the cards' surfaces (``triangles`` over ``hair_positions``), not
+    # just their vertices, or it falls through the gaps between vertices in blotches.
+    tree = cKDTree(hair_positions if triangles is None else card_samples(hair_positions, triangles))
     t = np.clip((distance - 0.04) / (0.22 - 0.04), 0.0, 1.0)
     contact = 1.0 - strength * (1.0 - t * t * (3 - 2 * t))
     # March toward a light above and in front of the face (the studio key, averaged over
@@ -490,9 +502,12 @@ def hair_shadow(skin_positions: np.ndarray, hair_positions: np.ndarray, *, stren
     toward = np.array([0.0, 0.75, 0.66]) / np.hypot(0.75, 0.66)
     steps = np.linspace(0.06, 0.6, 10)
     blocked = np.zeros(len(skin_positions), np.float64)
+    # Only skin near enough to the hair for a step to pass it is marched (distances beyond
+    # the last step's reach are left out of the search: the inf they give counts as open).
+    marched = distance < steps[-1] + 0.2
     for step in steps if cast > 0 else ():
-        near, _ = tree.query(skin_positions + step * toward, k=1)
-        blocked += smoothstep(0.12, 0.05, near)
+        near, _ = tree.query(skin_positions[marched] + step * toward, k=1, distance_upper_bound=0.12)
+        blocked[marched] += smoothstep(0.12, 0.05, near)
     shadow = 1.0 - cast * np.clip(blocked / 3.0, 0.0, 1.0)
     return np.minimum(contact, shadow).astype(np.float32)
 

@@ -78,14 +78,16 @@ class ProxyMesh:
 @dataclass(frozen=True, eq=False)
 class ProxyDraw:
     """One proxy in one frame: its mesh, vertex positions (V, 3), sRGB colour, sheen
-    (strength of the strand highlights: 1 for straight hair, less for coily hair) and
-    density (brows and lashes: how much of the skin their hairs cover, 0 … 1)."""
+    (strength of the strand highlights: 1 for straight hair, less for coily hair),
+    density (brows and lashes: how much of the skin their hairs cover, 0 … 1) and coil
+    (hair: 0 straight … 1 coily, which shows fine even curls instead of strands and clumps)."""
 
     mesh: ProxyMesh
     positions: np.ndarray
     color: tuple[float, float, float]
     sheen: float = 1.0
     density: float = 1.0
+    coil: float = 0.0
 
 
 def shade_texture(texture: np.ndarray, *, directions: bool = False, strands_only: bool = False) -> np.ndarray:
@@ -332,13 +334,9 @@ class ProxyLayer:
         self.texture = track(ctx.texture((tex.shape[1], tex.shape[0]), 4, tex.tobytes()))
         self.texture.build_mipmaps()  # an input texture, never rendered into
         self.texture.filter = (ctx.LINEAR_MIPMAP_LINEAR, ctx.LINEAR)
-        if mesh.kind == "hair":
-            # Cards seen at a slant (the crown from the front) squeeze the strands across the
-            # screen: anisotropic filtering keeps them instead of blurring them into blotches.
-            self.texture.anisotropy = 8.0
         self.programs, self.vaos = {}, {}
         self._last = None  # (camera position, vertex positions) of the last upload
-        self.look: tuple = ()  # (linear colour, sheen, density) of this frame
+        self.look: tuple = ()  # (linear colour, sheen, density, coil) of this frame
         self._camera_uniforms: tuple = ()  # (view-projection, lights) the programs hold
         self._vertex_triangles = np.asarray(mesh.corner_vertex)[self._triangles]  # ... over vertices
         self._order = np.arange(len(self._triangles))  # back to front, as last sorted
@@ -368,12 +366,14 @@ class ProxyLayer:
                              f"got {positions.shape}")
         camera_position = np.asarray(camera_position, np.float32)
         color = tuple(float(x) for x in srgb_to_linear(draw.color))
-        if self.look != (color, float(draw.sheen), float(draw.density)):
-            self.look = (color, float(draw.sheen), float(draw.density))
+        look = (color, float(draw.sheen), float(draw.density), float(draw.coil))
+        if self.look != look:
+            self.look = look
             for prog in self.programs.values():
                 _set_uniform(prog, "u_color", color)
-                _set_uniform(prog, "u_sheen", float(draw.sheen))
-                _set_uniform(prog, "u_density", float(draw.density))
+                _set_uniform(prog, "u_sheen", look[1])
+                _set_uniform(prog, "u_density", look[2])
+                _set_uniform(prog, "u_coil", look[3])
         # Hair mostly sits still (only 51-58 and the brow skin move it): skip the upload and
         # the sort when nothing moved since the last frame.
         if (self._last is not None and np.array_equal(self._last[0], camera_position)

@@ -16,6 +16,7 @@ uniform vec3 u_color;         // linear RGB
 uniform float u_along_v;      // 1: the texture's strands run along v everywhere (else: tex.gb says where)
 uniform float u_sheen;        // strand highlight strength (1 straight hair, less for coily)
 uniform float u_density;      // brows and lashes: how much of the skin their hairs cover
+uniform float u_coil;         // hair: 0 straight ... 1 coily
 
 out vec4 f_color;
 
@@ -99,12 +100,24 @@ void main() {
     // see shade_texture) and three scales of procedural strands, so neighbouring strands and
     // clumps differ the way real hair does, the same on every card.
     float strand = (0.45 + 1.1 * tex.r) * (0.7 + 0.6 * fine) * (0.78 + 0.44 * mid) * (0.86 + 0.28 * clump);
+#ifdef PASS_OPAQUE
+    if (u_coil > 0.0) {
+        // Coily hair: at any distance its curls blend into a fine, even, matte texture; the
+        // texture's tufts keep a little of their contrast, fine isotropic curls add the rest.
+        vec2 kp = v_uv * 300.0;
+        float kink = mix(0.5, value_noise(kp, 0), clamp(1.8 - 1.4 * fwidth(kp.x), 0.0, 1.0));
+        strand = mix(strand, (0.75 + 0.5 * tex.r) * (0.75 + 0.5 * kink), u_coil);
+    }
+#endif
     albedo = u_color * strand;
     // Depth in the volume: layers near the scalp lie under the outer ones and get little
     // light (roots and the under-layers darker), the gaps between clumps are darker still.
+    // Light hair (blond, grey) scatters light on through the strands, so its inner layers
+    // darken much less than dark hair's (the multiple scattering of Marschner's model).
+    float light_hair = sqrt(clamp(dot(u_color, vec3(0.2126, 0.7152, 0.0722)), 0.0, 1.0));
     float layer = smoothstep(0.0, 0.95, v_depth);
-    float self_shadow = mix(0.32, 1.0, layer * layer * (1.5 - 0.5 * layer)) * mix(0.8, 1.0, clump)
-                      * mix(0.8, 1.0, mid);
+    float self_shadow = mix(mix(0.3, 0.7, light_hair), 1.0, layer * layer * (1.5 - 0.5 * layer))
+                      * mix(mix(0.8, 0.92, light_hair), 1.0, clump) * mix(0.8, 1.0, mid);
     float jitter = 0.22 * (tex.r - 0.5) + 0.12 * (fine - 0.5) + 0.18 * (mid - 0.5) + 0.1 * (clump - 0.5);
     // Key light: strand diffuse blended with a squared half-Lambert, which keeps the volume
     // readable without the flat look of a plain wrap.
