@@ -478,7 +478,7 @@ def hair_exposure(points: np.ndarray, triangles: np.ndarray, *, reach: float = 0
 
 
 def hair_shadow(skin_positions: np.ndarray, hair_positions: np.ndarray, *, strength: float = 0.6,
-                cast: float = 0.55, triangles: np.ndarray | None = None) -> np.ndarray:
+                cast: float = 0.7, triangles: np.ndarray | None = None) -> np.ndarray:
     """Ambient visibility factor (1 open … 1 - strength) per skin vertex under the hair.
 
     Skin within a few millimetres of hair cards is shadowed by them: the scalp shows
@@ -508,7 +508,7 @@ def hair_shadow(skin_positions: np.ndarray, hair_positions: np.ndarray, *, stren
     for step in steps if cast > 0 else ():
         near, _ = tree.query(skin_positions[marched] + step * toward, k=1, distance_upper_bound=0.12)
         blocked[marched] += smoothstep(0.12, 0.05, near)
-    shadow = 1.0 - cast * np.clip(blocked / 3.0, 0.0, 1.0)
+    shadow = 1.0 - cast * np.clip(blocked / 2.5, 0.0, 1.0)
     return np.minimum(contact, shadow).astype(np.float32)
 
 

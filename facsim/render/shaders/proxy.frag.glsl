@@ -67,11 +67,14 @@ void main() {
     // instead of ending in the cards' cut edge. Inside the mass the cards' own alpha rules.
     float outline = 1.0 - smoothstep(0.02, 0.28, dot(n, v));
     float strand_mask = smoothstep(0.3, 0.7, 0.6 * mid + 0.4 * clump);
-    alpha *= 1.0 - outline * (1.0 - strand_mask) * 0.9;
     // A card's own outline frays the same way: strands end at different lengths across the
     // last triangle before the cut edge, so layers overlap as strand tips, not as steps.
+    // Coily hair's textures draw their own loose curls at every edge, and its cap is the
+    // dense base the tufts grow from: neither frays.
     float rag = 0.55 * mid + 0.45 * clump;
-    alpha *= 1.0 - smoothstep(0.45, 0.75, v_edge + 0.7 * (0.5 - rag));
+    float fray = outline * (1.0 - strand_mask) * 0.9;
+    fray = 1.0 - (1.0 - fray) * (1.0 - smoothstep(0.45, 0.75, v_edge + 0.7 * (0.5 - rag)));
+    alpha *= 1.0 - fray * (1.0 - u_coil);
 #endif
 #ifdef PASS_OPAQUE
     if (alpha < ALPHA_CUTOFF) discard;
@@ -106,7 +109,7 @@ void main() {
         // texture's tufts keep a little of their contrast, fine isotropic curls add the rest.
         vec2 kp = v_uv * 300.0;
         float kink = mix(0.5, value_noise(kp, 0), clamp(1.8 - 1.4 * fwidth(kp.x), 0.0, 1.0));
-        strand = mix(strand, (0.75 + 0.5 * tex.r) * (0.75 + 0.5 * kink), u_coil);
+        strand = mix(strand, (0.6 + 0.8 * tex.r) * (0.62 + 0.76 * kink), u_coil);
     }
 #endif
     albedo = u_color * strand;
@@ -114,7 +117,8 @@ void main() {
     // light (roots and the under-layers darker), the gaps between clumps are darker still.
     // Light hair (blond, grey) scatters light on through the strands, so its inner layers
     // darken much less than dark hair's (the multiple scattering of Marschner's model).
-    float light_hair = sqrt(clamp(dot(u_color, vec3(0.2126, 0.7152, 0.0722)), 0.0, 1.0));
+    // Coily hair is denser: its inner curls stay dark whatever the colour.
+    float light_hair = sqrt(clamp(dot(u_color, vec3(0.2126, 0.7152, 0.0722)), 0.0, 1.0)) * (1.0 - 0.6 * u_coil);
     float layer = smoothstep(0.0, 0.95, v_depth);
     float self_shadow = mix(mix(0.3, 0.7, light_hair), 1.0, layer * layer * (1.5 - 0.5 * layer))
                       * mix(mix(0.8, 0.92, light_hair), 1.0, clump) * mix(0.8, 1.0, mid);
