@@ -281,6 +281,26 @@ def card_outline(triangles: np.ndarray) -> np.ndarray:
     return out
 
 
+#: Radius (dm) over which hair strand directions are averaged across cards.
+STRAND_SMOOTHING = 0.15
+
+
+def neighbour_mean_operator(points: np.ndarray, radius: float):
+    """Sparse (P, P) matrix averaging each point's rows over the points within ``radius``
+    (Gaussian weights, sigma = radius / 2). Built once per hair layer: hair moves rigidly
+    with the head, so who neighbours whom does not change."""
+    from scipy.sparse import csr_matrix
+    from scipy.spatial import cKDTree
+
+    pairs = cKDTree(points).query_pairs(radius, output_type="ndarray")
+    i = np.concatenate([pairs[:, 0], pairs[:, 1], np.arange(len(points))])
+    j = np.concatenate([pairs[:, 1], pairs[:, 0], np.arange(len(points))])
+    d2 = np.sum((points[i] - points[j]) ** 2, axis=1)
+    w = np.exp(-d2 / (2.0 * (0.5 * radius) ** 2)).astype(np.float32)
+    m = csr_matrix((w, (i, j)), shape=(len(points), len(points)))
+    return csr_matrix(m.multiply(1.0 / np.asarray(m.sum(axis=1))))
+
+
 def _weld_operator(corner_vertex: np.ndarray):
     """Sparse (V, R) matrix summing corners onto their proxy vertex; None if no vertex is split."""
     from scipy.sparse import csr_matrix
@@ -336,6 +356,7 @@ class ProxyLayer:
         self.texture.filter = (ctx.LINEAR_MIPMAP_LINEAR, ctx.LINEAR)
         self.programs, self.vaos = {}, {}
         self._last = None  # (camera position, vertex positions) of the last upload
+        self._smooth = None  # hair: neighbour-averaging operator over corners (built on first upload)
         self.look: tuple = ()  # (linear colour, sheen, density, coil) of this frame
         self._camera_uniforms: tuple = ()  # (view-projection, lights) the programs hold
         self._vertex_triangles = np.asarray(mesh.corner_vertex)[self._triangles]  # ... over vertices
@@ -389,7 +410,16 @@ class ProxyLayer:
             normals = volume_normals(p, normals)
         buf[:, 3:6] = self._welded(normals)
         # Tangents stay per corner: strands really do flow apart on the two sides of a parting.
-        buf[:, 6:9] = strand_tangents(positions, self.mesh, self._normal_op, self._directions)
+        tangents = strand_tangents(positions, self.mesh, self._normal_op, self._directions)
+        if self.mesh.kind == "hair":
+            # Neighbouring cards' strands run the same way: averaged over the cards within a
+            # centimetre or two, the highlight runs on across the cards instead of lighting
+            # some and not their neighbours (a patchwork on the crown).
+            if self._smooth is None:
+                self._smooth = neighbour_mean_operator(p, STRAND_SMOOTHING)
+            tangents = np.asarray(self._smooth @ tangents, np.float32)
+            tangents /= np.linalg.norm(tangents, axis=1, keepdims=True) + 1e-12
+        buf[:, 6:9] = tangents
         buf[:, 9] = self._depth
         self._vbo.write(buf)
         centres = p[self._triangles].mean(axis=1) - np.asarray(camera_position, np.float32)

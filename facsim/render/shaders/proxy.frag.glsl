@@ -50,6 +50,16 @@ void main() {
     if (alpha < 0.01) discard;
 #else
 #ifdef KIND_HAIR
+    vec3 n = normalize(v_normal);
+    vec3 v = normalize(u_cam_pos - v_pos);
+    // Fraying below only ever lowers alpha: fragments the texture alone settles are dropped
+    // before the noise is computed (most of the blended pass's fragments are cards under the
+    // outer layer, seen through its frayed gaps, that belong to the alpha-tested pass).
+#ifdef PASS_OPAQUE
+    if (alpha < ALPHA_CUTOFF) discard;
+#else
+    if (alpha < 0.02 || (alpha >= ALPHA_CUTOFF && v_edge < 0.1 && dot(n, v) >= 0.28)) discard;
+#endif
     // Strand coordinates: across the strands (u) many, along them (v) few. Each noise fades
     // to its mean where it would be finer than a pixel, so small images do not shimmer.
     // Most of MakeHuman's hair textures run along v; where a texture's own strands turn away
@@ -60,8 +70,6 @@ void main() {
     float mid = mix(0.5, value_noise(mp, 0), along_v * clamp(2.0 - 1.4 * fwidth(mp.x), 0.0, 1.0));
     vec2 cp = v_uv * vec2(45.0, 1.2) + 7.0;
     float clump = mix(0.5, value_noise(cp, 0), along_v * clamp(2.0 - 1.5 * fwidth(cp.x), 0.0, 1.0));
-    vec3 n = normalize(v_normal);
-    vec3 v = normalize(u_cam_pos - v_pos);
     // The hair's outline: where the volume turns away from the eye, its outer strands stand
     // apart, so the outline breaks into strands and clumps with the background between them
     // instead of ending in the cards' cut edge. Inside the mass the cards' own alpha rules.
