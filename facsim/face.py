@@ -106,7 +106,8 @@ class Face:
         from facsim.render.proxies import ProxyMesh
 
         return [ProxyMesh(b.proxy.name, b.proxy.kind, b.proxy.triangles, b.proxy.corner_vertex, b.proxy.uv,
-                          b.proxy.texture, b.depth) for b in self.proxies]
+                          b.proxy.texture, b.depth, b.neutral if b.proxy.kind == "hair" else None)
+                for b in self.proxies]
 
     def proxy_draws(self, positions: np.ndarray) -> list:
         """This frame's :class:`facsim.render.proxies.ProxyDraw` s for geometry ``positions``."""

@@ -207,3 +207,10 @@ def test_hair_changes_the_render(face_of):
     top = slice(0, 25)
     # hair darkens the top of the head (liam's brown hair over light skin)
     assert b[top, :, :3].astype(float).mean() < a[top, :, :3].astype(float).mean() - 10
+
+
+def test_coily_hair_is_drawn_as_coily(face_of):
+    face = face_of("amara")  # afro01
+    draws = {m.kind: d for d, m in zip(face.proxy_draws(face.neutral), face.proxy_meshes)}
+    assert draws["hair"].coil == 1.0 and draws["hair"].sheen < 1.0
+    assert face_of("ava").proxy_draws(face_of("ava").neutral)[0].coil == 0.0

@@ -133,3 +133,47 @@ def test_lips_show_vertical_furrows_not_a_flat_paint(face_of, marks):
 
     # Crossing the lower lip's furrows varies the brightness far more than the chin's skin does.
     assert across("lower_lip") > 2.0 * across("chin")
+
+
+def test_hair_texture_keeps_its_strands_but_not_its_painted_light():
+    from facsim.render.proxies import shade_texture
+
+    rows, cols = np.mgrid[0:128, 0:128]
+    strands = 1.0 + 0.3 * np.sin(cols * 1.7)            # strands along v (image rows = v)
+    painted = np.where(rows < 64, 1.6, 0.6)              # a light band over the roots
+    tex = np.zeros((128, 128, 4), np.uint8)
+    tex[..., :3] = np.clip(80 * strands * painted, 0, 255)[..., None].astype(np.uint8)
+    tex[..., 3] = 255
+    kept = shade_texture(tex, strands_only=True)[..., 0].astype(float)
+    raw = shade_texture(tex)[..., 0].astype(float)
+    band = lambda img: abs(img[20:44, 20:108].mean() - img[84:108, 20:108].mean())  # noqa: E731
+    assert band(raw) > 40 and band(kept) < 5                 # the painted band is gone ...
+    assert kept[84:108, 20:108].std(axis=1).mean() > 15      # ... the strands across u stay
+
+
+def test_card_outline_frays_only_cards_with_an_inside():
+    from facsim.render.proxies import card_outline
+
+    # a 3x3-vertex card (one vertex inside) and a lone quad (all outline, e.g. an afro tuft)
+    grid = np.arange(9).reshape(3, 3)
+    card = [(grid[r, c], grid[r, c + 1], grid[r + 1, c + 1]) for r in range(2) for c in range(2)]
+    card += [(grid[r, c], grid[r + 1, c + 1], grid[r + 1, c]) for r in range(2) for c in range(2)]
+    tuft = [(9, 10, 11), (9, 11, 12)]
+    out = card_outline(np.array(card + tuft))
+    assert out[4] == 0 and np.all(out[[0, 1, 2, 3, 5, 6, 7, 8]] == 1)
+    assert np.all(out[9:] == 0)
+
+
+def test_outer_hair_layers_are_more_exposed_than_inner_ones():
+    from facsim.head.proxies import hair_exposure
+
+    # two concentric spherical shells of quads: the inner one lies under the outer one
+    u, v = np.meshgrid(np.linspace(0.2, 1.4, 12), np.linspace(-1.0, 1.0, 12), indexing="ij")
+    sphere = np.stack([np.sin(u) * np.cos(v), np.cos(u), np.sin(u) * np.sin(v)], axis=-1).reshape(-1, 3)
+    idx = np.arange(144).reshape(12, 12)
+    quads = [(idx[i, j], idx[i + 1, j], idx[i + 1, j + 1]) for i in range(11) for j in range(11)]
+    quads += [(idx[i, j], idx[i + 1, j + 1], idx[i, j + 1]) for i in range(11) for j in range(11)]
+    quads = np.array(quads)
+    points = np.concatenate([0.9 * sphere, 1.0 * sphere]) + [0.0, 8.0, 0.0]
+    exposure = hair_exposure(points, np.concatenate([quads, quads + 144]))
+    assert exposure[144:].mean() > 0.7 and exposure[:144].mean() < 0.3

@@ -50,7 +50,11 @@ class ProxyMesh:
         RGBA in image order (row 0 at the top). Only its brightness variation and alpha
         are used: the colour comes from :attr:`ProxyDraw.color`.
     depth : (V,) float, optional
-        0 at the scalp … 1 at the outermost strands, for self-shadowing (default 1).
+        Hair: 0 under the other layers … 1 in the open, for self-shadowing (default 1).
+    rest : (V, 3) float, optional
+        Hair: vertex positions at rest (the neutral face). Which cards neighbour which is
+        read from them once, so a frame's shading never depends on the frames before it.
+        Without them strand directions are not averaged across cards.
     """
 
     name: str
@@ -60,6 +64,7 @@ class ProxyMesh:
     uv: np.ndarray
     texture: np.ndarray
     depth: np.ndarray | None = None
+    rest: np.ndarray | None = None
 
     def __post_init__(self):
         if self.kind not in PROXY_KINDS:
@@ -356,7 +361,7 @@ class ProxyLayer:
         self.texture.filter = (ctx.LINEAR_MIPMAP_LINEAR, ctx.LINEAR)
         self.programs, self.vaos = {}, {}
         self._last = None  # (camera position, vertex positions) of the last upload
-        self._smooth = None  # hair: neighbour-averaging operator over corners (built on first upload)
+        self._smooth = None  # hair: neighbour-averaging operator over corners (from mesh.rest)
         self.look: tuple = ()  # (linear colour, sheen, density, coil) of this frame
         self._camera_uniforms: tuple = ()  # (view-projection, lights) the programs hold
         self._vertex_triangles = np.asarray(mesh.corner_vertex)[self._triangles]  # ... over vertices
@@ -411,12 +416,13 @@ class ProxyLayer:
         buf[:, 3:6] = self._welded(normals)
         # Tangents stay per corner: strands really do flow apart on the two sides of a parting.
         tangents = strand_tangents(positions, self.mesh, self._normal_op, self._directions)
-        if self.mesh.kind == "hair":
+        if self.mesh.kind == "hair" and self.mesh.rest is not None:
             # Neighbouring cards' strands run the same way: averaged over the cards within a
             # centimetre or two, the highlight runs on across the cards instead of lighting
             # some and not their neighbours (a patchwork on the crown).
             if self._smooth is None:
-                self._smooth = neighbour_mean_operator(p, STRAND_SMOOTHING)
+                rest = np.asarray(self.mesh.rest, np.float32)[self.mesh.corner_vertex]
+                self._smooth = neighbour_mean_operator(rest, STRAND_SMOOTHING)
             tangents = np.asarray(self._smooth @ tangents, np.float32)
             tangents /= np.linalg.norm(tangents, axis=1, keepdims=True) + 1e-12
         buf[:, 6:9] = tangents
