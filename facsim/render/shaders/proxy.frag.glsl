@@ -159,6 +159,9 @@ void main() {
                   * mix(0.5, 1.0, clump);
     float sparkle = smoothstep(0.45, 0.75, fine) * smoothstep(0.4, 0.7, mid);
     vec3 tint = mix(vec3(1.0), u_color / max(max(u_color.r, u_color.g), max(u_color.b, 1e-4)), 0.5);
+    // Light hair's own diffuse is bright already: a full-strength white lobe on it reads as
+    // white streaks, so it takes less.
+    gate *= mix(1.0, 0.55, light_hair);
     vec3 spec = u_key_col * gate * (0.16 * strands * tint * exp2(40.0 * log2(s1))
                                     + 0.55 * sparkle * u_color * exp2(10.0 * log2(s2)));
 #else
