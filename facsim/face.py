@@ -24,7 +24,7 @@ from facsim.render.options import RenderOptions
 #: shows the whole head with a little neck, the same in every frame.
 NECK_SHOWN = 0.45
 #: Bump when the occlusion bake changes, so cached bakes are redone.
-OCCLUSION_VERSION = 2
+OCCLUSION_VERSION = 3  # 3: the relaxed lids at rest (lids.yaml)
 
 
 @lru_cache(maxsize=1)
@@ -90,8 +90,9 @@ class Face:
 
     @cached_property
     def neutral(self) -> np.ndarray:
-        """Neutral geometry positions (N_geo, 3)."""
-        return self.head.positions(self.base_positions)
+        """Neutral geometry positions (N_geo, 3): the engine's rest (the sculpted face with relaxed
+        lids, facsim.engines.lids.RestLids), so every expression starts from it."""
+        return np.asarray(self.engine.neutral, np.float32)
 
     @cached_property
     def proxies(self) -> list:

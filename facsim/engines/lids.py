@@ -19,11 +19,21 @@ Examples
 --------
 >>> lids = EyeLids(rest, blink_offsets, centre, radius, margin)   # doctest: +SKIP
 >>> lids.close_on_lower(positions, blink_share)                   # doctest: +SKIP
+
+:class:`RestLids` is the relaxed aperture both engines start from (``lids.yaml``):
+MakeHuman's sculpted lids stare, so each eye's upper lid is lowered by the share of
+the closing target that brings its margin over the top of the iris, measured on
+the character (none where the lid already covers it, as on hooded older lids).
 """
 from __future__ import annotations
 
 import numpy as np
 
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import Callable
+
+from facsim._data import load_yaml
 from facsim.head.surface import smoothstep
 
 #: An upper-margin point whose elevation falls by more than this (degrees) at full weight
@@ -113,3 +123,112 @@ class EyeLids:
         share = np.where(through(np.ones(len(self.upper))), lo, 1.0)
         keep = 1.0 - (1.0 - np.interp(self.lid_lam, self.upper_lam, share)) * self.upper_share
         positions[self.lid] -= ((1.0 - keep)[:, None] * closing[self.lid]).astype(positions.dtype)
+
+
+# ------------------------------------------------------------------ the relaxed rest
+
+SIDES = ("left", "right")
+
+
+@lru_cache(maxsize=1)
+def rest_table() -> dict:
+    """The ``rest`` entry of ``lids.yaml`` (the one source of the relaxed aperture)."""
+    return load_yaml("lids.yaml")["rest"]
+
+
+def rest_lid_weight(lids: EyeLids, rest: np.ndarray, closing: np.ndarray, radius: float,
+                    spec: dict | None = None) -> float:
+    """The share of ``closing`` that lowers this eye's upper lid margin to a relaxed height.
+
+    The margin over the pupil (upper margin points within ``ahead_degrees`` of straight
+    ahead) should sit ``cover_mm`` below the iris's top (``iris_radius`` eyeball radii above
+    the centre). Heights change linearly with the share, so it is solved directly, then
+    clipped to ``[0, max_weight]``: 0 where the sculpted lid already covers that much.
+
+    Parameters
+    ----------
+    lids : EyeLids
+        The eye's lids on the sculpted neutral skin ``rest`` (N, 3).
+    closing : (N, 3) array
+        The closing target's offsets at full weight.
+    radius : float
+        The eyeball's radius (dm).
+    """
+    spec = spec or rest_table()
+    if not lids.ok:
+        return 0.0
+    ahead = np.abs(lids.upper_lam) < float(spec["ahead_degrees"])
+    upper = lids.upper[ahead] if ahead.sum() >= 2 else lids.upper
+    height = float(np.mean(rest[upper, 1])) - float(lids.centre[1])
+    drop = -float(np.mean(closing[upper, 1]))           # dm per unit share
+    target = float(spec["iris_radius"]) * radius - 0.01 * float(spec["cover_mm"])
+    if drop <= 1e-9:
+        return 0.0
+    return float(np.clip((height - target) / drop, 0.0, float(spec["max_weight"])))
+
+
+@dataclass(frozen=True)
+class RestLids:
+    """The relaxed upper lids of one character: a share of each eye's closing target.
+
+    ``weights`` maps side to the share at rest; :meth:`share` is what is left of it under
+    an expression (the ``fades_with`` AUs take it over); :meth:`offsets` the motion it
+    adds to the sculpted positions.
+    """
+
+    weights: dict
+    columns: dict                    # side -> (N, 3) float32 offsets of the closing target
+    fades_with: tuple
+
+    @classmethod
+    def measure(cls, rest: np.ndarray, column: Callable[[str], np.ndarray], eye: Callable[[str], tuple],
+                margin: Callable[[str], np.ndarray]) -> "RestLids":
+        """Measure both eyes on the sculpted neutral positions ``rest`` (N, 3).
+
+        ``column(side)`` gives the closing target's offsets (N, 3), ``eye(side)`` the
+        eyeball's (centre, radius), ``margin(side)`` the vertices along its lid margins.
+        """
+        spec = rest_table()
+        weights, columns = {}, {}
+        for side in SIDES:
+            centre, radius = eye(side)
+            closing = np.asarray(column(side), np.float32)
+            lids = EyeLids(rest, closing, centre, radius, margin(side))
+            weights[side] = rest_lid_weight(lids, np.asarray(rest, float), closing, radius, spec)
+            columns[side] = closing
+        # Faces are symmetric at rest: both eyes take the mean (the sculpted eyes differ by a hair).
+        mean = 0.5 * (weights["left"] + weights["right"])
+        return cls({side: mean for side in SIDES}, columns, tuple(int(c) for c in spec["fades_with"]))
+
+    def share(self, act, side: str) -> float:
+        """The rest share left on ``side`` under activations ``act``."""
+        taken = max((act[code, side] for code in self.fades_with), default=0.0)
+        return self.weights[side] * (1.0 - min(max(taken, 0.0), 1.0))
+
+    def offsets(self, act, count: int | None = None) -> np.ndarray:
+        """The rest lids' motion (N, 3) (or its first ``count`` rows) under ``act``."""
+        out = None
+        for side in SIDES:
+            s = self.share(act, side)
+            column = self.columns[side] if count is None else self.columns[side][:count]
+            out = s * column if out is None else out + s * column
+        return out.astype(np.float32)
+
+
+def closing_column(head, data, base_positions: np.ndarray, pattern: str, side: str,
+                   reach: tuple[float, float] = (0.05, 0.15)) -> np.ndarray:
+    """Offsets (N_base_geo, 3) float32 of a one-sided closing target (``{Side}`` in ``pattern``)
+    on ``side``, as the register engine's columns are: the left target kept within ``reach``
+    (dm) of the midline (it carries stray offsets on the far side), the right one its mirror.
+    """
+    x = np.asarray(base_positions, np.float32)[head.base_index, 0]
+    idx, delta = data.target(pattern.replace("{Side}", "Left"))
+    geo = head.geo_of_base[idx]
+    keep = geo >= 0
+    left = np.zeros((len(head.base_index), 3), np.float32)
+    left[geo[keep]] += delta[keep]
+    left *= smoothstep(-reach[1], -reach[0], x).astype(np.float32)[:, None]
+    if side == "left":
+        return left
+    mirror = head.mirror[: len(head.base_index)]
+    return left[mirror] * np.array([-1.0, 1.0, 1.0], np.float32)

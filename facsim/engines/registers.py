@@ -165,7 +165,8 @@ class RegisterEngine:
         self.data = data
         self.base_positions = np.asarray(base_positions, np.float32)
         self.ethnicity = character.ethnicity
-        self.neutral = head.positions(self.base_positions)
+        # The sculpted face (MakeHuman's staring lids); the rest is it with relaxed lids (:attr:`neutral`).
+        self.sculpted = head.positions(self.base_positions)
         x = self.base_positions[head.base_index, 0]
         self._half = smoothstep(-MIDLINE_BLEND, MIDLINE_BLEND, x).astype(np.float32)
         self._reach = smoothstep(-SIDED_REACH[1], -SIDED_REACH[0], x).astype(np.float32)  # left-side targets
@@ -207,18 +208,52 @@ class RegisterEngine:
         for pattern in register_table().get("lid_closing", ()):
             for side in ("left", "right"):
                 centre, radius = self.head.eye_pivot(self.base_positions, side)
-                margin = anchors[np.linalg.norm(self.neutral[anchors] - centre, axis=1) < 2 * radius]
-                out[pattern, side] = EyeLids(self.neutral[:skin], self.column(Column(pattern, side))[:skin],
+                margin = anchors[np.linalg.norm(self.sculpted[anchors] - centre, axis=1) < 2 * radius]
+                out[pattern, side] = EyeLids(self.sculpted[:skin], self.column(Column(pattern, side))[:skin],
                                              centre, radius, margin)
         return out
 
+    @cached_property
+    def rest_lids(self):
+        """The relaxed upper lids at rest (:class:`~facsim.engines.lids.RestLids`, ``lids.yaml``)."""
+        from facsim.engines.lids import RestLids, rest_table
+
+        skin = self.head.skin_vertex_count
+        anchors = np.unique(self.head.lash_anchors)
+        pattern = rest_table()["target"]
+
+        def eye(side):
+            return self.head.eye_pivot(self.base_positions, side)
+
+        def margin(side):
+            centre, radius = eye(side)
+            return anchors[np.linalg.norm(self.sculpted[anchors] - centre, axis=1) < 2 * radius]
+
+        return RestLids.measure(self.sculpted[:skin], lambda side: self.column(Column(pattern, side))[:skin], eye, margin)
+
+    @cached_property
+    def neutral(self) -> np.ndarray:
+        """The face at rest (N_geo, 3): the sculpted face with relaxed lids."""
+        return self.deform(Activations()).positions
+
+    def weights(self, act: Activations) -> dict[Column, float]:
+        """Column weights of ``act`` (Eq. 1) plus the relaxed lids' share of the closing target."""
+        weights = register_weights(act)
+        from facsim.engines.lids import rest_table
+
+        for side in ("left", "right"):
+            share = self.rest_lids.share(act, side)
+            if share:
+                col = Column(rest_table()["target"], side)
+                weights[col] = weights.get(col, 0.0) + share
+        return weights
+
     def deform(self, act: Activations) -> Deformation:
-        """The expression ``act``: targets weighted by Eq. 1, then the eyes and the head moved rigidly."""
-        if not act:
-            return Deformation(self.neutral)
+        """The expression ``act`` from the relaxed rest: targets weighted by Eq. 1, then the eyes
+        and the head moved rigidly."""
         base = self.base_positions[self.head.base_index]  # a copy (fancy indexing)
         closing = {}
-        for col, weight in register_weights(act).items():
+        for col, weight in self.weights(act).items():
             if weight:
                 base += weight * self.column(col)
                 if (col.pattern, col.side) in self.lids:
@@ -263,7 +298,7 @@ class RegisterEngine:
     def guard(self) -> SkinGuard:
         """The physical last step: skin off the eyeballs, no skin turned inside out."""
         centres = [self.head.eye_pivot(self.base_positions, side)[0] for side in ("left", "right")]
-        return SkinGuard(self.head, self.neutral, centres, self.head.eye_pivot(self.base_positions, "left")[1],
+        return SkinGuard(self.head, self.sculpted, centres, self.head.eye_pivot(self.base_positions, "left")[1],
                          neck_below=float(self.head.joint(self.base_positions, "joint-jaw")[1]))
 
     def reset(self) -> None:

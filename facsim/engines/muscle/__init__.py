@@ -18,6 +18,8 @@ Examples
 """
 from __future__ import annotations
 
+from functools import cached_property
+
 import numpy as np
 from scipy.spatial import cKDTree
 
@@ -149,14 +151,22 @@ class MuscleEngine:
     def __init__(self, head, data, character, base_positions):
         self.head = head
         base_positions = np.asarray(base_positions, np.float32)
-        self.model, self.wrinkles, neutral = _built(head, data, base_positions)
-        self.neutral = neutral.astype(np.float32)
-        self.parts = _Parts(head, data, neutral, self.model.net)
+        self.model, self.wrinkles, sculpted = _built(head, data, base_positions)
+        # The net rests on the sculpted face (MakeHuman's staring lids); the face at rest,
+        # :attr:`neutral`, carries relaxed lids on top (facsim.engines.lids.RestLids).
+        self.sculpted = sculpted.astype(np.float32)
+        self.parts = _Parts(head, data, sculpted, self.model.net)
         self.rigid = RigidMotion(head, base_positions)
+        self.rest_lids = _rest_lids(head, data, base_positions, self.sculpted, self.model.net)
         self.state = solver.rest_state(self.model)
         # The solver keeps its contact points off the eyes; this last step checks every skin point.
-        self.guard = SkinGuard(head, self.neutral, list(self.model.net.eye_centre), self.model.net.eye_radius,
+        self.guard = SkinGuard(head, self.sculpted, list(self.model.net.eye_centre), self.model.net.eye_radius,
                                neck_below=float(head.joint(base_positions, "joint-jaw")[1]))
+
+    @cached_property
+    def neutral(self) -> np.ndarray:
+        """The face at rest (N_geo, 3) float32: the net at rest with the relaxed lids."""
+        return self.geometry(solver.rest_state(self.model), Activations())
 
     # -- the Engine protocol
     def deform(self, act: Activations) -> Deformation:
@@ -235,7 +245,7 @@ class MuscleEngine:
         rot, shift = jaw_transform(state.jaw[index:index + 1], net.hinge, model.jaw_spec["yaw_per_lateral"])
         control = state.drive.tongue[index:index + 1]
         r, t = solver.tongue_frame(model.tongue, control, rot, shift, net.hinge)
-        skin = self.guard(state.points(index)[: net.count])
+        skin = self.guard(state.points(index)[: net.count] + self.rest_lids.offsets(act, net.count))
         out = self.parts.place(skin, rot[0], shift[0], net.hinge, (r[0], t[0]), model.tongue,
                                self.rigid.eye_rotations(act))
         out = out.astype(np.float32, copy=False)
@@ -259,6 +269,22 @@ def solve_static(model, target, *, steps: int, iterations: int) -> solver.State:
         state = solver.State(np.where(folded[None, :, None], more.x, state.x), target,
                              np.where(folded[:, None], more.jaw, state.jaw))
     return state
+
+
+def _rest_lids(head, data, base_positions, sculpted, net):
+    """The relaxed lids (:class:`~facsim.engines.lids.RestLids`) measured on the sculpted skin."""
+    from facsim.engines.lids import RestLids, closing_column, rest_table
+
+    count = net.count
+    anchors = np.unique(head.lash_anchors)
+    centres = dict(zip(SIDES, net.eye_centre))
+
+    def margin(side):
+        return anchors[np.linalg.norm(sculpted[anchors] - centres[side], axis=1) < 2 * net.eye_radius]
+
+    return RestLids.measure(sculpted[:count],
+                            lambda side: closing_column(head, data, base_positions, rest_table()["target"], side)[:count],
+                            lambda side: (centres[side], net.eye_radius), margin)
 
 
 _MODELS: dict = {}
