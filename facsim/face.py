@@ -177,6 +177,34 @@ class Face:
                                                triangles=bound.proxy.corner_vertex[bound.proxy.triangles])
         return occlusion
 
+    def frame_occlusion(self, positions: np.ndarray) -> np.ndarray:
+        """:attr:`shading_occlusion` with the eyeballs shaded by the lids where ``positions`` put them."""
+        from facsim.render.geometry import lid_shade
+
+        occlusion = np.array(self.shading_occlusion, np.float32, copy=True)
+        for side, (upper, lower) in self._lid_margins.items():
+            eye = self.head.eye_vertices[side]
+            centre = self.head.eye_pivot(self.base_positions, side)[0]
+            occlusion[eye] *= lid_shade(positions, centre, eye, upper, lower)
+        return occlusion
+
+    @cached_property
+    def _lid_margins(self) -> dict:
+        """Side -> (upper, lower) lid-margin skin vertices (the lashes' roots), told apart at
+        rest: a margin vertex above the line between the eye's corners is the upper lid's."""
+        from facsim.render.geometry import _spherical
+
+        anchors = np.unique(self.head.lash_anchors)
+        out = {}
+        for side in self.head.eye_vertices:
+            centre, radius = self.head.eye_pivot(self.base_positions, side)
+            margin = anchors[np.linalg.norm(self.neutral[anchors] - centre, axis=1) < 2 * radius]
+            lam, phi = _spherical(self.neutral[margin].astype(float), centre)
+            a, b = np.argmin(lam), np.argmax(lam)
+            corners = np.interp(lam, [lam[a], lam[b]], [phi[a], phi[b]])
+            out[side] = (margin[phi > corners], margin[phi < corners])
+        return out
+
     @cached_property
     def occlusion(self) -> np.ndarray:
         """Ambient visibility per vertex (1 open … 0 enclosed), baked once on the neutral face.
@@ -252,7 +280,7 @@ class Face:
         positions = np.asarray(deformation.positions, np.float32)
         return self.renderer(options).render(
             positions, appearance=self.appearance, camera=camera,
-            wrinkle=deformation.wrinkle, crease_phase=deformation.crease_phase, occlusion=self.shading_occlusion,
+            wrinkle=deformation.wrinkle, crease_phase=deformation.crease_phase, occlusion=self.frame_occlusion(positions),
             proxies=self.proxy_draws(positions),
         )
 

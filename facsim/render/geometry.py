@@ -186,3 +186,46 @@ def _faces_touching(face_uv: np.ndarray, mask: np.ndarray) -> np.ndarray:
     r1 = np.clip(np.ceil(hi[:, 1] * h).astype(np.int64) + 1, 0, h)
     count = sat[r1, c1] - sat[r0, c1] - sat[r1, c0] + sat[r0, c0]
     return count > 0
+
+
+
+#: The upper lid's shadow on the eyeball: its depth just under the margin and its reach
+#: (degrees of eyeball arc, ~0.28 mm each on hm08); the lower lid's is lighter and shorter.
+UPPER_LID_SHADE = (0.6, 8.0)
+LOWER_LID_SHADE = (0.2, 3.0)
+
+
+def lid_shade(positions: np.ndarray, centre: np.ndarray, eye: np.ndarray, upper: np.ndarray,
+              lower: np.ndarray) -> np.ndarray:
+    """Shade (N_eye,) in (0, 1] of one eyeball's vertices ``eye`` under its lids.
+
+    The upper lid is a thick fold that stands off the eyeball and carries the lashes: it
+    shades a band of the eyeball just below its margin; the lower lid, a little of the
+    eyeball just above it. Each eyeball vertex is compared with the margins' elevation
+    (about ``centre``) at its own azimuth, so the shadow follows the lids in every frame
+    (5 raises it with the lid, 43 closes it away). ``upper``/``lower`` are the margins'
+    skin vertices.
+
+    >>> p = np.array([[0.0, 0, 1], [0.0, 0.5, 0.87], [0.1, 0.5, 0.86], [0.0, -0.5, 0.87], [0.1, -0.5, 0.86]])
+    >>> s = lid_shade(p, np.zeros(3), np.array([0]), np.array([1, 2]), np.array([3, 4]))
+    >>> 0.5 < float(s[0]) < 1.0
+    True
+    """
+    p = np.asarray(positions, dtype=np.float64)
+    lam, phi = _spherical(p[eye], centre)
+    out = np.ones(len(eye))
+    for margin, (depth, reach), sign in ((upper, UPPER_LID_SHADE, 1.0), (lower, LOWER_LID_SHADE, -1.0)):
+        if len(margin) < 2:
+            continue
+        m_lam, m_phi = _spherical(p[margin], centre)
+        order = np.argsort(m_lam)
+        inside = np.maximum(sign * (np.interp(lam, m_lam[order], m_phi[order]) - phi), 0.0)
+        out *= 1.0 - depth * np.exp(-inside / reach)
+    return out.astype(np.float32)
+
+
+def _spherical(points: np.ndarray, centre: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Azimuth about +Y from +Z (degrees) and elevation (degrees) of points about ``centre``."""
+    q = points - centre
+    r = np.maximum(np.linalg.norm(q, axis=-1), 1e-12)
+    return np.degrees(np.arctan2(q[..., 0], q[..., 2])), np.degrees(np.arcsin(np.clip(q[..., 1] / r, -1, 1)))

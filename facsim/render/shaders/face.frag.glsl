@@ -299,7 +299,7 @@ void main() {
     // A little less saturated than the base colour (real irises are greyish), a lighter
     // collarette ring a third of the way out, a dark pupillary ruff, and a dark limbal ring
     // at the rim that blurs into the sclera.
-    vec3 base_iris = mix(u_iris, vec3(dot(u_iris, vec3(0.3, 0.55, 0.15))), 0.2);
+    vec3 base_iris = mix(u_iris, vec3(dot(u_iris, vec3(0.3, 0.55, 0.15))), 0.3);
     vec3 iris = base_iris * (0.5 + 1.0 * fibre);
     iris *= 1.0 + 0.35 * exp(-pow((t - 0.3) / 0.12, 2.0));
     iris *= mix(0.45, 1.0, smoothstep(0.0, 0.08, t));
@@ -310,8 +310,10 @@ void main() {
     // (conjunctival vessels, strongest nasally and temporally), with faint vessels there.
     float corner = smoothstep(0.4, 0.8, theta) * (0.55 + 0.45 * abs(cos(angle)));
     float vessels = smoothstep(0.7, 0.95, value_noise(vec2(angle * 9.0, theta * 14.0), 0)) * corner;
-    vec3 sclera = u_sclera * vec3(0.84, 0.82, 0.8)
-                * mix(vec3(1.0), vec3(1.0, 0.8, 0.76), 0.6 * corner + 0.4 * vessels);
+    // (Issue 13, reviewers: "glossy, doll-like eyes" - the sclera a touch greyer and warmer,
+    // never brighter than the lit skin beside it.)
+    vec3 sclera = u_sclera * vec3(0.78, 0.75, 0.72)
+                * mix(vec3(1.0), vec3(1.0, 0.78, 0.72), 0.7 * corner + 0.5 * vessels);
     // Caruncle and plica: a pink fleshy fold fills the inner corner (e.x toward the nose:
     // -x for the eye on the +x side of the head).
     float nasal = front * smoothstep(0.45, 0.63, -sign(v_pos.x) * e.x);
@@ -321,11 +323,14 @@ void main() {
     sclera *= 1.0 - 0.35 * limbal;
     float iris_soft = front * (1.0 - smoothstep(IRIS_RADIUS - aa - 0.015, IRIS_RADIUS + aa, r));
     vec3 albedo = mix(sclera, iris, max(iris_mask, 0.6 * iris_soft));
-    // The eyeball sits in the lids' shade: the upper lid and lashes shadow its top, the
-    // canthi its corners (eye frame: +y up, +x across the eye).
-    // (At rest about e.y in [-0.2, 0.2] and e.x in [-0.65, 0.65] show between the lids.)
-    float lid_shade = (1.0 - 0.5 * smoothstep(-0.12, 0.2, e.y)) * (1.0 - 0.15 * smoothstep(0.05, 0.2, -e.y))
-                    * (1.0 - 0.3 * smoothstep(0.35, 0.7, abs(e.x)));
+    // The eyeball sits in the lids' shade. The thick upper lid and its lashes shadow a band
+    // under its margin and the lower lid a little above its own: that shade follows the lids
+    // in every frame and arrives in occ (Face.frame_occlusion, facsim.render.geometry.lid_shade),
+    // so 5 bares lit sclera and 43 closes the shadow away. Here only what the lids cannot
+    // say: the canthi shade the corners, and light falls off over the eyeball's curve toward
+    // the orbit (eye frame: +y up, +x across the eye; at rest about e.y in [-0.2, 0.2] and
+    // e.x in [-0.65, 0.65] show between the lids).
+    float lid_shade = (1.0 - 0.15 * smoothstep(-0.05, 0.3, e.y)) * (1.0 - 0.35 * smoothstep(0.3, 0.7, abs(e.x)));
     vec3 diffuse = diffuse_light(n, vec3(0.15), occ) * albedo * lid_shade;
     // Wet surface: a small soft catch-light on the cornea only, a faint broad sheen
     // elsewhere; no bright Fresnel rim (it made the eyes look like glass). The cornea bulges
