@@ -398,7 +398,9 @@ class BoundProxy:
             # Lower lashes are sparser and finer than upper ones: start them part-way
             # along the taper.
             y = self.neutral[:, 1]
-            depth = np.where(y < 0.5 * (y.min() + y.max()), 0.45 + 0.55 * depth, depth)
+            # (Issue 13: at 0.45 they still read as painted doll's lashes; real lower lashes
+            # are short, sparse and hardly show beside the upper ones.)
+            depth = np.where(y < 0.5 * (y.min() + y.max()), 0.65 + 0.35 * depth, depth)
         return np.clip(depth, 0.0, 1.0).astype(np.float32)
 
     @property

@@ -42,10 +42,16 @@ void main() {
     // v_depth: 0 at the brow's head ... 1 at its tail. The head's hairs grow upward, spaced,
     // so skin shows through (a solid dark head reads as a frown); the tail thins out.
     float thin = mix(0.5, 1.0, smoothstep(0.0, 0.35, v_depth)) * mix(1.0, 0.55, smoothstep(0.7, 1.0, v_depth));
-    alpha = clamp(tex.a * 2.0, 0.0, 0.92) * thin * u_density;
+    // The texture's own strokes keep their contrast (doubling alpha filled dense brows such
+    // as eyebrow012 into a flat painted strip, issue 13), with a fine breakup across them.
+    float grain = value_noise(v_uv * vec2(260.0, 260.0), 0);
+    grain = mix(0.5, grain, clamp(2.0 - 1.5 * fwidth(v_uv.x * 260.0), 0.0, 1.0));
+    alpha = clamp(tex.a * 1.35, 0.0, 0.88) * (0.75 + 0.5 * grain) * thin * u_density;
 #else
-    // v_depth: 0 at the lid ... 1 at the lash tips: each lash tapers to a fine point.
-    alpha = clamp(tex.a * 1.25, 0.0, 1.0) * mix(1.0, 0.4, v_depth) * u_density;
+    // v_depth: 0 at the lid ... 1 at the lash tips: each lash tapers to a fine point, so
+    // the lash line is dense at the lid margin (it gives the upper lid its dark edge) and the
+    // tips fade instead of ending in spikes (lower lashes start part-way along, proxies.py).
+    alpha = clamp(tex.a * 1.25, 0.0, 1.0) * mix(1.0, 0.15, smoothstep(0.0, 1.0, v_depth)) * u_density;
 #endif
     if (alpha < 0.01) discard;
 #else
