@@ -330,7 +330,9 @@ void main() {
     // say: the canthi shade the corners, and light falls off over the eyeball's curve toward
     // the orbit (eye frame: +y up, +x across the eye; at rest about e.y in [-0.2, 0.2] and
     // e.x in [-0.65, 0.65] show between the lids).
-    float lid_shade = (1.0 - 0.15 * smoothstep(-0.05, 0.3, e.y)) * (1.0 - 0.35 * smoothstep(0.3, 0.7, abs(e.x)));
+    // The socket around it hides much of the sky: the whole eyeball takes less ambient than
+    // the skin.
+    float lid_shade = 0.7 * (1.0 - 0.15 * smoothstep(-0.05, 0.3, e.y)) * (1.0 - 0.35 * smoothstep(0.3, 0.7, abs(e.x)));
     vec3 diffuse = diffuse_light(n, vec3(0.15), occ) * albedo * lid_shade;
     // Wet surface: a small soft catch-light on the cornea only, a faint broad sheen
     // elsewhere; no bright Fresnel rim (it made the eyes look like glass). The cornea bulges
