@@ -182,16 +182,16 @@ class Face:
         from facsim.render.geometry import lid_shade
 
         occlusion = np.array(self.shading_occlusion, np.float32, copy=True)
-        for side, (upper, lower) in self._lid_margins.items():
-            eye = self.head.eye_vertices[side]
-            centre = self.head.eye_pivot(self.base_positions, side)[0]
+        for side, (centre, upper, lower) in self._lid_margins.items():
+            # Only the eyeball's front can show between the lids (at any gaze 61-64 give).
+            eye = self.head.eye_vertices[side][self.head.eye_local[:, 2] > -0.3]
             occlusion[eye] *= lid_shade(positions, centre, eye, upper, lower)
         return occlusion
 
     @cached_property
     def _lid_margins(self) -> dict:
-        """Side -> (upper, lower) lid-margin skin vertices (the lashes' roots), told apart at
-        rest: a margin vertex above the line between the eye's corners is the upper lid's."""
+        """Side -> (eye centre, upper, lower lid-margin skin vertices) (the lashes' roots), told
+        apart at rest: a margin vertex above the line between the eye's corners is the upper lid's."""
         from facsim.render.geometry import _spherical
 
         anchors = np.unique(self.head.lash_anchors)
@@ -202,7 +202,7 @@ class Face:
             lam, phi = _spherical(self.neutral[margin].astype(float), centre)
             a, b = np.argmin(lam), np.argmax(lam)
             corners = np.interp(lam, [lam[a], lam[b]], [phi[a], phi[b]])
-            out[side] = (margin[phi > corners], margin[phi < corners])
+            out[side] = (centre, margin[phi > corners], margin[phi < corners])
         return out
 
     @cached_property

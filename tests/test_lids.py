@@ -16,7 +16,7 @@ HIGH_LID, COVERED = "amara", ("noah", "george")
 def _cover_mm(face, positions, side="left") -> float:
     """How far (mm) the upper lid margin over the pupil sits below the top of the iris."""
     centre, radius = face.head.eye_pivot(face.base_positions, side)
-    upper = face._lid_margins[side][0]
+    upper = face._lid_margins[side][1]
     lam, _ = spherical(positions[upper], centre)
     ahead = upper[np.abs(lam) < float(rest_table()["ahead_degrees"])]
     return 100.0 * (float(rest_table()["iris_radius"]) * radius - (positions[ahead, 1].mean() - centre[1]))
@@ -58,8 +58,7 @@ def test_5_widens_and_43_closes_from_the_relaxed_rest(face_of, engine):
     assert not face.engine.rest_lids.offsets(face.activations("43E")).any()  # 43 closes as from the sculpted rest
     if engine == "muscle":
         return  # (how far its net closes the lids is the muscle engine's own, tests/test_muscle_*.py)
-    upper, lower = face._lid_margins["left"]
-    centre = face.head.eye_pivot(face.base_positions, "left")[0]
+    centre, upper, lower = face._lid_margins["left"]
     lam_u, phi_u = spherical(closed[upper], centre)
     lam_l, phi_l = spherical(closed[lower], centre)
     order = np.argsort(lam_l)
@@ -77,8 +76,7 @@ def test_the_lids_shade_on_the_eyeball_follows_the_upper_lid(face_of):
     assert len(band) >= 2
     from facsim.render.geometry import lid_shade
 
-    centre = face.head.eye_pivot(face.base_positions, "left")[0]
-    upper, lower = face._lid_margins["left"]
+    centre, upper, lower = face._lid_margins["left"]
     at_rest, widened = (lid_shade(p, centre, band, upper, lower) for p in (face.neutral, face.deform("5E").positions))
     assert np.allclose(face.frame_occlusion(face.neutral)[band], face.shading_occlusion[band] * at_rest)
     assert at_rest.mean() < 0.75 and widened.mean() > at_rest.mean() + 0.1, (at_rest, widened)

@@ -211,13 +211,13 @@ def lid_shade(positions: np.ndarray, centre: np.ndarray, eye: np.ndarray, upper:
     >>> 0.5 < float(s[0]) < 1.0
     True
     """
-    p = np.asarray(positions, dtype=np.float64)
-    lam, phi = _spherical(p[eye], centre)
+    p = np.asarray(positions)
+    lam, phi = _spherical(p[eye].astype(np.float64), centre)
     out = np.ones(len(eye))
     for margin, (depth, reach), sign in ((upper, UPPER_LID_SHADE, 1.0), (lower, LOWER_LID_SHADE, -1.0)):
         if len(margin) < 2:
             continue
-        m_lam, m_phi = _spherical(p[margin], centre)
+        m_lam, m_phi = _spherical(p[margin].astype(np.float64), centre)
         order = np.argsort(m_lam)
         inside = np.maximum(sign * (np.interp(lam, m_lam[order], m_phi[order]) - phi), 0.0)
         out *= 1.0 - depth * np.exp(-inside / reach)
