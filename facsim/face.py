@@ -179,14 +179,29 @@ class Face:
 
     def frame_occlusion(self, positions: np.ndarray) -> np.ndarray:
         """:attr:`shading_occlusion` with the eyeballs shaded by the lids where ``positions`` put them."""
-        from facsim.render.geometry import lid_shade
+        from facsim.render.geometry import lid_crease_shade, lid_shade
 
         occlusion = np.array(self.shading_occlusion, np.float32, copy=True)
         for side, (centre, upper, lower) in self._lid_margins.items():
             # Only the eyeball's front can show between the lids (at any gaze 61-64 give).
             eye = self.head.eye_vertices[side][self.head.eye_local[:, 2] > -0.3]
             occlusion[eye] *= lid_shade(positions, centre, eye, upper, lower)
+            crease, weights, height = self._lid_creases[side]
+            occlusion[crease] *= lid_crease_shade(positions, centre, crease, weights, upper, height)
         return occlusion
+
+    @cached_property
+    def _lid_creases(self) -> dict:
+        """Side -> (crease skin vertices, weights, their rest height above the margin)."""
+        from facsim.render.geometry import _height_above, lid_crease_weights
+
+        out = {}
+        skin = np.arange(self.head.skin_vertex_count)
+        for side, (centre, upper, _) in self._lid_margins.items():
+            radius = self.head.eye_pivot(self.base_positions, side)[1]
+            crease, weights = lid_crease_weights(self.neutral, centre, skin, upper, radius)
+            out[side] = (crease, weights, _height_above(np.asarray(self.neutral), centre, crease, upper))
+        return out
 
     @cached_property
     def _lid_margins(self) -> dict:

@@ -229,3 +229,38 @@ def _spherical(points: np.ndarray, centre: np.ndarray) -> tuple[np.ndarray, np.n
     q = points - centre
     r = np.maximum(np.linalg.norm(q, axis=-1), 1e-12)
     return np.degrees(np.arctan2(q[..., 0], q[..., 2])), np.degrees(np.arcsin(np.clip(q[..., 1] / r, -1, 1)))
+
+
+#: The upper lid's crease (the supratarsal fold, where the levator's fibres pull the lid skin
+#: in): its height above the lid margin at rest (dm), half-width (dm) and shade.
+LID_CREASE = (0.07, 0.012, 0.3)
+
+
+def lid_crease_weights(rest: np.ndarray, centre: np.ndarray, skin: np.ndarray, upper: np.ndarray,
+                       radius: float) -> tuple[np.ndarray, np.ndarray]:
+    """The skin vertices of the upper lid's crease, chosen once at rest: (vertices, weights in
+    (0, 1]) of those within two half-widths of :data:`LID_CREASE`'s height above the margin
+    (measured straight up from the margin at the vertex's azimuth, in front of the eyeball)."""
+    p = np.asarray(rest, dtype=np.float64)
+    near = skin[(np.linalg.norm(p[skin] - centre, axis=1) < 1.6 * radius) & (p[skin, 2] > centre[2])]
+    height = _height_above(p, centre, near, upper)
+    h0, w, _ = LID_CREASE
+    keep = np.abs(height - h0) < 2.0 * w
+    return near[keep], np.exp(-((height[keep] - h0) / w) ** 2)
+
+
+def lid_crease_shade(positions: np.ndarray, centre: np.ndarray, vertices: np.ndarray, weights: np.ndarray,
+                     upper: np.ndarray, rest_height: np.ndarray) -> np.ndarray:
+    """Shade (K,) of the crease ``vertices``: deepest when the lid is raised (5 folds more lid
+    skin into it), gone as the lid closes (the skin above the margin is stretched flat)."""
+    height = _height_above(np.asarray(positions), centre, vertices, upper)
+    deepen = np.clip(1.0 + (rest_height - height) / 0.03, 0.0, 1.6)
+    return (1.0 - LID_CREASE[2] * weights * deepen).astype(np.float32)
+
+
+def _height_above(p: np.ndarray, centre: np.ndarray, vertices: np.ndarray, upper: np.ndarray) -> np.ndarray:
+    """Height (dm) of ``vertices`` above the upper margin at their azimuth about ``centre``."""
+    lam, _ = _spherical(p[vertices].astype(np.float64), centre)
+    m_lam, _ = _spherical(p[upper].astype(np.float64), centre)
+    order = np.argsort(m_lam)
+    return p[vertices, 1] - np.interp(lam, m_lam[order], p[upper, 1][order])
