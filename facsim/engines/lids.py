@@ -124,6 +124,51 @@ class EyeLids:
         keep = 1.0 - (1.0 - np.interp(self.lid_lam, self.upper_lam, share)) * self.upper_share
         positions[self.lid] -= ((1.0 - keep)[:, None] * closing[self.lid]).astype(positions.dtype)
 
+    def meet_lower(self, positions: np.ndarray, amount: float) -> None:
+        """Bring the upper lid onto the lower one (in place), closing ``amount`` (0..1) of the
+        gap left between the margins (or of the overlap where it went through).
+
+        An engine whose closing lid does not reach the lower one everywhere (the muscle
+        engine's net leaves the corners open and dips in the middle) gets the contact the
+        register engine's target has: each upper margin point turns about the eyeball's
+        centre down to the lower margin's elevation at its azimuth, the lid skin above
+        following less with height (turning about the centre keeps the skin on its sphere,
+        and the order of points along each meridian, so no fold can form).
+        """
+        if not self.ok or amount <= 0.0:
+            return
+        lam_u, phi_u = spherical(positions[self.upper], self.centre)
+        lam_l, phi_l = spherical(positions[self.lower], self.centre)
+        order_l = np.argsort(lam_l)
+        gap = phi_u - (np.interp(lam_u, lam_l[order_l], phi_l[order_l]) + OVERLAP)
+        order = np.argsort(lam_u)
+        # Signed: a margin left above the lower one comes down, one pulled through it (the net's
+        # dip in the middle) comes back up to it.
+        turn_u = float(amount) * gap[order]
+        lam, phi = spherical(positions[self.lid], self.centre)
+        above = phi - np.interp(lam, lam_u[order], phi_u[order])
+        turn = np.radians(np.interp(lam, lam_u[order], turn_u)) * self.upper_share \
+            * (1.0 - smoothstep(0.0, MEET_FOLLOW, above))
+        q = positions[self.lid] - self.centre
+        c, s = np.cos(turn), np.sin(turn)
+        y, z = q[:, 1] * c - q[:, 2] * s, q[:, 1] * s + q[:, 2] * c
+        positions[self.lid, 1] = (self.centre[1] + y).astype(positions.dtype)
+        positions[self.lid, 2] = (self.centre[2] + z).astype(positions.dtype)
+
+
+#: Lid skin this many degrees above the upper margin no longer follows :meth:`EyeLids.meet_lower`.
+MEET_FOLLOW = 25.0
+#: AU codes that close the eye, and the level from which :meth:`EyeLids.meet_lower` starts
+#: bringing the margins together (fully at 1).
+CLOSING = (43, 45, 46)
+MEET_FROM = 0.6
+
+
+def meet_amount(act, side: str) -> float:
+    """How much of the gap between the margins :meth:`EyeLids.meet_lower` closes under ``act``."""
+    level = max(act[code, side] for code in CLOSING)
+    return float(smoothstep(MEET_FROM, 1.0, np.asarray(level, float)))
+
 
 # ------------------------------------------------------------------ the relaxed rest
 

@@ -26,6 +26,7 @@ from scipy.spatial import cKDTree
 from facsim.engines.base import Deformation
 from facsim.engines.rigid import RigidMotion
 from facsim.engines.guard import SkinGuard
+from facsim.engines.lids import meet_amount
 from facsim.facs.activations import Activations
 from facsim.engines.muscle import solver
 from facsim.engines.muscle.muscles import au_table, build_muscles, build_tongue, drive, jaw_pose, pressure_patches
@@ -150,7 +151,9 @@ class MuscleEngine:
 
     def __init__(self, head, data, character, base_positions):
         self.head = head
+        self.data = data
         base_positions = np.asarray(base_positions, np.float32)
+        self.base_positions = base_positions
         self.model, self.wrinkles, sculpted = _built(head, data, base_positions)
         # The net rests on the sculpted face (MakeHuman's staring lids); the face at rest,
         # :attr:`neutral`, carries relaxed lids on top (facsim.engines.lids.RestLids).
@@ -162,6 +165,20 @@ class MuscleEngine:
         # The solver keeps its contact points off the eyes; this last step checks every skin point.
         self.guard = SkinGuard(head, self.sculpted, list(self.model.net.eye_centre), self.model.net.eye_radius,
                                neck_below=float(head.joint(base_positions, "joint-jaw")[1]))
+
+    @cached_property
+    def eyelids(self) -> dict:
+        """Side -> :class:`~facsim.engines.lids.EyeLids` on the sculpted skin."""
+        from facsim.engines.lids import EyeLids, closing_column, rest_table
+
+        count, net = self.model.net.count, self.model.net
+        anchors = np.unique(self.head.lash_anchors)
+        out = {}
+        for side, centre in zip(SIDES, net.eye_centre):
+            margin = anchors[np.linalg.norm(self.sculpted[anchors] - centre, axis=1) < 2 * net.eye_radius]
+            column = closing_column(self.head, self.data, self.base_positions, rest_table()["target"], side)[:count]
+            out[side] = EyeLids(self.sculpted[:count], column, centre, net.eye_radius, margin)
+        return out
 
     @cached_property
     def neutral(self) -> np.ndarray:
@@ -245,7 +262,12 @@ class MuscleEngine:
         rot, shift = jaw_transform(state.jaw[index:index + 1], net.hinge, model.jaw_spec["yaw_per_lateral"])
         control = state.drive.tongue[index:index + 1]
         r, t = solver.tongue_frame(model.tongue, control, rot, shift, net.hinge)
-        skin = self.guard(state.points(index)[: net.count] + self.rest_lids.offsets(act, net.count))
+        skin = state.points(index)[: net.count] + self.rest_lids.offsets(act, net.count)
+        for side, lids in self.eyelids.items():   # closing lids meet (the net leaves the corners open)
+            amount = meet_amount(act, side)
+            if amount > 0.0:
+                lids.meet_lower(skin, amount)
+        skin = self.guard(skin)
         out = self.parts.place(skin, rot[0], shift[0], net.hinge, (r[0], t[0]), model.tongue,
                                self.rigid.eye_rotations(act))
         out = out.astype(np.float32, copy=False)
