@@ -51,20 +51,20 @@ def test_hooded_lids_are_left_as_they_are(face_of, name):
 
 @pytest.mark.parametrize("engine", ["registers", "muscle"])
 def test_5_widens_and_43_closes_from_the_relaxed_rest(face_of, engine):
+    """(The muscle engine's net leaves the lid corners open and dips in the middle; its lids are
+    brought together by facsim.engines.lids.EyeLids.meet_lower.)"""
     face = face_of(HIGH_LID, engine)
     rest = _cover_mm(face, face.neutral)
     wide, closed = (face.deform(code).positions for code in ("5E", "43E"))
     assert rest - _cover_mm(face, wide) > 1.5          # the lid rises more than 1.5 mm over the iris
     assert not face.engine.rest_lids.offsets(face.activations("43E")).any()  # 43 closes as from the sculpted rest
-    if engine == "muscle":
-        return  # (how far its net closes the lids is the muscle engine's own, tests/test_muscle_*.py)
     centre, upper, lower = face._lid_margins["left"]
     lam_u, phi_u = spherical(closed[upper], centre)
     lam_l, phi_l = spherical(closed[lower], centre)
     order = np.argsort(lam_l)
     ahead = np.abs(lam_u) < 12
     gap = phi_u[ahead] - np.interp(lam_u[ahead], lam_l[order], phi_l[order])
-    assert gap.max() < 2.0, gap                        # closed: the margins meet (degrees of arc)
+    assert np.abs(gap).max() < 2.0, gap                # closed: the margins meet over the eye (degrees of arc)
 
 
 def test_the_lids_shade_on_the_eyeball_follows_the_upper_lid(face_of):
