@@ -24,7 +24,7 @@ from facsim.render.options import RenderOptions
 #: shows the whole head with a little neck, the same in every frame.
 NECK_SHOWN = 0.45
 #: Bump when the occlusion bake changes, so cached bakes are redone.
-OCCLUSION_VERSION = 3  # 3: the relaxed lids at rest (lids.yaml)
+OCCLUSION_VERSION = 4  # 4: the relaxed lids at rest (lids.yaml); 3 was a withdrawn rest (rest_pose.yaml) whose bakes may linger in caches
 
 
 @lru_cache(maxsize=1)
