@@ -42,6 +42,11 @@ STATIC_ITERATIONS = 20
 JAW_DEGREES_PER_STEP = 10.0
 #: At most this many extra rounds of iterations for a static solve that ends with folded skin.
 POLISH_ROUNDS = 5
+#: A static solve keeps relaxing, at most this many more rounds of ``iterations``, while a round
+#: still moves some skin point further than :data:`SETTLED_DM` (issue 13: anger's brows stood at
+#: half their depth after the fixed 2 x 20 iterations; most single AUs settle within them).
+CONVERGE_ROUNDS = 4
+SETTLED_DM = 0.002
 #: Expressions solved together by :meth:`MuscleEngine.solve_many`.
 BATCH = 4
 #: Iterations per animation frame (the state carries over, so frames converge over time).
@@ -290,6 +295,17 @@ def solve_static(model, target, *, steps: int, iterations: int) -> solver.State:
         # Only the folded ones take the extra round (so a batch solves each alike to alone).
         state = solver.State(np.where(folded[None, :, None], more.x, state.x), target,
                              np.where(folded[:, None], more.jaw, state.jaw))
+    # Not yet at rest: relax further while a round still moves the skin (per configuration).
+    active = np.ones(state.x.shape[1], bool)
+    skin = model.net.count
+    for _ in range(CONVERGE_ROUNDS):
+        more = solver.solve(model, state, target, steps=1, iterations=iterations)
+        moved = np.sqrt(((more.x[:, :, :skin] - state.x[:, :, :skin]) ** 2).sum(axis=0)).max(axis=1)
+        state = solver.State(np.where(active[None, :, None], more.x, state.x), target,
+                             np.where(active[:, None], more.jaw, state.jaw))
+        active &= moved > SETTLED_DM
+        if not active.any():
+            break
     return state
 
 
