@@ -227,8 +227,9 @@ class MuscleEngine:
         ``b`` of ``state``.
 
         Expressions needing the same number of increments are solved together, a
-        few at a time (beyond that the arrays leave the cache); each solves exactly
-        as it would alone.
+        few at a time (beyond that the arrays leave the cache); each solves as it
+        would alone, up to round-off (the batch's width changes the last bits of the
+        sparse solves; over a settled solve that stays below 0.1 mm).
         """
         acts = list(acts)
         extra = [self._extra_steps(drive(self.model.layer, act)) for act in acts]
