@@ -75,14 +75,10 @@ def test_a_character_model_is_built_once_and_shared(face_of):
 
 
 def test_batched_solves_equal_single_ones(engine):
-    """Batched, each expression solves as alone up to round-off: the sparse back-substitution
-    and the per-configuration sums differ in the last bits with the batch's width (1e-15), and
-    the minimiser's accept/reject decisions carry that on; a static solve that relaxes until
-    settled ends within 0.1 mm (1e-3 dm) of the same solve alone (measured: 0.02 mm)."""
     acts = [activations(parse(t)) for t in ("1", "15", "26")]
     together = engine.solve_many(acts)
     for act, batched in zip(acts, together):
-        assert np.abs(engine.deform(act).positions - batched).max() < 1e-3
+        assert np.abs(engine.deform(act).positions - batched).max() < 1e-5
 
 
 def test_jaw_statics(model):
