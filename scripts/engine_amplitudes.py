@@ -4,10 +4,13 @@ Measured on the deformed mesh, against the character's neutral face:
 chin and lower-lip drop, lower-teeth (jaw) drop, the lips' inner gap at the
 midline, inner and outer brow rise (mean of both sides), and the change of the
 distance between the inner brows (negative: drawn together, AU 4).
+With ``--upper``: the upper-face figures instead — brow rise and spread, the
+glabella's drop, the upper and lower lids' rise, the eye's aperture change
+(negative: narrowed), the cheek's and nose wing's rise (AU 6, 9, 10).
 
 Usage::
 
-    python3 scripts/engine_amplitudes.py [--character ava] [--engines registers muscle] [EXPR ...]
+    python3 scripts/engine_amplitudes.py [--character ava] [--engines registers muscle] [--upper] [EXPR ...]
 """
 from __future__ import annotations
 
@@ -20,6 +23,10 @@ EXPRESSIONS = ["25", "26", "27", "25+26", "1", "2", "4", "1+2", "1+4", "1+2+4",
                "surprise", "fear", "sadness"]
 MM = 100.0
 COLUMNS = ("chin", "lo-lip", "jaw", "gap", "in-brow", "out-brow", "brow-dx")
+#: The upper face (``--upper``): AUs 1, 2, 4, 5, 6, 7, 9, 41-44 and the emotions that show them.
+UPPER_EXPRESSIONS = ["1", "2", "4", "1+2", "1+4", "1+2+4", "5", "6", "7", "9", "41", "42", "43", "44",
+                     "anger", "fear", "sadness", "surprise", "disgust", "happiness"]
+UPPER_COLUMNS = ("in-brow", "out-brow", "brow-dx", "glab", "up-lid", "lo-lid", "aperture", "cheek", "nose")
 
 
 def amplitudes(face, expression) -> dict[str, float]:
@@ -50,6 +57,12 @@ def amplitudes(face, expression) -> dict[str, float]:
         "in-brow": rise("inner_brow"),
         "out-brow": rise("outer_brow"),
         "brow-dx": MM * (spread(p) - spread(rest)),
+        "glab": MM * (p[marks["glabella"], 1] - rest[marks["glabella"], 1]),
+        "up-lid": rise("upper_lid"),
+        "lo-lid": rise("lower_lid"),
+        "aperture": rise("upper_lid") - rise("lower_lid"),
+        "cheek": rise("cheek"),
+        "nose": rise("nose_wing"),
     }
 
 
@@ -57,18 +70,21 @@ def main(argv=None) -> None:
     from facsim.face import Face
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("expressions", nargs="*", default=EXPRESSIONS)
+    parser.add_argument("expressions", nargs="*")
     parser.add_argument("--character", default="ava")
     parser.add_argument("--engines", nargs="+", default=["registers", "muscle"])
+    parser.add_argument("--upper", action="store_true", help="upper-face columns (brows, lids, cheek, nose)")
     args = parser.parse_args(argv)
+    columns = UPPER_COLUMNS if args.upper else COLUMNS
+    expressions = args.expressions or (UPPER_EXPRESSIONS if args.upper else EXPRESSIONS)
 
     faces = {name: Face(args.character, engine=name) for name in args.engines}
     print(f"{args.character}: motion from neutral in mm (gap: change of the lips' inner gap)")
-    print(f"{'expression':<12}{'engine':<10}" + "".join(f"{c:>9}" for c in COLUMNS))
-    for expr in args.expressions:
+    print(f"{'expression':<12}{'engine':<10}" + "".join(f"{c:>9}" for c in columns))
+    for expr in expressions:
         for name, face in faces.items():
             row = amplitudes(face, expr)
-            print(f"{expr:<12}{name:<10}" + "".join(f"{row[c]:9.1f}" for c in COLUMNS))
+            print(f"{expr:<12}{name:<10}" + "".join(f"{row[c]:9.1f}" for c in columns))
 
 
 if __name__ == "__main__":

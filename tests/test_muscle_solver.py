@@ -204,3 +204,20 @@ def test_furrow_phase_counts_furrows_across_the_compression(engine, head):
     spacing = engine.wrinkles.wavelength[region].mean()
     assert abs(per_x) > 3 * abs(per_y), (per_x, per_y)
     assert 0.5 < abs(per_x) * spacing < 1.5, abs(per_x) * spacing
+
+
+def test_raised_brows_lift_the_forehead_level_across_the_midline(engine, head):
+    """On 1+2 the skin over the glabella rises with the brows beside it (issue 13: it lagged at
+    half their rise, and the forehead folded into one V over the midline)."""
+    from facsim.head.landmarks import landmarks
+
+    marks = landmarks(head)
+    rest, skin = engine.neutral, head.skin
+    moved = engine.deform(activations(parse("1+2"))).positions
+    brow = rest[marks["inner_brow_left"], 1]
+    for low, high in ((0.08, 0.16), (0.16, 0.26)):  # two rows of the net above the brows
+        band = skin[(rest[skin, 1] > brow + low) & (rest[skin, 1] < brow + high)
+                    & (rest[skin, 2] > rest[marks["glabella"], 2] - 0.15)]
+        x, rise = np.abs(rest[band, 0]), moved[band, 1] - rest[band, 1]
+        midline, beside = rise[x < 0.05].mean(), rise[(x > 0.1) & (x < 0.22)].mean()
+        assert midline > 0.65 * beside, (low, midline, beside)

@@ -796,6 +796,8 @@ def minimise(model: Model, x: np.ndarray, ld: Loads, iterations: int, *, toleran
     raw = (e, g)
     g = hold(g.copy(), gaps, floors, sign=1.0)  # the walls take up what pushes into them
     s_hist, y_hist, rho_hist = (list(part) for part in memory[:3]) if memory else ([], [], [])
+    # Which configurations each pair belongs to (rho may also be 0 after a failed step: still theirs).
+    own_hist = list(memory[4]) if len(memory) > 4 else [rho != 0 for rho in rho_hist]
     # The step that worked last time, but never below a quarter: a converged frame's failed steps
     # must not leave the next frame (a new drive) crawling.
     trust = np.maximum(memory[3], 0.25) if len(memory) > 3 else np.ones(x.shape[1])
@@ -855,9 +857,18 @@ def minimise(model: Model, x: np.ndarray, ld: Loads, iterations: int, *, toleran
             s_hist.append(s)
             y_hist.append(y)
             rho_hist.append(np.where(keep, 1.0 / np.where(keep, sy, 1.0), 0.0))
-            if len(s_hist) > HISTORY:
-                del s_hist[0], y_hist[0], rho_hist[0]
-    return x, (tuple(s_hist), tuple(y_hist), tuple(rho_hist), trust), raw
+            own_hist.append(keep)
+            # Each configuration keeps its own last HISTORY pairs, as it would solved alone: a
+            # pair another one kept must not push its oldest out (the batch's shared slots did,
+            # and longer solves then drifted from the same solve alone).
+            owned = np.sum(own_hist, axis=0)
+            for b in np.flatnonzero(owned > HISTORY):
+                oldest = next(k for k, own in enumerate(own_hist) if own[b])
+                rho_hist[oldest] = np.where(np.arange(len(keep)) == b, 0.0, rho_hist[oldest])
+                own_hist[oldest] = own_hist[oldest] & (np.arange(len(keep)) != b)
+            while own_hist and not own_hist[0].any():
+                del s_hist[0], y_hist[0], rho_hist[0], own_hist[0]
+    return x, (tuple(s_hist), tuple(y_hist), tuple(rho_hist), trust, tuple(own_hist)), raw
 
 
 # ------------------------------------------------------------------ solve ---

@@ -195,7 +195,7 @@ def wrinkle_field(model: WrinkleModel, positions: np.ndarray) -> tuple[np.ndarra
     # held flat by the bone beneath): the direction snaps to the nearer of height and width.
     snapped = np.where(np.abs(v_dir[:, 1:2]) >= np.abs(v_dir[:, 0:1]), [[0.0, 1.0, 0.0]], [[1.0, 0.0, 0.0]])
     along = (1 - model.straight)[:, None] * v_dir + model.straight[:, None] * snapped
-    phase = _furrow_phase(model, along)
+    phase = _furrow_phase(model, along, positions)
     # Squeezed sideways the skin makes vertical furrows; zones may crease less that way (the
     # forehead's deep lines are horizontal: drawn together, brows furrow the glabella, not the brow).
     sideways = along[:, 0] ** 2 / np.maximum((along ** 2).sum(1), 1e-12)
@@ -204,7 +204,7 @@ def wrinkle_field(model: WrinkleModel, positions: np.ndarray) -> tuple[np.ndarra
     return np.clip(out, 0.0, 2.0).astype(np.float32), phase.astype(np.float32)
 
 
-def _furrow_phase(model: WrinkleModel, along: np.ndarray) -> np.ndarray:
+def _furrow_phase(model: WrinkleModel, along: np.ndarray, positions: np.ndarray) -> np.ndarray:
     """The phase whose gradient is ``along / wavelength`` as nearly as can be (least squares
     over the skin edges): furrows then keep their spacing where the direction turns, which
     measuring each point from one origin would not (a small turn there moves far points by
@@ -213,12 +213,22 @@ def _furrow_phase(model: WrinkleModel, along: np.ndarray) -> np.ndarray:
     A direction's sign is arbitrary: each point takes the one whose largest component is
     positive, and an edge whose ends still disagree (where the field turns through the
     diagonal) asks for no change of phase across it.
+
+    Where the lines run straight across (the forehead), their phase counts the skin's height
+    NOW, not at rest: the frontalis lifts the skin above its bellies more than at the midline
+    between them, so lines at a fixed rest height sagged into one V over the midline (issue 13).
+    Counted on the deformed height they stay level, at an even spacing on the squeezed skin,
+    as buckled skin's are. Only the height is taken so: sideways (the glabella's vertical
+    furrows under 4) the phase still counts rest width, whose spacing the skin carries along.
     """
     largest = np.take_along_axis(along, np.abs(along).argmax(axis=1)[:, None], axis=1)
     along = along * np.where(largest < 0, -1.0, 1.0)
     i, j = model.edges[:, 0], model.edges[:, 1]
     mean = 0.5 * (along[i] + along[j])
     agree = (along[i] * along[j]).sum(1) > 0
-    step = (model.rest[j] - model.rest[i]) * mean
+    delta = model.rest[j] - model.rest[i]
+    level = 0.5 * (model.straight[i] + model.straight[j])
+    delta[:, 1] += level * ((positions[j, 1] - positions[i, 1]) - delta[:, 1])
+    step = delta * mean
     diff = np.where(agree, step.sum(1) * 2.0 / (model.wavelength[i] + model.wavelength[j]), 0.0)
     return model.integrate(model.incidence.T @ diff)
