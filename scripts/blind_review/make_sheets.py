@@ -21,6 +21,8 @@ for s in range(0, len(items), 6):
     for k, it in enumerate(items[s:s + 6]):
         n = s + k + 1
         im = Image.open(it["path"]).convert("RGBA")
+        if im.size != (320, 320):  # renders of any size fill the cell whole (pasted as-is, 448² lost the mouth)
+            im = im.resize((320, 320), Image.LANCZOS)
         bg = Image.new("RGBA", im.size, "white"); bg.alpha_composite(im)
         x, y = (k % 3) * 320, (k // 3) * (320 + 36)
         sheet.paste(bg.convert("RGB"), (x, y + 36))
