@@ -426,7 +426,8 @@ def test_analyse_a_video_gives_a_timeline(client, tmp_path):
     assert result["kind"] == "video" and result["frames"] == 5
     assert any(t.get("au") == 12 for t in result["timeline"]["tracks"])
     preview = client.post("/api/timeline/preview", json={"timeline": result["timeline"]}).json()
-    assert preview["frames"] == 5 and max(preview["curves"]["12"]["left"]) > 0   # what the 3-D view plays
+    # what the 3-D view plays (the side the fit gives the smile follows the AU basis; either will do)
+    assert preview["frames"] == 5 and max(max(curve) for curve in preview["curves"]["12"].values()) > 0
 
 
 def test_analyse_refuses_what_is_not_a_face_picture(client):
