@@ -112,7 +112,7 @@ def build_wrinkles(anat: Anatomy, net: TensionNet, spec: dict) -> WrinkleModel:
     integrate = spla.factorized((incidence.T @ incidence + 1e-4 * sp.identity(n)).tocsc())
     return WrinkleModel(
         triangles=tri, rest_inverse=inv, rest_frame=frame, to_vertex=to_vertex.tocsr(), rest=rest,
-        wavelength=wavelength, zone_gain=zone_gain, across_gain=across_gain, straight=np.clip(straight * 2.0, 0.0, 1.0), crease=crease,
+        wavelength=wavelength, zone_gain=zone_gain, across_gain=across_gain, straight=np.clip(straight * 4.0, 0.0, 1.0), crease=crease,
         on_face=on_face,
         gain=float(w["gain"]), threshold=float(w["threshold"]), exponent=float(w["exponent"]),
         smooth=smooth.tocsr(), passes=int(w.get("smoothing", 2)),
