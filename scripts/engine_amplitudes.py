@@ -3,11 +3,16 @@
 Measured on the deformed mesh, against the character's neutral face:
 chin and lower-lip drop, lower-teeth (jaw) drop, the lips' inner gap at the
 midline, inner and outer brow rise (mean of both sides), and the change of the
-distance between the inner brows (negative: drawn together, AU 4).
+distance between the inner brows (negative: drawn together, AU 4); for the
+lower face, the lip corners' rise (mean of both sides), the change of the
+mouth's width, the rise of the upper lip's inner edge at the midline, the
+forward motion of the lips, and how far the upper lip's inner edge lies above
+the upper incisors' edge (positive: that much upper tooth shows when the lips
+are parted; about -1 at rest).
 
 Usage::
 
-    python3 scripts/engine_amplitudes.py [--character ava] [--engines registers muscle] [EXPR ...]
+    python3 scripts/engine_amplitudes.py [--character ava] [--engines registers muscle] [--lower] [EXPR ...]
 """
 from __future__ import annotations
 
@@ -18,8 +23,12 @@ import numpy as np
 #: What the table shows by default: the jaw and lip parting, the brows, and the emotions using them.
 EXPRESSIONS = ["25", "26", "27", "25+26", "1", "2", "4", "1+2", "1+4", "1+2+4",
                "surprise", "fear", "sadness"]
+#: The lower face's AUs and the emotions that use them (``--lower``).
+LOWER = ["10", "12", "12C", "6+12", "6+12+25", "14", "15", "16", "16+25", "17", "20", "20+25",
+         "22", "23", "24", "25", "9+15+16", "happiness", "disgust", "fear", "anger", "sadness"]
 MM = 100.0
 COLUMNS = ("chin", "lo-lip", "jaw", "gap", "in-brow", "out-brow", "brow-dx")
+LOWER_COLUMNS = ("lo-lip", "jaw", "gap", "corner", "width", "up-lip", "protr", "teeth")
 
 
 def amplitudes(face, expression) -> dict[str, float]:
@@ -34,7 +43,9 @@ def amplitudes(face, expression) -> dict[str, float]:
         expression = emotion(expression)
     p = np.asarray(face.deform(expression).positions, float)
     shape = mouth_shape(face, positions=p)
-    rest_gap = mouth_shape(face, positions=rest).gap
+    rest_shape = mouth_shape(face, positions=rest)
+    gauge = face._mouth_gauge
+    corners = [marks["lip_corner_left"], marks["lip_corner_right"]]
 
     def rise(name):
         return MM * np.mean([p[marks[f"{name}_{s}"], 1] - rest[marks[f"{name}_{s}"], 1] for s in ("left", "right")])
@@ -46,10 +57,15 @@ def amplitudes(face, expression) -> dict[str, float]:
         "chin": MM * (rest[marks["chin"], 1] - p[marks["chin"], 1]),
         "lo-lip": MM * (rest[marks["lower_lip"], 1] - p[marks["lower_lip"], 1]),
         "jaw": shape.jaw_drop,
-        "gap": shape.gap - rest_gap,
+        "gap": shape.gap - rest_shape.gap,
         "in-brow": rise("inner_brow"),
         "out-brow": rise("outer_brow"),
         "brow-dx": MM * (spread(p) - spread(rest)),
+        "corner": MM * np.mean(p[corners, 1] - rest[corners, 1]),
+        "width": shape.width - rest_shape.width,
+        "up-lip": MM * (p[gauge.upper_lip, 1] - rest[gauge.upper_lip, 1]),
+        "protr": shape.protrusion,
+        "teeth": MM * (p[gauge.upper_lip, 1] - p[gauge.incisor_edge, 1]),
     }
 
 
@@ -57,18 +73,22 @@ def main(argv=None) -> None:
     from facsim.face import Face
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("expressions", nargs="*", default=EXPRESSIONS)
+    parser.add_argument("expressions", nargs="*")
+    parser.add_argument("--lower", action="store_true",
+                        help="the lower face's AUs and columns (lip corners, width, upper lip, teeth)")
     parser.add_argument("--character", default="ava")
     parser.add_argument("--engines", nargs="+", default=["registers", "muscle"])
     args = parser.parse_args(argv)
+    columns = LOWER_COLUMNS if args.lower else COLUMNS
+    expressions = args.expressions or (LOWER if args.lower else EXPRESSIONS)
 
     faces = {name: Face(args.character, engine=name) for name in args.engines}
     print(f"{args.character}: motion from neutral in mm (gap: change of the lips' inner gap)")
-    print(f"{'expression':<12}{'engine':<10}" + "".join(f"{c:>9}" for c in COLUMNS))
-    for expr in args.expressions:
+    print(f"{'expression':<12}{'engine':<10}" + "".join(f"{c:>9}" for c in columns))
+    for expr in expressions:
         for name, face in faces.items():
             row = amplitudes(face, expr)
-            print(f"{expr:<12}{name:<10}" + "".join(f"{row[c]:9.1f}" for c in COLUMNS))
+            print(f"{expr:<12}{name:<10}" + "".join(f"{row[c]:9.1f}" for c in columns))
 
 
 if __name__ == "__main__":
