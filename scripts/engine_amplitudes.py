@@ -7,10 +7,15 @@ distance between the inner brows (negative: drawn together, AU 4).
 With ``--upper``: the upper-face figures instead — brow rise and spread, the
 glabella's drop, the upper and lower lids' rise, the eye's aperture change
 (negative: narrowed), the cheek's and nose wing's rise (AU 6, 9, 10).
+With ``--lower``: the lower face — the lip corners' rise (mean of both sides),
+the change of the mouth's width, the rise of the upper lip's inner edge at the
+midline, the forward motion of the lips, and how far the upper lip's inner
+edge lies above the upper incisors' edge (positive: that much upper tooth
+shows when the lips are parted; about -1 at rest).
 
 Usage::
 
-    python3 scripts/engine_amplitudes.py [--character ava] [--engines registers muscle] [--upper] [EXPR ...]
+    python3 scripts/engine_amplitudes.py [EXPR ...] [--character ava] [--upper | --lower] [--engines registers muscle]
 """
 from __future__ import annotations
 
@@ -21,12 +26,16 @@ import numpy as np
 #: What the table shows by default: the jaw and lip parting, the brows, and the emotions using them.
 EXPRESSIONS = ["25", "26", "27", "25+26", "1", "2", "4", "1+2", "1+4", "1+2+4",
                "surprise", "fear", "sadness"]
+#: The lower face's AUs and the emotions that use them (``--lower``).
+LOWER = ["10", "12", "12C", "6+12", "6+12+25", "14", "15", "16", "16+25", "17", "20", "20+25",
+         "22", "23", "24", "25", "9+15+16", "happiness", "disgust", "fear", "anger", "sadness"]
 MM = 100.0
 COLUMNS = ("chin", "lo-lip", "jaw", "gap", "in-brow", "out-brow", "brow-dx")
 #: The upper face (``--upper``): AUs 1, 2, 4, 5, 6, 7, 9, 41-44 and the emotions that show them.
 UPPER_EXPRESSIONS = ["1", "2", "4", "1+2", "1+4", "1+2+4", "5", "6", "7", "9", "41", "42", "43", "44",
                      "anger", "fear", "sadness", "surprise", "disgust", "happiness"]
 UPPER_COLUMNS = ("in-brow", "out-brow", "brow-dx", "glab", "up-lid", "lo-lid", "aperture", "cheek", "nose")
+LOWER_COLUMNS = ("lo-lip", "jaw", "gap", "corner", "width", "up-lip", "protr", "teeth")
 
 
 def amplitudes(face, expression) -> dict[str, float]:
@@ -41,7 +50,9 @@ def amplitudes(face, expression) -> dict[str, float]:
         expression = emotion(expression)
     p = np.asarray(face.deform(expression).positions, float)
     shape = mouth_shape(face, positions=p)
-    rest_gap = mouth_shape(face, positions=rest).gap
+    rest_shape = mouth_shape(face, positions=rest)
+    gauge = face._mouth_gauge
+    corners = [marks["lip_corner_left"], marks["lip_corner_right"]]
 
     def rise(name):
         return MM * np.mean([p[marks[f"{name}_{s}"], 1] - rest[marks[f"{name}_{s}"], 1] for s in ("left", "right")])
@@ -53,7 +64,7 @@ def amplitudes(face, expression) -> dict[str, float]:
         "chin": MM * (rest[marks["chin"], 1] - p[marks["chin"], 1]),
         "lo-lip": MM * (rest[marks["lower_lip"], 1] - p[marks["lower_lip"], 1]),
         "jaw": shape.jaw_drop,
-        "gap": shape.gap - rest_gap,
+        "gap": shape.gap - rest_shape.gap,
         "in-brow": rise("inner_brow"),
         "out-brow": rise("outer_brow"),
         "brow-dx": MM * (spread(p) - spread(rest)),
@@ -63,6 +74,11 @@ def amplitudes(face, expression) -> dict[str, float]:
         "aperture": rise("upper_lid") - rise("lower_lid"),
         "cheek": rise("cheek"),
         "nose": rise("nose_wing"),
+        "corner": MM * np.mean(p[corners, 1] - rest[corners, 1]),
+        "width": shape.width - rest_shape.width,
+        "up-lip": MM * (p[gauge.upper_lip, 1] - rest[gauge.upper_lip, 1]),
+        "protr": shape.protrusion,
+        "teeth": MM * (p[gauge.upper_lip, 1] - p[gauge.incisor_edge, 1]),
     }
 
 
@@ -71,12 +87,17 @@ def main(argv=None) -> None:
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("expressions", nargs="*")
+    parser.add_argument("--lower", action="store_true",
+                        help="the lower face's AUs and columns (lip corners, width, upper lip, teeth)")
     parser.add_argument("--character", default="ava")
     parser.add_argument("--engines", nargs="+", default=["registers", "muscle"])
     parser.add_argument("--upper", action="store_true", help="upper-face columns (brows, lids, cheek, nose)")
     args = parser.parse_args(argv)
-    columns = UPPER_COLUMNS if args.upper else COLUMNS
-    expressions = args.expressions or (UPPER_EXPRESSIONS if args.upper else EXPRESSIONS)
+    if args.upper and args.lower:
+        parser.error("choose one of --upper and --lower")
+    columns, defaults = ((UPPER_COLUMNS, UPPER_EXPRESSIONS) if args.upper else
+                         (LOWER_COLUMNS, LOWER) if args.lower else (COLUMNS, EXPRESSIONS))
+    expressions = args.expressions or defaults
 
     faces = {name: Face(args.character, engine=name) for name in args.engines}
     print(f"{args.character}: motion from neutral in mm (gap: change of the lips' inner gap)")

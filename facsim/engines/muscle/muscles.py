@@ -197,8 +197,12 @@ class _Builder:
         # Lid muscles lie on the tarsus, right under the skin; elsewhere half a tissue depth down.
         depth = 0.0 if on_eye else INSERTION_DEPTH * (w * self.net.depth[heads]).sum()
         node = self.node(centre - depth * normal, vid, 0.1 * self.net.depth[vid])
+        # `stiffness` (relative) ties a strong muscle's point more firmly to its skin: through the
+        # default arcs a tension T stretches them T / insertion, and zygomaticus major reached its
+        # pulley (the fiber fully shortened) with the lip corner only 10 mm up (issue 13).
+        k = self.c["insertion"] * float(sel.get("stiffness", 1.0))
         for h, wh in zip(heads, w):
-            self.arc(node, int(h), self.c["insertion"] * wh)
+            self.arc(node, int(h), k * wh)
         return node, heads, w
 
     def guide(self, sel: dict, side: str, on_jaw: bool) -> int:
