@@ -217,9 +217,18 @@ def test_jaw_opens_more_on_open_vowels(face_of, said, engine):
 
 
 def test_muscle_engine_closes_the_lips_on_bilabials(face_of, said):
+    """At equilibrium the lip muscles close the lips on /p b m/ even against a smile.
+
+    Solved to equilibrium (4 increments x 40 iterations): the default static budget (2 x 20)
+    stops short of the lips' contact, and where it stops moves with any change of the net
+    (the gap there ranged from -1.6 to +1.5 mm over single-muscle edits; converged, -1.4).
+    """
     face = face_of("ava", "muscle")
-    phones, shapes = _shapes(face, said[PANGRAM], BILABIAL, "happiness")
-    assert max(s.gap for s in shapes) <= 1.0
+    phones = [p for p in said[PANGRAM].phones if p.name in BILABIAL]
+    gauge = MouthGauge(face.head, face.neutral)
+    acts = _activations(said[PANGRAM], [p.middle for p in phones], "happiness")
+    shapes = [gauge.measure(d.positions) for d in face.engine.deform_many(acts, steps=4, iterations=40)]
+    assert len(shapes) >= 3 and max(s.gap for s in shapes) <= 1.0
 
 
 def test_a_compressed_recording_aligns_too(said, tmp_path):
