@@ -224,6 +224,19 @@ def test_lids_lips_and_neck_stay_physical_on_other_characters(face_of, head, cha
     assert not problems, "\n".join(problems)
 
 
+def test_fear_and_closed_eye_smiles_stay_physical_on_amara(face_of, head):
+    """Amara's lids are the tightest of the presets: anger's glare rule (5 raised 1.5x under
+    lowered brows) folded her upper lid in fear's 1+2+4+5, and 12's raised cheek with closed
+    eyes her outer corner; the rule now yields to 1/2, and 12 halves its cheek raise there."""
+    from facsim.engines.checks import GeometryCheck
+
+    engine = face_of("amara").engine
+    check = GeometryCheck(head, engine.neutral)
+    texts = ["1+2+4+5+20+26", "1+2+4+5", "1+2+4+5+7+20+26", "12E+43E", "12E+45E", "12E+L46E"]
+    problems = [q for text in texts for q in _geometry_problems(engine, check, text)]
+    assert not problems, "\n".join(problems)
+
+
 def _eye_seen(head, positions, side, within=None) -> int:
     """How many of the eyeball's points (its front within 40 degrees of its gaze, or the local
     points ``within`` selects) are seen from straight ahead: no skin triangle between them and the

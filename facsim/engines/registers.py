@@ -115,9 +115,10 @@ def register_weights(act: Activations) -> dict[Column, float]:
 def combination_scales(act: Activations, code: int, side: str) -> dict[str, float]:
     """Target → factor on AU ``code``'s maxima on ``side`` from the table's ``combinations``.
 
-    A rule applies when every AU it names acts on that side. Its factor applies in
-    full when the other AUs of the rule act at least as strongly as ``code`` and
-    fades with their share of ``code``'s intensity, so the face moves smoothly as a
+    A rule applies when every AU it names acts on that side and none of those it
+    lists under ``unless`` does. Its factor applies in full when the other AUs of the
+    rule act at least as strongly as ``code`` and fades with their share of ``code``'s
+    intensity (and out with an ``unless`` AU's), so the face moves smoothly as a
     partner AU fades in. The whole expression at half intensity (HapFACS's 50 %
     emotions) keeps the combination's appearance: both AUs are halved, the conflict
     between them is the same, so is the rule (fear at 50 % keeps raised inner brows).
@@ -130,6 +131,8 @@ def combination_scales(act: Activations, code: int, side: str) -> dict[str, floa
     0.725
     >>> combination_scales(Activations({(4, "left"): 1.0}), 4, "left")
     {}
+    >>> combination_scales(Activations({(1, "left"): 1.0, (4, "left"): 1.0, (5, "left"): 1.0}), 5, "left")
+    {}
     """
     out: dict[str, float] = {}
     level = act[code, side]
@@ -141,6 +144,8 @@ def combination_scales(act: Activations, code: int, side: str) -> dict[str, floa
             continue
         partners = [act[c, side] for c in rule["when"] if c != code]
         share = min(1.0, min(partners, default=level) / level)
+        # ``unless``: AUs that undo the rule's reason fade it out as they come in
+        share *= 1.0 - min(1.0, max((act[c, side] for c in rule.get("unless", ())), default=0.0) / level)
         if share <= 0.0:
             continue
         factor = 1.0 - share * (1.0 - float(scale["by"]))
