@@ -28,7 +28,7 @@ LIVE_LINK_FACE_HEADER = (
 PERFORMANCE = Timeline((
     Track(facs="1+2+26", timing=Envelope(0.1, 0.4, 0.5, 0.4, 0.85)),
     Track(au=12, side="left", timing=(Segment(0.2, 0.6, 0.0, 0.55, "smoothstep"), Segment(0.9, 1.3, 0.55, 0.0))),
-    Track(au=45, timing=Envelope(0.8, 0.1, 0.0, 0.15)),
+    Track(au=45, timing=Envelope(0.0, 0.08, 0.0, 0.1)),  # before the smile: with 12, the 12+45 rule halves 12's cheek raise
     Track(au=4, timing=Hold(1.4, 1.5, 0.3)),       # after 1 has gone: with 1, the 1+4 rule scales 4's brow-lowering
     Track(au=51, timing=Envelope(0.0, 0.5, 0.3, 0.5, 0.6)),
     Track(au=54, timing=Hold(0.3, 0.9, 0.4)),
