@@ -160,7 +160,6 @@ class Face:
         shadowed by it and the mouth darkening with depth."""
         from facsim.head.mouth import mouth_depth_visibility
         from facsim.head.proxies import hair_shadow
-
         from facsim.head.skin import CONTACT_DEPTH, contact_shadow
 
         occlusion = np.array(self.occlusion, np.float32, copy=True)
@@ -171,7 +170,6 @@ class Face:
         occlusion[interior] = visibility
         for bound in self.proxies:
             if bound.proxy.kind == "hair":
-                skin = self.head.skin
                 hair = bound.binding.positions(self.neutral)
                 occlusion[skin] *= hair_shadow(self.neutral[skin], hair,
                                                triangles=bound.proxy.corner_vertex[bound.proxy.triangles])
@@ -207,14 +205,13 @@ class Face:
     def _lid_margins(self) -> dict:
         """Side -> (eye centre, upper, lower lid-margin skin vertices) (the lashes' roots), told
         apart at rest: a margin vertex above the line between the eye's corners is the upper lid's."""
-        from facsim.render.geometry import _spherical
+        from facsim.engines.lids import lid_margin, spherical
 
-        anchors = np.unique(self.head.lash_anchors)
         out = {}
         for side in self.head.eye_vertices:
             centre, radius = self.head.eye_pivot(self.base_positions, side)
-            margin = anchors[np.linalg.norm(self.neutral[anchors] - centre, axis=1) < 2 * radius]
-            lam, phi = _spherical(self.neutral[margin].astype(float), centre)
+            margin = lid_margin(self.head, self.neutral, centre, radius)
+            lam, phi = spherical(self.neutral[margin].astype(float), centre)
             a, b = np.argmin(lam), np.argmax(lam)
             corners = np.interp(lam, [lam[a], lam[b]], [phi[a], phi[b]])
             out[side] = (centre, margin[phi > corners], margin[phi < corners])

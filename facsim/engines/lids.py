@@ -58,6 +58,12 @@ def spherical(points: np.ndarray, centre: np.ndarray) -> tuple[np.ndarray, np.nd
     return np.degrees(np.arctan2(q[..., 0], q[..., 2])), np.degrees(np.arcsin(np.clip(q[..., 1] / r, -1, 1)))
 
 
+def lid_margin(head, positions: np.ndarray, centre: np.ndarray, radius: float) -> np.ndarray:
+    """The lid-margin skin vertices (the lashes' roots) of the eye at ``centre``, both lids."""
+    anchors = np.unique(head.lash_anchors)
+    return anchors[np.linalg.norm(np.asarray(positions)[anchors] - centre, axis=1) < 2 * radius]
+
+
 class EyeLids:
     """One eye's lids, found from a closing target on a character's neutral skin.
 

@@ -205,34 +205,30 @@ class RegisterEngine:
     def lids(self) -> dict:
         """(target, side) -> :class:`~facsim.engines.lids.EyeLids` for the closing targets
         (``lid_closing`` in the table)."""
-        from facsim.engines.lids import EyeLids
+        from facsim.engines.lids import EyeLids, lid_margin
 
         skin = self.head.skin_vertex_count
-        anchors = np.unique(self.head.lash_anchors)
         out = {}
         for pattern in register_table().get("lid_closing", ()):
             for side in ("left", "right"):
                 centre, radius = self.head.eye_pivot(self.base_positions, side)
-                margin = anchors[np.linalg.norm(self.sculpted[anchors] - centre, axis=1) < 2 * radius]
                 out[pattern, side] = EyeLids(self.sculpted[:skin], self.column(Column(pattern, side))[:skin],
-                                             centre, radius, margin)
+                                             centre, radius, lid_margin(self.head, self.sculpted, centre, radius))
         return out
 
     @cached_property
     def rest_lids(self):
         """The relaxed upper lids at rest (:class:`~facsim.engines.lids.RestLids`, ``lids.yaml``)."""
-        from facsim.engines.lids import RestLids, rest_table
+        from facsim.engines.lids import RestLids, lid_margin, rest_table
 
         skin = self.head.skin_vertex_count
-        anchors = np.unique(self.head.lash_anchors)
         pattern = rest_table()["target"]
 
         def eye(side):
             return self.head.eye_pivot(self.base_positions, side)
 
         def margin(side):
-            centre, radius = eye(side)
-            return anchors[np.linalg.norm(self.sculpted[anchors] - centre, axis=1) < 2 * radius]
+            return lid_margin(self.head, self.sculpted, *eye(side))
 
         return RestLids.measure(self.sculpted[:skin], lambda side: self.column(Column(pattern, side))[:skin], eye, margin)
 
@@ -243,9 +239,9 @@ class RegisterEngine:
 
     def weights(self, act: Activations) -> dict[Column, float]:
         """Column weights of ``act`` (Eq. 1) plus the relaxed lids' share of the closing target."""
-        weights = register_weights(act)
         from facsim.engines.lids import rest_table
 
+        weights = register_weights(act)
         for side in ("left", "right"):
             share = self.rest_lids.share(act, side)
             if share:

@@ -20,6 +20,7 @@ import math
 import numpy as np
 import scipy.sparse as sp
 
+from facsim.engines.lids import spherical
 from facsim.head.mesh import REGIONS, RenderTopology
 from facsim.head.surface import normal_operator, vertex_normals  # noqa: F401 — re-exported for the renderer
 
@@ -212,23 +213,16 @@ def lid_shade(positions: np.ndarray, centre: np.ndarray, eye: np.ndarray, upper:
     True
     """
     p = np.asarray(positions)
-    lam, phi = _spherical(p[eye].astype(np.float64), centre)
+    lam, phi = spherical(p[eye].astype(np.float64), centre)
     out = np.ones(len(eye))
     for margin, (depth, reach), sign in ((upper, UPPER_LID_SHADE, 1.0), (lower, LOWER_LID_SHADE, -1.0)):
         if len(margin) < 2:
             continue
-        m_lam, m_phi = _spherical(p[margin].astype(np.float64), centre)
+        m_lam, m_phi = spherical(p[margin].astype(np.float64), centre)
         order = np.argsort(m_lam)
         inside = np.maximum(sign * (np.interp(lam, m_lam[order], m_phi[order]) - phi), 0.0)
         out *= 1.0 - depth * np.exp(-inside / reach)
     return out.astype(np.float32)
-
-
-def _spherical(points: np.ndarray, centre: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Azimuth about +Y from +Z (degrees) and elevation (degrees) of points about ``centre``."""
-    q = points - centre
-    r = np.maximum(np.linalg.norm(q, axis=-1), 1e-12)
-    return np.degrees(np.arctan2(q[..., 0], q[..., 2])), np.degrees(np.arcsin(np.clip(q[..., 1] / r, -1, 1)))
 
 
 #: The upper lid's crease (the supratarsal fold, where the levator's fibres pull the lid skin
@@ -260,7 +254,7 @@ def lid_crease_shade(positions: np.ndarray, centre: np.ndarray, vertices: np.nda
 
 def _height_above(p: np.ndarray, centre: np.ndarray, vertices: np.ndarray, upper: np.ndarray) -> np.ndarray:
     """Height (dm) of ``vertices`` above the upper margin at their azimuth about ``centre``."""
-    lam, _ = _spherical(p[vertices].astype(np.float64), centre)
-    m_lam, _ = _spherical(p[upper].astype(np.float64), centre)
+    lam, _ = spherical(p[vertices].astype(np.float64), centre)
+    m_lam, _ = spherical(p[upper].astype(np.float64), centre)
     order = np.argsort(m_lam)
     return p[vertices, 1] - np.interp(lam, m_lam[order], p[upper, 1][order])

@@ -42,13 +42,6 @@ STATIC_ITERATIONS = 20
 JAW_DEGREES_PER_STEP = 10.0
 #: At most this many extra rounds of iterations for a static solve that ends with folded skin.
 POLISH_ROUNDS = 5
-#: A static solve may keep relaxing, at most this many more rounds of ``iterations``, while a round
-#: still moves some skin point further than :data:`SETTLED_DM` (issue 13: anger's brows stood at
-#: 60 % of their settled depth after the fixed 2 x 20 iterations). Off (0) for now: settled static
-#: solves cost 2.4x the CPU, drift 0.26 mm between batched and single solves (the stop is per
-#: configuration), and the animation path then lags them (tests/test_muscle_engine.py).
-CONVERGE_ROUNDS = 0
-SETTLED_DM = 0.002
 #: Expressions solved together by :meth:`MuscleEngine.solve_many`.
 BATCH = 4
 #: Iterations per animation frame (the state carries over, so frames converge over time).
@@ -167,25 +160,43 @@ class MuscleEngine:
         self.sculpted = sculpted.astype(np.float32)
         self.parts = _Parts(head, data, sculpted, self.model.net)
         self.rigid = RigidMotion(head, base_positions)
-        self.rest_lids = _rest_lids(head, data, base_positions, self.sculpted, self.model.net)
+        self.rest_lids = self._measure_rest_lids()
         self.state = solver.rest_state(self.model)
         # The solver keeps its contact points off the eyes; this last step checks every skin point.
         self.guard = SkinGuard(head, self.sculpted, list(self.model.net.eye_centre), self.model.net.eye_radius,
                                neck_below=float(head.joint(base_positions, "joint-jaw")[1]))
 
     @cached_property
+    def _closing_columns(self) -> dict:
+        """Side -> the closing target's motion of the net's skin points (``lids.yaml``'s target)."""
+        from facsim.engines.lids import closing_column, rest_table
+
+        return {side: closing_column(self.head, self.data, self.base_positions, rest_table()["target"], side)
+                [: self.model.net.count] for side in SIDES}
+
+    def _margin(self, side: str) -> np.ndarray:
+        from facsim.engines.lids import lid_margin
+
+        net = self.model.net
+        return lid_margin(self.head, self.sculpted, net.eye_centre[SIDES.index(side)], net.eye_radius)
+
+    def _measure_rest_lids(self):
+        """The relaxed lids (:class:`~facsim.engines.lids.RestLids`) measured on the sculpted skin."""
+        from facsim.engines.lids import RestLids
+
+        net = self.model.net
+        return RestLids.measure(self.sculpted[:net.count], self._closing_columns.__getitem__,
+                                lambda side: (net.eye_centre[SIDES.index(side)], net.eye_radius), self._margin)
+
+    @cached_property
     def eyelids(self) -> dict:
         """Side -> :class:`~facsim.engines.lids.EyeLids` on the sculpted skin."""
-        from facsim.engines.lids import EyeLids, closing_column, rest_table
+        from facsim.engines.lids import EyeLids
 
-        count, net = self.model.net.count, self.model.net
-        anchors = np.unique(self.head.lash_anchors)
-        out = {}
-        for side, centre in zip(SIDES, net.eye_centre):
-            margin = anchors[np.linalg.norm(self.sculpted[anchors] - centre, axis=1) < 2 * net.eye_radius]
-            column = closing_column(self.head, self.data, self.base_positions, rest_table()["target"], side)[:count]
-            out[side] = EyeLids(self.sculpted[:count], column, centre, net.eye_radius, margin)
-        return out
+        net = self.model.net
+        return {side: EyeLids(self.sculpted[:net.count], self._closing_columns[side], centre, net.eye_radius,
+                              self._margin(side))
+                for side, centre in zip(SIDES, net.eye_centre)}
 
     @cached_property
     def neutral(self) -> np.ndarray:
@@ -298,34 +309,9 @@ def solve_static(model, target, *, steps: int, iterations: int) -> solver.State:
         # Only the folded ones take the extra round (so a batch solves each alike to alone).
         state = solver.State(np.where(folded[None, :, None], more.x, state.x), target,
                              np.where(folded[:, None], more.jaw, state.jaw))
-    # Not yet at rest: relax further while a round still moves the skin (per configuration).
-    active = np.ones(state.x.shape[1], bool)
-    skin = model.net.count
-    for _ in range(CONVERGE_ROUNDS):
-        more = solver.solve(model, state, target, steps=1, iterations=iterations)
-        moved = np.sqrt(((more.x[:, :, :skin] - state.x[:, :, :skin]) ** 2).sum(axis=0)).max(axis=1)
-        state = solver.State(np.where(active[None, :, None], more.x, state.x), target,
-                             np.where(active[:, None], more.jaw, state.jaw))
-        active &= moved > SETTLED_DM
-        if not active.any():
-            break
+    # Not at rest after these rounds (issue 13: anger's brows stood at 60 % of their settled depth);
+    # relaxing until settled cost 2.4x the CPU and the animation path then lagged it: not done.
     return state
-
-
-def _rest_lids(head, data, base_positions, sculpted, net):
-    """The relaxed lids (:class:`~facsim.engines.lids.RestLids`) measured on the sculpted skin."""
-    from facsim.engines.lids import RestLids, closing_column, rest_table
-
-    count = net.count
-    anchors = np.unique(head.lash_anchors)
-    centres = dict(zip(SIDES, net.eye_centre))
-
-    def margin(side):
-        return anchors[np.linalg.norm(sculpted[anchors] - centres[side], axis=1) < 2 * net.eye_radius]
-
-    return RestLids.measure(sculpted[:count],
-                            lambda side: closing_column(head, data, base_positions, rest_table()["target"], side)[:count],
-                            lambda side: (centres[side], net.eye_radius), margin)
 
 
 _MODELS: dict = {}
