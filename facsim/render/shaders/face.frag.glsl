@@ -67,19 +67,42 @@ uniform vec3 u_cheek;
 uniform float u_wrinkle_darken;
 
 #ifdef USE_WRINKLE
-// Creases: thin dark furrows with a faint lit ridge beside each, one at each whole number of
-// the crease phase (v_crease, in furrow spacings), slightly wavy, fading in with the wrinkle
-// amount and to their mean where they would be finer than a pixel.
-float crease_shade(float wrinkle, float phase, vec2 uv) {
-    float s = phase + 0.5 * value_noise(uv * vec2(40.0, 25.0), 0);
-    float c = cos(2.0 * PI * s);
-    float valley = pow(0.5 + 0.5 * c, 10.0);
-    float ridge = pow(0.5 + 0.5 * cos(2.0 * PI * (s + 0.22)), 8.0);
-    float lines = 1.0 - 0.55 * valley + 0.12 * ridge;
-    float detail = clamp(2.0 - 3.0 * fwidth(s), 0.0, 1.0);
-    float amount = smoothstep(0.15, 0.9, wrinkle);
-    float cavity = 1.0 - u_wrinkle_darken * clamp(wrinkle, 0.0, 1.0);
-    return mix(1.0, mix(0.93, lines, detail), amount) * cavity;
+// Creases as folds of skin, not painted lines (issue 13: "stamped/carved"): compressed skin
+// buckles into rounded rolls with a narrow crevice between them. One crevice at each whole
+// number of the crease phase (v_crease, in furrow spacings; slightly wavy). The fold is a
+// height profile across the furrows: a broad roll (the bulge between two furrows) minus a
+// narrow crevice. Its slope tilts the shading normal (crease_height's gradient, in
+// main()), so the key light catches one flank of each roll and leaves the other in soft
+// shade, as on real skin; only the bottom of the crevice darkens (light cannot reach it).
+// Each line has its own depth, and the depth varies along it (lines fade out, break and
+// restart); all of it grows with the wrinkle amount, so lines fade at their ends.
+struct Fold {
+    float slope;     // dH/ds: height change per furrow spacing (dm)
+    float crevice;   // 0..1 how deep in a crevice the point lies (occlusion)
+    float s;         // the wavy phase (for its screen derivatives)
+};
+Fold crease_fold(float wrinkle, float phase, vec2 uv) {
+    float s = phase + 0.3 * value_noise(uv * vec2(40.0, 25.0), 0);
+    float line = floor(s + 0.5);
+    float t = s - line;                                       // -0.5 .. 0.5, crevice at 0
+    float aa = fwidth(s);
+    // Depth along the line: per-line (hash) times a slow variation along it.
+    float along = value_noise(uv * vec2(22.0, 44.0) + 9.0 * hash2(ivec2(int(line), 3)), 0);
+    float depth = (0.5 + 0.5 * hash2(ivec2(int(line), 11))) * smoothstep(0.1, 0.55, along);
+    float amount = smoothstep(0.1, 0.9, wrinkle) * (0.7 + 0.3 * clamp(wrinkle - 0.9, 0.0, 1.0));
+    // The crevice is widened where it would be finer than a pixel, keeping its area (a
+    // pre-filter: no aliasing, no shimmer as the face moves); the roll fades to flat when
+    // the furrows themselves are finer than a few pixels.
+    const float W = 0.075;
+    float w = max(W, 0.8 * aa);
+    float g = exp(-(t * t) / (w * w));
+    float roll = clamp(2.0 - 4.0 * aa, 0.0, 1.0);
+    Fold f;
+    // H(t) = A (-0.5 cos 2 pi t) - C exp(-t^2 / w^2): roll 0.6 mm high, crevice 0.3 mm deep.
+    f.slope = amount * depth * (roll * 0.016 * PI * sin(2.0 * PI * t) + 0.007 * (W / w) * 2.0 * t / (w * w) * g);
+    f.crevice = amount * depth * (W / w) * exp(-(t * t) / (2.2 * w * w));
+    f.s = s;
+    return f;
 }
 #endif
 
@@ -205,8 +228,19 @@ void main() {
     float hair = brow.x;
     albedo = mix(albedo, u_brows * brow.y, hair);
     float cavity = 1.0 - 0.42 * u_age * detail.a;   // age lines and folds
+    // Surface frame for bump mapping from screen derivatives (Mikkelsen's surface gradient):
+    // a height h tilts the normal to normalize(|det| n - sign(det) (dh/dx r1 + dh/dy r2)).
+    vec3 dpdx = dFdx(v_pos), dpdy = dFdy(v_pos);
+    vec3 r1 = cross(dpdy, n), r2 = cross(n, dpdx);
+    float det = dot(dpdx, r1);
+    vec3 n_smooth = n;
 #ifdef USE_WRINKLE
-    cavity *= crease_shade(v_wrinkle, v_crease, v_uv);
+    Fold fold = crease_fold(v_wrinkle, v_crease, v_uv);
+    // Compressed skin is a little darker overall (blood pushed together, less light between
+    // the rolls), and the crevices' bottoms darker still.
+    cavity *= (1.0 - u_wrinkle_darken * clamp(v_wrinkle, 0.0, 1.0)) * (1.0 - 0.4 * fold.crevice);
+    vec3 fold_grad = sign(det) * fold.slope * (dFdx(fold.s) * r1 + dFdy(fold.s) * r2);
+    n = normalize(abs(det) * n - fold_grad);
 #endif
 #ifdef USE_PORES
     // Pores and fine relief: small pits and a finer orange-peel bump (surface gradient from
@@ -216,9 +250,6 @@ void main() {
     vec2 pore_uv = v_uv * vec2(700.0, 1400.0);   // cells ~0.5 mm, round (1:2, see the spots)
     float pit = smoothstep(0.55, 0.85, value_noise(pore_uv, 0));
     float pore_h = 0.5 * value_noise(pore_uv * 0.37 + 3.0, 0) - pit;
-    vec3 dpdx = dFdx(v_pos), dpdy = dFdy(v_pos);
-    vec3 r1 = cross(dpdy, n), r2 = cross(n, dpdx);
-    float det = dot(dpdx, r1);
     vec3 grad = sign(det) * (dFdx(pore_h) * r1 + dFdy(pore_h) * r2);
     float pore_fade = clamp(2.2 - 2.5 * max(fwidth(pore_uv.x), fwidth(pore_uv.y)), 0.0, 1.0);
     float pore_amount = pore_fade * (0.3 + 1.2 * tone.b) * (1.0 - paint.g) * (1.0 - hair);
@@ -229,9 +260,6 @@ void main() {
     // height, surface gradient from screen derivatives: its cells span several pixels, so
     // the 2x2-quad derivative is smooth) tilts the normal a little, which breaks the sheen
     // into the irregular highlights of real skin instead of a plastic glaze.
-    vec3 dpdx = dFdx(v_pos), dpdy = dFdy(v_pos);
-    vec3 r1 = cross(dpdy, n), r2 = cross(n, dpdx);
-    float det = dot(dpdx, r1);
     vec3 grad = sign(det) * (dFdx(mottle) * r1 + dFdy(mottle) * r2);
     float relief = (0.0012 + 0.0008 * u_age) * (0.5 + tone.b) * (1.0 - paint.g) * (1.0 - hair);
     vec3 bumped = normalize(abs(det) * n - relief * grad);
