@@ -68,6 +68,13 @@ class Appearance:
     tone : (H, W, 4) uint8, optional
         Skin tone maps in the same UV space and row order: R = periorbital darkening,
         G = translucency, B = pore strength, A = sun exposure (see :mod:`facsim.head.skin`).
+    freckles : float
+        0 … 1: how densely freckles cover the sun-exposed skin (nose, cheekbones, forehead).
+    redness : float
+        0 … 2: how strongly the redder areas of ``detail`` show (1 = as painted).
+    seed : float
+        0 … 1000: where this person's skin patterns (mottling, moles, freckles) fall, so two
+        people of the same colouring do not share one skin.
     """
 
     colors: Mapping[str, tuple[float, float, float]] = field(default_factory=lambda: DEFAULT_COLORS)
@@ -76,6 +83,9 @@ class Appearance:
     beard: float = 0.0
     age: float = 0.0
     tone: np.ndarray | None = None
+    freckles: float = 0.0
+    redness: float = 1.0
+    seed: float = 0.0
 
     def __post_init__(self):
         colors = dict(self.colors)
@@ -105,10 +115,10 @@ class Appearance:
             tone = np.asarray(self.tone)
             if tone.ndim != 3 or tone.shape[2] != 4 or tone.dtype != np.uint8:
                 raise ValueError(f"tone must be an (H, W, 4) uint8 array, got {tone.dtype} {tone.shape}")
-        for name in ("beard", "age"):
+        for name, top in (("beard", 1.0), ("age", 1.0), ("freckles", 1.0), ("redness", 2.0), ("seed", 1000.0)):
             value = float(getattr(self, name))
-            if not 0.0 <= value <= 1.0:
-                raise ValueError(f"{name} must be in [0, 1], got {value}")
+            if not 0.0 <= value <= top:
+                raise ValueError(f"{name} must be in [0, {top:g}], got {value}")
             object.__setattr__(self, name, value)
 
 
@@ -143,6 +153,49 @@ BROW = {
 }
 
 
+@dataclass(frozen=True)
+class Complexion:
+    """How one person's skin departs from their group's typical colouring.
+
+    ``lightness`` scales the skin colour in linear light; ``undertone`` is -1 (cooler,
+    pinker) … 1 (warmer, more golden/olive); ``freckles`` and ``redness`` as in
+    :class:`Appearance`; ``seed`` places the person's skin patterns.
+    """
+
+    lightness: float = 1.0
+    undertone: float = 0.0
+    freckles: float = 0.0
+    redness: float = 1.0
+    seed: float = 0.0
+
+
+def complexion(character: Character) -> Complexion:
+    """The character's own complexion, drawn from a hash of who they are.
+
+    People of one ancestry differ widely in skin colour, undertone, freckling and
+    flushing (issue 13: reviewers said the same few identities repeat; every preset of an
+    ethnicity had one skin colour). Each character gets a fixed draw (a hash of its preset
+    name, or of its parameters for custom characters): lightness within about ±1 Fitzpatrick
+    step (wider for dark skin), an undertone, a redness, and freckles mostly on light skin (fewer with age: they
+    give way to age spots). The same character always gets the same complexion.
+    """
+    import hashlib
+
+    key = character.name or repr((character.gender, character.age, character.african, character.asian,
+                                  character.caucasian, character.muscle, character.weight,
+                                  sorted(character.face.items())))
+    digest = hashlib.sha256(f"complexion:{key}".encode()).digest()
+    u = [int.from_bytes(digest[4 * k: 4 * k + 4], "little") / 2 ** 32 for k in range(5)]
+    mix = character.ethnicity
+    light = float(mix.get("caucasian", 0.0)) + 0.4 * float(mix.get("asian", 0.0))
+    freckled = light * smoothstep(0.45, 0.75, u[2]) * (1.0 - 0.6 * float(np.clip((character.age - 30) / 40, 0, 1)))
+    # Dark skin spans a wider range of lightness (Fitzpatrick IV-VI) than light skin.
+    spread = 0.2 + 0.3 * float(mix.get("african", 0.0))
+    return Complexion(lightness=round(1.0 + spread * (2.0 * u[0] - 1.0), 3), undertone=round(2.0 * u[1] - 1.0, 3),
+                      freckles=round(float(freckled), 3), redness=round(0.6 + 0.8 * u[3], 3),
+                      seed=round(1000.0 * u[4], 2))
+
+
 def character_colors(character: Character) -> dict[str, tuple[float, float, float]]:
     """sRGB colours (0 … 1) for every key in :data:`COLOR_NAMES`, and the scalp ``hair``."""
     mix = character.ethnicity
@@ -152,6 +205,12 @@ def character_colors(character: Character) -> dict[str, tuple[float, float, floa
         return lin
 
     skin = blend("skin")
+    own = complexion(character)
+    # Warmer undertones have relatively less blue (and a touch less red: olive), cooler ones
+    # are pinker (more red, less green).
+    tint = np.array([1.0 - 0.02 * own.undertone, 1.0 - 0.025 * min(own.undertone, 0.0),
+                     1.0 - 0.07 * own.undertone])
+    skin = skin * own.lightness * tint
     older = float(np.clip((character.age - 50) / 40, 0, 1))
     greying = float(np.clip((character.age - 45) / 25, 0, 1))
     female = float(np.clip(1.0 - character.gender, 0, 1))
@@ -194,9 +253,11 @@ def character_appearance(character: Character, head, *, blush: float | None = No
     # A shaved beard shows as a faint blue-grey shadow on men; age lines from about 35.
     beard = float(np.clip((character.gender - 0.5) * 2, 0, 1) * np.clip((character.age - 16) / 6, 0, 1)) * 0.8
     age = float(np.clip((character.age - 32) / 45, 0, 1))
+    own = complexion(character)
     return Appearance(colors=colors, paint=paint_texture(head, round(blush, 3), painted_brows),
                       detail=detail_texture(head), beard=round(beard, 3), age=round(age, 3),
-                      tone=tone_texture(head, position_map))
+                      tone=tone_texture(head, position_map), freckles=own.freckles, redness=own.redness,
+                      seed=own.seed)
 
 
 DETAIL_SIZE = (1024, 512)  # rows (v), columns (u) over assets.PAINT_UV_BOX

@@ -424,6 +424,9 @@ class Renderer:
                 _set_uniform(prog, f"u_{key}", lin(key))
             _set_uniform(prog, "u_beard", appearance.beard)
             _set_uniform(prog, "u_age", appearance.age)
+            _set_uniform(prog, "u_freckles", appearance.freckles)
+            _set_uniform(prog, "u_redness", appearance.redness)
+            _set_uniform(prog, "u_skin_seed", appearance.seed)
         elif name == "eyeball":
             for key in ("sclera", "iris", "pupil"):
                 _set_uniform(prog, f"u_{key}", lin(key))

@@ -65,6 +65,25 @@ uniform vec3 u_brows;
 uniform vec3 u_eyelid;
 uniform vec3 u_cheek;
 uniform float u_wrinkle_darken;
+uniform float u_freckles;    // 0..1 freckle density on sun-exposed skin
+uniform float u_redness;     // 0..2 scale of the redder areas
+uniform float u_skin_seed;   // where this person's skin patterns fall
+
+// Round spots scattered over a grid of cells (p in cell units): each cell holds at most one,
+// with probability `prob`, at a random place and of a random radius up to `radius` (cell
+// units). Returns (coverage 0..1, the spot's own random 0..1). Antialiased by the cell's
+// size on screen; spots smaller than a pixel fade to their mean coverage.
+vec2 spots(vec2 p, float prob, float radius, int salt) {
+    vec2 cell = floor(p);
+    ivec2 c = ivec2(cell) + ivec2(977 * salt, 613 * salt);
+    float h = hash2(c);
+    vec2 centre = cell + 0.3 + 0.4 * vec2(hash2(c + ivec2(17, 3)), hash2(c + ivec2(5, 29)));
+    float r = radius * (0.45 + 0.55 * fract(h * 7.31));
+    float aa = max(fwidth(p.x), 1e-4);
+    float cover = 1.0 - smoothstep(r - 0.6 * aa, r + 0.6 * aa, length(p - centre));
+    cover = mix(PI * r * r, cover, clamp(3.0 * r / aa - 1.0, 0.0, 1.0));   // sub-pixel: mean
+    return vec2(cover * step(h, prob), fract(h * 13.7));
+}
 
 #ifdef USE_WRINKLE
 // Creases as folds of skin, not painted lines (issue 13: "stamped/carved"): compressed skin
@@ -183,24 +202,34 @@ void main() {
     // lines, averaged; faded to its mean where it would be finer than a pixel; it also breaks
     // up the sheen below). All of it grows with age. (hm08's paint box is twice as long in v
     // as in u, hence the 1:2 frequencies: round cells.)
-    vec2 grain_uv = v_uv * vec2(350.0, 700.0);
+    // Each person's patterns lie elsewhere on the noise (u_skin_seed), so no two share a skin.
+    vec2 skin_uv = v_uv + vec2(0.0731, 0.0419) * u_skin_seed;
+    vec2 grain_uv = skin_uv * vec2(350.0, 700.0);
     float grain = mix(0.5, value_noise(grain_uv, 0),
                       clamp(2.0 - 1.2 * max(fwidth(grain_uv.x), fwidth(grain_uv.y)), 0.0, 1.0));
-    float blotch = value_noise(v_uv * vec2(150.0, 300.0), 0);
-    float patches = value_noise(v_uv * vec2(24.0, 48.0) + 17.0, 0);
+    float blotch = value_noise(skin_uv * vec2(150.0, 300.0), 0);
+    float patches = value_noise(skin_uv * vec2(24.0, 48.0) + 17.0, 0);
     float mottle = 0.6 * blotch + 0.4 * grain;
     vec3 albedo = u_skin * (1.0 + vec3(0.10, 0.12, 0.13) * (1.0 + 1.2 * u_age) * (mottle - 0.5));
     albedo *= mix(vec3(1.04, 0.97, 0.96), vec3(0.975, 1.0, 1.02), patches);
     // Regional colour: redder nose, cheeks and ears (blood close to the surface), in broken
     // capillary patches rather than an airbrushed blob; darker, cooler skin around the eyes
     // (thin skin over vessels and muscle), more so with age; a shaved beard's blue-grey shadow.
-    float red = detail.r * mix(0.45, 1.35, smoothstep(0.2, 0.8, 0.55 * blotch + 0.45 * patches));
+    float red = u_redness * detail.r * mix(0.45, 1.35, smoothstep(0.2, 0.8, 0.55 * blotch + 0.45 * patches));
     albedo *= mix(vec3(1.0), vec3(1.05, 0.80, 0.77), (0.7 + 0.3 * u_age) * red);   // older: broken veins
     albedo *= mix(vec3(1.0), vec3(0.78, 0.70, 0.75), tone.r * (0.6 + 0.5 * u_age));
     albedo = mix(albedo, albedo * vec3(0.70, 0.72, 0.78), u_beard * detail.g * (1.0 - paint.g));
     // Age spots: sparse, soft tan patches where the sun reaches, growing with age.
     float spot = smoothstep(0.72, 0.9, blotch) * tone.a * u_age;
     albedo *= mix(vec3(1.0), vec3(0.86, 0.76, 0.66), spot);
+    // Freckles (cells ~2.5 mm, spots ~1 mm, denser where the sun reaches) and a few moles and
+    // small red marks anywhere on the face (cells ~12 mm): no real skin is without them,
+    // and they are what makes one person's skin their own.
+    float sun = tone.a * (1.0 - paint.g);
+    vec2 freckle = spots(skin_uv * vec2(140.0, 280.0), u_freckles * smoothstep(0.05, 0.6, sun), 0.3, 1);
+    albedo *= mix(vec3(1.0), vec3(0.80, 0.66, 0.55), freckle.x * (0.35 + 0.45 * freckle.y));
+    vec2 mark = spots(skin_uv * vec2(30.0, 60.0), 0.06 * (1.0 - paint.g) * (1.0 - paint.b), 0.09, 2);
+    albedo *= mix(vec3(1.0), mix(vec3(0.55, 0.42, 0.36), vec3(1.0, 0.78, 0.76), step(0.55, mark.y)), mark.x);
     albedo = mix(albedo, u_cheek, paint.a);
     albedo = mix(albedo, u_eyelid, paint.b);
     // Lips: the red is not a flat paint. Fine vertical furrows run across it (every 1.5 mm
@@ -227,13 +256,18 @@ void main() {
 #endif
     float hair = brow.x;
     albedo = mix(albedo, u_brows * brow.y, hair);
-    float cavity = 1.0 - 0.42 * u_age * detail.a;   // age lines and folds
+    // Age lines and folds (detail.a: forehead lines, crow's feet, nasolabial and marionette
+    // folds, tear troughs) are grooves in the skin, not paint: only their floor darkens a
+    // little; their slopes shade them (below), lit on one flank and in soft shade on the other.
+    float cavity = 1.0 - 0.2 * u_age * detail.a;
     // Surface frame for bump mapping from screen derivatives (Mikkelsen's surface gradient):
     // a height h tilts the normal to normalize(|det| n - sign(det) (dh/dx r1 + dh/dy r2)).
     vec3 dpdx = dFdx(v_pos), dpdy = dFdy(v_pos);
     vec3 r1 = cross(dpdy, n), r2 = cross(n, dpdx);
     float det = dot(dpdx, r1);
     vec3 n_smooth = n;
+    float age_h = -0.014 * u_age * detail.a;   // up to 1.4 mm deep (dm)
+    n = normalize(abs(det) * n - sign(det) * (dFdx(age_h) * r1 + dFdy(age_h) * r2));
 #ifdef USE_WRINKLE
     Fold fold = crease_fold(v_wrinkle, v_crease, v_uv);
     // Compressed skin is a little darker overall (blood pushed together, less light between
@@ -255,14 +289,25 @@ void main() {
     float pore_amount = pore_fade * (0.3 + 1.2 * tone.b) * (1.0 - paint.g) * (1.0 - hair);
     vec3 bumped = normalize(abs(det) * n - (0.0006 + 0.0003 * u_age) * pore_amount * grad);
     cavity *= 1.0 - 0.07 * pit * pore_amount;
+    float spec_break = 1.0 - 0.6 * pit * pore_amount;   // pores hold no oil film facing the light
 #else
     // Micro-relief at small sizes: the skin's millimetre-scale unevenness (the mottle as a
     // height, surface gradient from screen derivatives: its cells span several pixels, so
     // the 2x2-quad derivative is smooth) tilts the normal a little, which breaks the sheen
     // into the irregular highlights of real skin instead of a plastic glaze.
-    vec3 grad = sign(det) * (dFdx(mottle) * r1 + dFdy(mottle) * r2);
+    // Pores show at this size too where they are largest (nose, the cheeks beside it: tone.b),
+    // as a speckle of small pits about a millimetre apart that darken a little and break
+    // the sheen; faded to nothing where they would be finer than a pixel.
+    vec2 pore_uv = v_uv * vec2(420.0, 840.0);
+    float pore_fade = clamp(2.2 - 1.6 * max(fwidth(pore_uv.x), fwidth(pore_uv.y)), 0.0, 1.0);
+    float pit = smoothstep(0.62, 0.9, value_noise(pore_uv + 7.0, 0))
+              * pore_fade * smoothstep(0.3, 0.9, tone.b) * (1.0 - paint.g) * (1.0 - hair);
+    float relief_h = mottle - 0.5 * pit;
+    vec3 grad = sign(det) * (dFdx(relief_h) * r1 + dFdy(relief_h) * r2);
     float relief = (0.0012 + 0.0008 * u_age) * (0.5 + tone.b) * (1.0 - paint.g) * (1.0 - hair);
     vec3 bumped = normalize(abs(det) * n - relief * grad);
+    cavity *= 1.0 - 0.07 * pit;
+    float spec_break = 1.0 - 0.7 * pit;   // pores hold no oil film facing the light
 #endif
     // Contact shadows: the baked visibility is close to 1 on the open face and falls only in
     // the nostrils, the lip line, the eye sockets and under the jaw; squaring it deepens
@@ -281,6 +326,10 @@ void main() {
     // and blue; red, scattered further under the skin, sees the smooth surface.
     lit += u_key_col * vec3(0.35, 1.0, 1.0) * (dot(bumped, u_key_dir) - dot(n, u_key_dir));
 #endif
+    // Subsurface scattering reddens the terminator: where the key grazes the surface, light
+    // that entered on the lit side comes out beyond it, its green and blue absorbed on the way.
+    float key_cos = dot(n_smooth, u_key_dir);
+    lit += u_key_col * vec3(0.075, 0.018, 0.006) * exp(-key_cos * key_cos * 16.0) * contact * (1.0 - hair);
     // Light that scatters out of the skin's shadowed side is redder than the light going in.
     lit *= mix(vec3(1.0), vec3(1.06, 0.97, 0.95), (1.0 - contact) * (1.0 - hair));
     vec3 diffuse = lit * albedo;
@@ -304,7 +353,7 @@ void main() {
                   + blinn(bumped, u_rim_dir, v, broad_shine) * u_rim_col) * mix(0.2, 0.75, oil);
     vec3 tight = blinn(bumped, u_key_dir, v, mix(32.0, 70.0, wet)) * u_key_col
                * (mix(0.08, 2.2, oil * oil) + 1.6 * wet);
-    vec3 spec = (broad + tight) * fres * (1.0 - hair) * (0.4 + 1.2 * grain);
+    vec3 spec = (broad + tight) * fres * (1.0 - hair) * (0.4 + 1.2 * grain) * spec_break;
     radiance = (diffuse + spec * contact) * cavity;
 #endif
 
