@@ -264,7 +264,7 @@ DETAIL_SIZE = (1024, 512)  # rows (v), columns (u) over assets.PAINT_UV_BOX
 
 
 #: Bump when the detail recipe changes, so cached detail textures are redone.
-DETAIL_VERSION = 1
+DETAIL_VERSION = 2  # 2: irregular age lines, an asymmetric nasolabial fold
 
 
 @lru_cache(maxsize=2)
@@ -344,30 +344,57 @@ def oil_density(positions: np.ndarray) -> np.ndarray:
 
 
 def age_line_density(positions: np.ndarray) -> np.ndarray:
-    """Lines and shadows that come with age: forehead lines, crow's feet, nasolabial and
-    marionette folds, tear troughs. The renderer scales them by the character's age."""
+    """Lines and folds that come with age: forehead lines, crow's feet, nasolabial and
+    marionette folds, tear troughs, as a depth (0 … 1) that the renderer shades as grooves
+    (their slopes light and shade them) and scales by the character's age.
+
+    Real lines are irregular (issue 13: evenly spaced, even-depth lines looked stamped): each
+    forehead line and each crow's-foot ray has its own depth and length, wanders a little,
+    and fades out along its length; the nasolabial fold is a groove with a steep side toward
+    the lip and a long, gentle slope up onto the cheek (the cheek's bulge over it).
+    """
     x, y, z = positions[..., 0], positions[..., 1], positions[..., 2]
     ax = np.abs(x)
-    # Forehead: three or four gently arched horizontal lines.
-    arch = y - 0.12 * ax ** 2 + 0.012 * np.sin(9.0 * x)
-    forehead = smoothstep(7.6, 7.66, arch) * smoothstep(7.9, 7.8, arch) * smoothstep(0.42, 0.22, ax) * smoothstep(1.1, 1.3, z)
-    lines = (0.5 + 0.5 * np.cos(2 * np.pi * (arch - 7.62) / 0.09)) ** 12
-    out = 0.6 * forehead * lines
-    # Crow's feet: short lines fanning out from the outer eye corner.
+    rng = np.random.default_rng(13)   # fixed: the lines are part of the head model
+    # Forehead: four or five gently arched lines, each with its own depth, extent and waviness.
+    out = np.zeros(np.shape(x))
+    front = smoothstep(1.1, 1.3, z)
+    for k in range(5):
+        height = 7.6 + 0.075 * k + rng.uniform(-0.012, 0.012)
+        wave = rng.uniform(0.006, 0.016) * np.sin(rng.uniform(6, 12) * x + rng.uniform(0, 2 * np.pi))
+        d = (y - 0.12 * ax ** 2 - wave - height) / rng.uniform(0.008, 0.012)
+        reach = rng.uniform(0.22, 0.42)
+        along = (0.55 + 0.45 * np.sin(rng.uniform(8, 16) * x + rng.uniform(0, 2 * np.pi))) * smoothstep(reach, reach - 0.15, ax)
+        out = np.maximum(out, rng.uniform(0.35, 0.7) * np.exp(-d * d) * along * front)
+    # Crow's feet: short rays fanning out from the outer eye corner, each its own length and depth.
     cx, cy = 0.47, 7.28
     dx, dy = ax - cx, y - cy
     radius = np.hypot(dx, dy)
     angle = np.arctan2(dy, np.maximum(dx, 1e-6))
-    fan = (0.5 + 0.5 * np.cos(angle * 11.0)) ** 6 * smoothstep(0.03, 0.06, radius) * smoothstep(0.16, 0.09, radius)
-    out += 0.7 * fan * (dx > 0) * smoothstep(0.6, 0.9, z)
-    # Folds: distance to the nasolabial (nose wing -> past the lip corner) and marionette segments.
-    for (ax0, ay0), (ax1, ay1), depth, width in (((0.15, 6.86), (0.29, 6.60), 0.8, 0.018),
-                                                 ((0.26, 6.58), (0.24, 6.38), 0.45, 0.02)):
-        out += depth * np.exp(-(_segment_distance(ax, y, ax0, ay0, ax1, ay1) / width) ** 2) * smoothstep(1.1, 1.3, z)
-    # Tear trough: a soft shadow under the lower lid, inner half.
-    out += 0.5 * _blob(positions, (0.22, 7.13, 1.42), (0.08, 0.035, 0.1))
+    for k in range(6):
+        ray = -0.75 + 0.3 * k + rng.uniform(-0.08, 0.08)
+        bend = ray + rng.uniform(-0.6, 0.6) * (radius - 0.05)
+        width = 0.012 / np.maximum(radius, 0.03)
+        length = rng.uniform(0.09, 0.15)
+        depth = rng.uniform(0.35, 0.7) * smoothstep(0.03, 0.055, radius) * smoothstep(length, length - 0.05, radius)
+        out = np.maximum(out, depth * np.exp(-((angle - bend) / width) ** 2) * (dx > 0) * smoothstep(0.6, 0.9, z))
+    # Folds: distance to the nasolabial (nose wing -> past the lip corner) and marionette
+    # segments; steep toward the midline, a long gentle rise on the lateral (cheek) side.
+    for (ax0, ay0), (ax1, ay1), depth, width in (((0.15, 6.86), (0.29, 6.60), 0.85, 0.016),
+                                                 ((0.26, 6.58), (0.24, 6.38), 0.45, 0.018)):
+        dist, side = _segment_distance(ax, y, ax0, ay0, ax1, ay1), _segment_side(ax, y, ax0, ay0, ax1, ay1)
+        scale = np.where(side > 0, 3.0 * width, width)
+        out = np.maximum(out, depth * np.exp(-(dist / scale) ** 2) * front)
+    # Tear trough: a soft groove under the lower lid, inner half.
+    out = np.maximum(out, 0.5 * _blob(positions, (0.22, 7.13, 1.42), (0.08, 0.035, 0.1)))
     out = np.where(np.isfinite(out), out, 0.0)
     return np.clip(out, 0, 1).astype(np.float32)
+
+
+def _segment_side(x, y, x0, y0, x1, y1):
+    """Which side of the line through the segment each point lies: > 0 on its left
+    (going from (x0, y0) to (x1, y1)), < 0 on its right."""
+    return (x1 - x0) * (y - y0) - (y1 - y0) * (x - x0)
 
 
 def _segment_distance(x, y, x0, y0, x1, y1):

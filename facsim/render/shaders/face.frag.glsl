@@ -318,6 +318,12 @@ void main() {
     // sees the smooth normal; green and blue see the pores' relief (normal blending).
     vec3 wrap = vec3(0.42, 0.2, 0.14) * (1.0 - hair) * (1.0 - 0.3 * u_age);
     vec3 lit = diffuse_light(n, wrap, contact);
+    // Light in the shade reaches the eye after travelling through the skin: all but the
+    // direct key (fill, sky, rim) comes out redder and more saturated, as in photographs,
+    // where skin in shadow is a deeper red-brown and never the grey of a painted surface.
+    vec3 key_part = clamp((dot(n, u_key_dir) + wrap) / (1.0 + wrap), 0.0, 1.0) * u_key_col
+                  * mix(1.0, contact, KEY_OCCLUSION);
+    lit = key_part + (lit - key_part) * mix(vec3(1.0), vec3(1.14, 0.92, 0.84), 1.0 - hair);
 #ifdef USE_PORES
     lit.gb = mix(lit.gb, diffuse_light(bumped, 0.5 * wrap, contact).gb, 0.6);
 #endif
