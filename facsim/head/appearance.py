@@ -264,7 +264,7 @@ DETAIL_SIZE = (1024, 512)  # rows (v), columns (u) over assets.PAINT_UV_BOX
 
 
 #: Bump when the detail recipe changes, so cached detail textures are redone.
-DETAIL_VERSION = 2  # 2: irregular age lines, an asymmetric nasolabial fold
+DETAIL_VERSION = 3  # 3: sheen on the cheekbones; 2: irregular age lines, an asymmetric nasolabial fold
 
 
 @lru_cache(maxsize=2)
@@ -339,7 +339,8 @@ def oil_density(positions: np.ndarray) -> np.ndarray:
     """The T-zone (forehead, nose, chin) is oilier, hence glossier, than the cheeks."""
     oil = (0.85 * _blob(positions, (0.0, 7.75, 1.45), (0.35, 0.25, 0.3))
            + 1.0 * _blob(positions, (0.0, 7.1, 1.62), (0.09, 0.3, 0.2))
-           + 0.6 * _blob(positions, (0.0, 6.32, 1.48), (0.14, 0.1, 0.2)))
+           + 0.6 * _blob(positions, (0.0, 6.32, 1.48), (0.14, 0.1, 0.2))
+           + 0.3 * _blob(positions, (0.42, 7.0, 1.32), (0.12, 0.09, 0.2)))   # cheekbones catch a sheen
     return np.clip(0.35 + oil, 0, 1).astype(np.float32)
 
 

@@ -108,17 +108,18 @@ Fold crease_fold(float wrinkle, float phase, vec2 uv) {
     // Depth along the line: per-line (hash) times a slow variation along it.
     float along = value_noise(uv * vec2(22.0, 44.0) + 9.0 * hash2(ivec2(int(line), 3)), 0);
     float depth = (0.5 + 0.5 * hash2(ivec2(int(line), 11))) * smoothstep(0.1, 0.55, along);
-    float amount = smoothstep(0.1, 0.9, wrinkle) * (0.7 + 0.3 * clamp(wrinkle - 0.9, 0.0, 1.0));
+    // Older skin creases sooner (less elastic): the same compression shows more lines.
+    float amount = smoothstep(0.15 - 0.15 * u_age, 0.8 - 0.3 * u_age, wrinkle);
     // The crevice is widened where it would be finer than a pixel, keeping its area (a
     // pre-filter: no aliasing, no shimmer as the face moves); the roll fades to flat when
     // the furrows themselves are finer than a few pixels.
-    const float W = 0.075;
+    const float W = 0.085;
     float w = max(W, 0.8 * aa);
     float g = exp(-(t * t) / (w * w));
     float roll = clamp(2.0 - 4.0 * aa, 0.0, 1.0);
     Fold f;
-    // H(t) = A (-0.5 cos 2 pi t) - C exp(-t^2 / w^2): roll 0.6 mm high, crevice 0.3 mm deep.
-    f.slope = amount * depth * (roll * 0.016 * PI * sin(2.0 * PI * t) + 0.007 * (W / w) * 2.0 * t / (w * w) * g);
+    // H(t) = A (-0.5 cos 2 pi t) - C exp(-t^2 / w^2): roll 2.6 mm, crevice 0.9 mm deep.
+    f.slope = amount * depth * (roll * 0.026 * PI * sin(2.0 * PI * t) + 0.009 * (W / w) * 2.0 * t / (w * w) * g);
     f.crevice = amount * depth * (W / w) * exp(-(t * t) / (2.2 * w * w));
     f.s = s;
     return f;
@@ -272,7 +273,7 @@ void main() {
     Fold fold = crease_fold(v_wrinkle, v_crease, v_uv);
     // Compressed skin is a little darker overall (blood pushed together, less light between
     // the rolls), and the crevices' bottoms darker still.
-    cavity *= (1.0 - u_wrinkle_darken * clamp(v_wrinkle, 0.0, 1.0)) * (1.0 - 0.4 * fold.crevice);
+    cavity *= (1.0 - u_wrinkle_darken * clamp(v_wrinkle, 0.0, 1.0)) * (1.0 - 0.6 * fold.crevice);
     vec3 fold_grad = sign(det) * fold.slope * (dFdx(fold.s) * r1 + dFdy(fold.s) * r2);
     n = normalize(abs(det) * n - fold_grad);
 #endif
@@ -323,7 +324,9 @@ void main() {
     // where skin in shadow is a deeper red-brown and never the grey of a painted surface.
     vec3 key_part = clamp((dot(n, u_key_dir) + wrap) / (1.0 + wrap), 0.0, 1.0) * u_key_col
                   * mix(1.0, contact, KEY_OCCLUSION);
-    lit = key_part + (lit - key_part) * mix(vec3(1.0), vec3(1.14, 0.92, 0.84), 1.0 - hair);
+    // (Melanin absorbs much of the scattered light in dark skin: less reddening there.)
+    float scatter = (1.0 - hair) * smoothstep(0.03, 0.3, dot(u_skin, vec3(0.2126, 0.7152, 0.0722)));
+    lit = key_part + (lit - key_part) * mix(vec3(1.0), vec3(1.14, 0.92, 0.84), scatter);
 #ifdef USE_PORES
     lit.gb = mix(lit.gb, diffuse_light(bumped, 0.5 * wrap, contact).gb, 0.6);
 #endif
@@ -335,7 +338,7 @@ void main() {
     // Subsurface scattering reddens the terminator: where the key grazes the surface, light
     // that entered on the lit side comes out beyond it, its green and blue absorbed on the way.
     float key_cos = dot(n_smooth, u_key_dir);
-    lit += u_key_col * vec3(0.075, 0.018, 0.006) * exp(-key_cos * key_cos * 16.0) * contact * (1.0 - hair);
+    lit += u_key_col * vec3(0.075, 0.018, 0.006) * exp(-key_cos * key_cos * 16.0) * contact * scatter;
     // Light that scatters out of the skin's shadowed side is redder than the light going in.
     lit *= mix(vec3(1.0), vec3(1.06, 0.97, 0.95), (1.0 - contact) * (1.0 - hair));
     vec3 diffuse = lit * albedo;
@@ -358,8 +361,8 @@ void main() {
     vec3 broad = (blinn(bumped, u_key_dir, v, broad_shine) * u_key_col
                   + blinn(bumped, u_rim_dir, v, broad_shine) * u_rim_col) * mix(0.2, 0.75, oil);
     vec3 tight = blinn(bumped, u_key_dir, v, mix(32.0, 70.0, wet)) * u_key_col
-               * (mix(0.08, 2.2, oil * oil) + 1.6 * wet);
-    vec3 spec = (broad + tight) * fres * (1.0 - hair) * (0.4 + 1.2 * grain) * spec_break;
+               * (mix(0.12, 3.2, oil * oil) + 1.6 * wet);
+    vec3 spec = (broad + tight) * fres * (1.0 - hair) * (0.6 + 0.8 * grain) * spec_break;
     radiance = (diffuse + spec * contact) * cavity;
 #endif
 
