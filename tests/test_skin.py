@@ -177,3 +177,37 @@ def test_outer_hair_layers_are_more_exposed_than_inner_ones():
     points = np.concatenate([0.9 * sphere, 1.0 * sphere]) + [0.0, 8.0, 0.0]
     exposure = hair_exposure(points, np.concatenate([quads, quads + 144]))
     assert exposure[144:].mean() > 0.7 and exposure[:144].mean() < 0.3
+
+
+def test_people_of_one_ancestry_do_not_share_one_skin():
+    """Issue 13, "the same few identities repeat": every preset of an ethnicity had one skin
+    colour. Each person now has their own complexion, fixed for that person."""
+    from facsim.head.appearance import character_colors, complexion
+    from facsim.head.character import resolve_character
+
+    for group in (("ava", "emma", "liam", "noah"), ("amara", "kwame", "tunde", "kofi")):
+        skins = {name: character_colors(resolve_character(name))["skin"] for name in group}
+        values = np.array(list(skins.values()))
+        assert len({tuple(np.round(v, 3)) for v in values}) == len(group)
+        assert np.ptp(values.mean(1)) > 0.03          # visibly lighter and darker people
+    assert complexion(resolve_character("ava")) == complexion(resolve_character("ava"))
+    assert complexion(resolve_character("random:7")) != complexion(resolve_character("random:8"))
+    light = [complexion(resolve_character(n)).freckles for n in ("ava", "emma", "liam", "noah", "george")]
+    dark = [complexion(resolve_character(n)).freckles for n in ("amara", "kwame", "tunde", "kofi", "ngozi")]
+    assert max(light) > 0.3 and max(dark) == 0.0      # freckles on some light skins
+
+
+def test_freckles_and_the_skin_seed_change_the_skin_not_the_background(face_of):
+    face = face_of("ava")
+    plain, camera = render(face, dataclasses.replace(face.appearance, freckles=0.0))
+    freckled, _ = render(face, dataclasses.replace(face.appearance, freckles=1.0))
+    darker = (plain - freckled).sum(-1)
+    assert (darker > 2).sum() > 0.01 * SIZE * SIZE       # browner skin where the sun reaches ...
+    assert (darker < -3).sum() < 0.001 * SIZE * SIZE   # ... and nowhere lighter
+    assert not darker[:, :8].any()
+    other, _ = render(face, dataclasses.replace(face.appearance, freckles=0.0, seed=500.0))
+    changed = np.abs(other - plain).sum(-1) > 3
+    assert changed.sum() > 0.01 * SIZE * SIZE
+    assert not changed[:, :8].any()
+    with pytest.raises(ValueError, match="freckles must be in"):
+        dataclasses.replace(face.appearance, freckles=1.5)

@@ -109,7 +109,7 @@ Fold crease_fold(float wrinkle, float phase, vec2 uv) {
     float along = value_noise(uv * vec2(22.0, 44.0) + 9.0 * hash2(ivec2(int(line), 3)), 0);
     float depth = (0.5 + 0.5 * hash2(ivec2(int(line), 11))) * smoothstep(0.1, 0.55, along);
     // Older skin creases sooner (less elastic): the same compression shows more lines.
-    float amount = smoothstep(0.15 - 0.15 * u_age, 0.8 - 0.3 * u_age, wrinkle);
+    float amount = smoothstep(0.15 - 0.08 * u_age, 0.8 - 0.2 * u_age, wrinkle);
     // The crevice is widened where it would be finer than a pixel, keeping its area (a
     // pre-filter: no aliasing, no shimmer as the face moves); the roll fades to flat when
     // the furrows themselves are finer than a few pixels.
