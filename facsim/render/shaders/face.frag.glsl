@@ -260,14 +260,22 @@ void main() {
     // Age lines and folds (detail.a: forehead lines, crow's feet, nasolabial and marionette
     // folds, tear troughs) are grooves in the skin, not paint: only their floor darkens a
     // little; their slopes shade them (below), lit on one flank and in soft shade on the other.
-    float cavity = 1.0 - 0.2 * u_age * detail.a;
+    // They deepen where the skin is pushed together: a smile's compression deepens the
+    // nasolabial fold and the crow's feet, raised brows the forehead lines, on any face (the
+    // lines of a young face show only then).
+#ifdef USE_WRINKLE
+    float line_depth = min(u_age + 1.2 * smoothstep(0.05, 0.5, v_wrinkle), 1.5);
+#else
+    float line_depth = u_age;
+#endif
+    float cavity = 1.0 - 0.2 * line_depth * detail.a;
     // Surface frame for bump mapping from screen derivatives (Mikkelsen's surface gradient):
     // a height h tilts the normal to normalize(|det| n - sign(det) (dh/dx r1 + dh/dy r2)).
     vec3 dpdx = dFdx(v_pos), dpdy = dFdy(v_pos);
     vec3 r1 = cross(dpdy, n), r2 = cross(n, dpdx);
     float det = dot(dpdx, r1);
     vec3 n_smooth = n;
-    float age_h = -0.014 * u_age * detail.a;   // up to 1.4 mm deep (dm)
+    float age_h = -0.014 * line_depth * detail.a;   // up to 2 mm deep (dm)
     n = normalize(abs(det) * n - sign(det) * (dFdx(age_h) * r1 + dFdy(age_h) * r2));
 #ifdef USE_WRINKLE
     Fold fold = crease_fold(v_wrinkle, v_crease, v_uv);
