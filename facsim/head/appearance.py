@@ -260,11 +260,12 @@ def character_appearance(character: Character, head, *, blush: float | None = No
                       seed=own.seed)
 
 
-DETAIL_SIZE = (1024, 512)  # rows (v), columns (u) over assets.PAINT_UV_BOX
+DETAIL_SIZE = (2048, 1024)  # rows (v), columns (u) over assets.PAINT_UV_BOX; fine enough that the
+# age lines, shaded from their slopes, show no texel steps in a 1024² still
 
 
 #: Bump when the detail recipe changes, so cached detail textures are redone.
-DETAIL_VERSION = 3  # 3: sheen on the cheekbones; 2: irregular age lines, an asymmetric nasolabial fold
+DETAIL_VERSION = 4  # 4: 2048 rows; 3: sheen on the cheekbones; 2: irregular age lines, an asymmetric nasolabial fold
 
 
 @lru_cache(maxsize=2)

@@ -281,7 +281,7 @@ void main() {
     Fold fold = crease_fold(v_wrinkle, v_crease, v_uv);
     // Compressed skin is a little darker overall (blood pushed together, less light between
     // the rolls), and the crevices' bottoms darker still.
-    cavity *= (1.0 - u_wrinkle_darken * clamp(v_wrinkle, 0.0, 1.0)) * (1.0 - 0.6 * fold.crevice);
+    cavity *= (1.0 - u_wrinkle_darken * clamp(v_wrinkle, 0.0, 1.0)) * (1.0 - 0.5 * fold.crevice);
     vec3 fold_grad = sign(det) * fold.slope * (dFdx(fold.s) * r1 + dFdy(fold.s) * r2);
     n = normalize(abs(det) * n - fold_grad);
 #endif
