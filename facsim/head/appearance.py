@@ -192,7 +192,7 @@ def complexion(character: Character) -> Complexion:
     # Dark skin spans a wider range of lightness (Fitzpatrick IV-VI) than light skin.
     spread = 0.2 + 0.3 * float(mix.get("african", 0.0))
     return Complexion(lightness=round(1.0 + spread * (2.0 * u[0] - 1.0), 3), undertone=round(2.0 * u[1] - 1.0, 3),
-                      freckles=round(float(freckled), 3), redness=round(0.6 + 0.8 * u[3], 3),
+                      freckles=round(float(freckled), 3), redness=round(0.8 + 0.6 * u[3], 3),
                       seed=round(1000.0 * u[4], 2))
 
 
@@ -209,7 +209,7 @@ def character_colors(character: Character) -> dict[str, tuple[float, float, floa
     # Warmer undertones have relatively less blue (and a touch less red: olive), cooler ones
     # are pinker (more red, less green).
     tint = np.array([1.0 - 0.02 * own.undertone, 1.0 - 0.025 * min(own.undertone, 0.0),
-                     1.0 - 0.07 * own.undertone])
+                     1.0 - 0.05 * own.undertone])
     skin = skin * own.lightness * tint
     older = float(np.clip((character.age - 50) / 40, 0, 1))
     greying = float(np.clip((character.age - 45) / 25, 0, 1))

@@ -217,7 +217,7 @@ void main() {
     // capillary patches rather than an airbrushed blob; darker, cooler skin around the eyes
     // (thin skin over vessels and muscle), more so with age; a shaved beard's blue-grey shadow.
     float red = u_redness * detail.r * mix(0.45, 1.35, smoothstep(0.2, 0.8, 0.55 * blotch + 0.45 * patches));
-    albedo *= mix(vec3(1.0), vec3(1.05, 0.80, 0.77), (0.7 + 0.3 * u_age) * red);   // older: broken veins
+    albedo *= mix(vec3(1.0), vec3(1.06, 0.77, 0.75), (0.75 + 0.3 * u_age) * red);   // older: broken veins
     albedo *= mix(vec3(1.0), vec3(0.78, 0.70, 0.75), tone.r * (0.6 + 0.5 * u_age));
     albedo = mix(albedo, albedo * vec3(0.70, 0.72, 0.78), u_beard * detail.g * (1.0 - paint.g));
     // Age spots: sparse, soft tan patches where the sun reaches, growing with age.
