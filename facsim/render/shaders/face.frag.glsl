@@ -76,8 +76,8 @@ uniform float u_skin_seed;   // where this person's skin patterns fall
 vec2 spots(vec2 p, float prob, float radius, int salt) {
     vec2 cell = floor(p);
     ivec2 c = ivec2(cell) + ivec2(977 * salt, 613 * salt);
-    float h = hash2(c);
-    vec2 centre = cell + 0.3 + 0.4 * vec2(hash2(c + ivec2(17, 3)), hash2(c + ivec2(5, 29)));
+    float h = hash2(c);   // one hash per cell; its digits place and size the spot (cheap)
+    vec2 centre = cell + 0.3 + 0.4 * fract(h * vec2(97.31, 53.17));
     float r = radius * (0.45 + 0.55 * fract(h * 7.31));
     float aa = max(fwidth(p.x), 1e-4);
     float cover = 1.0 - smoothstep(r - 0.6 * aa, r + 0.6 * aa, length(p - centre));
@@ -307,11 +307,10 @@ void main() {
     // Pores show at this size too where they are largest (nose, the cheeks beside it: tone.b),
     // as a speckle of small pits about a millimetre apart that darken a little and break
     // the sheen; faded to nothing where they would be finer than a pixel.
-    vec2 pore_uv = v_uv * vec2(420.0, 840.0);
-    float pore_fade = clamp(2.2 - 1.6 * max(fwidth(pore_uv.x), fwidth(pore_uv.y)), 0.0, 1.0);
-    float pit = smoothstep(0.62, 0.9, value_noise(pore_uv + 7.0, 0))
-              * pore_fade * smoothstep(0.3, 0.9, tone.b) * (1.0 - paint.g) * (1.0 - hair);
-    float relief_h = mottle - 0.5 * pit;
+    // (The grain's own peaks, so no further noise is evaluated; it is already faded to its
+    // flat mean where it would be finer than a pixel.)
+    float pit = smoothstep(0.64, 0.9, grain) * smoothstep(0.3, 0.9, tone.b) * (1.0 - paint.g) * (1.0 - hair);
+    float relief_h = mottle - 1.0 * pit;
     vec3 grad = sign(det) * (dFdx(relief_h) * r1 + dFdy(relief_h) * r2);
     float relief = (0.0012 + 0.0008 * u_age) * (0.5 + tone.b) * (1.0 - paint.g) * (1.0 - hair);
     vec3 bumped = normalize(abs(det) * n - relief * grad);
