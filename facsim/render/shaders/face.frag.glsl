@@ -370,7 +370,13 @@ void main() {
     vec3 tight = blinn(bumped, u_key_dir, v, mix(32.0, 70.0, wet)) * u_key_col
                * (mix(0.12, 3.2, oil * oil) + 1.6 * wet);
     vec3 spec = (broad + tight) * fres * (1.0 - hair) * (0.6 + 0.8 * grain) * spec_break;
-    radiance = (diffuse + spec * contact) * cavity;
+#ifdef USE_WRINKLE
+    // Light reaching a crevice's floor has passed through the skin around it: redder.
+    vec3 crevice_tint = mix(vec3(1.0), vec3(1.0, 0.94, 0.92), fold.crevice * scatter);
+#else
+    vec3 crevice_tint = vec3(1.0);
+#endif
+    radiance = (diffuse + spec * contact) * cavity * crevice_tint;
 #endif
 
 #ifdef REGION_EYEBALL
