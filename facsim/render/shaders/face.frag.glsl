@@ -322,9 +322,10 @@ void main() {
     // those small shadows (a soft studio key still reaches into them partly).
     float contact = occ * occ;
     // Subsurface look: light wraps past the terminator, red furthest, so the shadow edge is
-    // soft and warm (less with age: thinner skin). Red scatters furthest under the skin, so it
+    // soft and warm (less with age: thinner skin); only a little, as skin scatters light a
+    // few millimetres and too much wrap is what looks waxy. Red scatters furthest under the skin, so it
     // sees the smooth normal; green and blue see the pores' relief (normal blending).
-    vec3 wrap = vec3(0.42, 0.2, 0.14) * (1.0 - hair) * (1.0 - 0.3 * u_age);
+    vec3 wrap = vec3(0.3, 0.13, 0.08) * (1.0 - hair) * (1.0 - 0.3 * u_age);
     vec3 lit = diffuse_light(n, wrap, contact);
     // Light in the shade reaches the eye after travelling through the skin: all but the
     // direct key (fill, sky, rim) comes out redder and more saturated, as in photographs,
