@@ -11,6 +11,7 @@ character overrides them.
 """
 from __future__ import annotations
 
+import hashlib
 from functools import lru_cache
 
 import numpy as np
@@ -176,11 +177,10 @@ def complexion(character: Character) -> Complexion:
     flushing (issue 13: reviewers said the same few identities repeat; every preset of an
     ethnicity had one skin colour). Each character gets a fixed draw (a hash of its preset
     name, or of its parameters for custom characters): lightness within about ±1 Fitzpatrick
-    step (wider for dark skin), an undertone, a redness, and freckles mostly on light skin (fewer with age: they
-    give way to age spots). The same character always gets the same complexion.
+    step (wider for dark skin), an undertone, a redness, and freckles mostly on light skin
+    (fewer with age: they give way to age spots). The same character always gets the same
+    complexion. A ``colors: {skin: ...}`` override still wins.
     """
-    import hashlib
-
     key = character.name or repr((character.gender, character.age, character.african, character.asian,
                                   character.caucasian, character.muscle, character.weight,
                                   sorted(character.face.items())))

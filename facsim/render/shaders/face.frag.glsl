@@ -90,9 +90,8 @@ vec2 spots(vec2 p, float prob, float radius, int salt) {
 // buckles into rounded rolls with a narrow crevice between them. One crevice at each whole
 // number of the crease phase (v_crease, in furrow spacings; slightly wavy). The fold is a
 // height profile across the furrows: a broad roll (the bulge between two furrows) minus a
-// narrow crevice. Its slope tilts the shading normal (crease_height's gradient, in
-// main()), so the key light catches one flank of each roll and leaves the other in soft
-// shade, as on real skin; only the bottom of the crevice darkens (light cannot reach it).
+// narrow crevice. Its slope (Fold.slope) tilts the shading normal in main(), so the key
+// light catches one flank of each roll and leaves the other in soft shade, as on real skin; only the bottom of the crevice darkens (light cannot reach it).
 // Each line has its own depth, and the depth varies along it (lines fade out, break and
 // restart); all of it grows with the wrinkle amount, so lines fade at their ends.
 struct Fold {
@@ -118,7 +117,7 @@ Fold crease_fold(float wrinkle, float phase, vec2 uv) {
     float g = exp(-(t * t) / (w * w));
     float roll = clamp(2.0 - 4.0 * aa, 0.0, 1.0);
     Fold f;
-    // H(t) = A (-0.5 cos 2 pi t) - C exp(-t^2 / w^2): roll 2.6 mm, crevice 0.9 mm deep.
+    // H(t) = A (-0.5 cos 2 pi t) - C exp(-t^2 / w^2): rolls 2.6 mm high, crevices 0.9 mm deep.
     f.slope = amount * depth * (roll * 0.026 * PI * sin(2.0 * PI * t) + 0.009 * (W / w) * 2.0 * t / (w * w) * g);
     f.crevice = amount * depth * (W / w) * exp(-(t * t) / (2.2 * w * w));
     f.s = s;
@@ -323,8 +322,8 @@ void main() {
     float contact = occ * occ;
     // Subsurface look: light wraps past the terminator, red furthest, so the shadow edge is
     // soft and warm (less with age: thinner skin); only a little, as skin scatters light a
-    // few millimetres and too much wrap is what looks waxy. Red scatters furthest under the skin, so it
-    // sees the smooth normal; green and blue see the pores' relief (normal blending).
+    // few millimetres and too much wrap is what looks waxy. Red scatters furthest under the
+    // skin, so it sees the smooth normal; green and blue see the pores' relief.
     vec3 wrap = vec3(0.3, 0.13, 0.08) * (1.0 - hair) * (1.0 - 0.3 * u_age);
     vec3 lit = diffuse_light(n, wrap, contact);
     // Light in the shade reaches the eye after travelling through the skin: all but the
