@@ -265,7 +265,7 @@ DETAIL_SIZE = (2048, 1024)  # rows (v), columns (u) over assets.PAINT_UV_BOX; fi
 
 
 #: Bump when the detail recipe changes, so cached detail textures are redone.
-DETAIL_VERSION = 4  # 4: 2048 rows; 3: sheen on the cheekbones; 2: irregular age lines, an asymmetric nasolabial fold
+DETAIL_VERSION = 6  # 6: wider grooves; 5: positions upsampled cubically; 4: 2048 rows; 3: sheen on the cheekbones; 2: irregular age lines, an asymmetric nasolabial fold
 
 
 @lru_cache(maxsize=2)
@@ -278,7 +278,12 @@ def detail_texture(head) -> np.ndarray:
 
 
 def _build_detail(head) -> np.ndarray:
-    positions = _resize(position_map(head), DETAIL_SIZE)
+    # Cubic, not bilinear: the age lines are shaded from their slopes, and a bilinear
+    # upsampling's kinks every few texels show as dashes along a slanting line.
+    from scipy.ndimage import zoom
+
+    source = position_map(head)
+    positions = zoom(source, (DETAIL_SIZE[0] / source.shape[0], DETAIL_SIZE[1] / source.shape[1], 1), order=3)
     lips = _resize(head.masks["lips"].astype(np.float32) / 255, DETAIL_SIZE)
     centre, radius = head.eye_pivot(head.base_vertices, "left")
     margin = lid_margin_density(positions, centre, radius)
@@ -364,7 +369,7 @@ def age_line_density(positions: np.ndarray) -> np.ndarray:
     for k in range(5):
         height = 7.6 + 0.075 * k + rng.uniform(-0.012, 0.012)
         wave = rng.uniform(0.006, 0.016) * np.sin(rng.uniform(6, 12) * x + rng.uniform(0, 2 * np.pi))
-        d = (y - 0.12 * ax ** 2 - wave - height) / rng.uniform(0.008, 0.012)
+        d = (y - 0.12 * ax ** 2 - wave - height) / rng.uniform(0.016, 0.022)
         reach = rng.uniform(0.22, 0.42)
         along = (0.55 + 0.45 * np.sin(rng.uniform(8, 16) * x + rng.uniform(0, 2 * np.pi))) * smoothstep(reach, reach - 0.15, ax)
         out = np.maximum(out, rng.uniform(0.35, 0.7) * np.exp(-d * d) * along * front)
@@ -376,7 +381,7 @@ def age_line_density(positions: np.ndarray) -> np.ndarray:
     for k in range(6):
         ray = -0.75 + 0.3 * k + rng.uniform(-0.08, 0.08)
         bend = ray + rng.uniform(-0.6, 0.6) * (radius - 0.05)
-        width = 0.012 / np.maximum(radius, 0.03)
+        width = 0.018 / np.maximum(radius, 0.03)
         length = rng.uniform(0.09, 0.15)
         depth = rng.uniform(0.35, 0.7) * smoothstep(0.03, 0.055, radius) * smoothstep(length, length - 0.05, radius)
         out = np.maximum(out, depth * np.exp(-((angle - bend) / width) ** 2) * (dx > 0) * smoothstep(0.6, 0.9, z))

@@ -267,14 +267,14 @@ void main() {
 #else
     float line_depth = u_age;
 #endif
-    float cavity = 1.0 - 0.2 * line_depth * detail.a;
+    float cavity = 1.0 - 0.25 * line_depth * detail.a;
     // Surface frame for bump mapping from screen derivatives (Mikkelsen's surface gradient):
     // a height h tilts the normal to normalize(|det| n - sign(det) (dh/dx r1 + dh/dy r2)).
     vec3 dpdx = dFdx(v_pos), dpdy = dFdy(v_pos);
     vec3 r1 = cross(dpdy, n), r2 = cross(n, dpdx);
     float det = dot(dpdx, r1);
     vec3 n_smooth = n;
-    float age_h = -0.014 * line_depth * detail.a;   // up to 2 mm deep (dm)
+    float age_h = -0.022 * line_depth * detail.a;   // up to 3 mm deep (dm), ~2 mm across
     n = normalize(abs(det) * n - sign(det) * (dFdx(age_h) * r1 + dFdy(age_h) * r2));
 #ifdef USE_WRINKLE
     Fold fold = crease_fold(v_wrinkle, v_crease, v_uv);
