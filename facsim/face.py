@@ -188,6 +188,17 @@ class Face:
             occlusion[crease] *= lid_crease_shade(positions, centre, crease, weights, upper, height)
         return occlusion
 
+    def frame_lids(self, positions: np.ndarray) -> np.ndarray:
+        """(N_geo, 2) degrees of arc below the upper lid's margin and above the lower's of each
+        eyeball vertex where ``positions`` put the lids (90 elsewhere): the renderer's ``lids``."""
+        from facsim.render.geometry import lid_elevations
+
+        lids = np.full((len(positions), 2), 90.0, np.float32)
+        for side, (centre, upper, lower) in self._lid_margins.items():
+            eye = self.head.eye_vertices[side][self.head.eye_local[:, 2] > -0.3]
+            lids[eye] = lid_elevations(positions, centre, eye, upper, lower)
+        return lids
+
     @cached_property
     def _lid_creases(self) -> dict:
         """Side -> (crease skin vertices, weights, their rest height above the margin)."""
@@ -293,7 +304,7 @@ class Face:
         return self.renderer(options).render(
             positions, appearance=self.appearance, camera=camera,
             wrinkle=deformation.wrinkle, crease_phase=deformation.crease_phase, occlusion=self.frame_occlusion(positions),
-            proxies=self.proxy_draws(positions),
+            lids=self.frame_lids(positions), proxies=self.proxy_draws(positions),
         )
 
     def start_animation(self) -> Engine:

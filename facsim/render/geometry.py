@@ -225,6 +225,33 @@ def lid_shade(positions: np.ndarray, centre: np.ndarray, eye: np.ndarray, upper:
     return out.astype(np.float32)
 
 
+def lid_elevations(positions: np.ndarray, centre: np.ndarray, eye: np.ndarray, upper: np.ndarray,
+                   lower: np.ndarray) -> np.ndarray:
+    """How far (degrees of eyeball arc) each of one eyeball's vertices ``eye`` lies below its
+    upper lid's margin and above its lower lid's, at the vertex's own azimuth about ``centre``.
+
+    (N_eye, 2) float32: column 0 is the upper margin's elevation minus the vertex's, column 1
+    the vertex's minus the lower margin's; both are positive on the eyeball that shows between
+    the lids. The eyeball shader draws what lies along the margins from them (the lash line's
+    shadow under the upper lid, the wet rim and tear line over the lower one): they follow
+    the lids in every frame, as :func:`lid_shade` does.
+
+    >>> p = np.array([[0.0, 0, 1], [0.0, 0.5, 0.87], [0.1, 0.5, 0.86], [0.0, -0.5, 0.87], [0.1, -0.5, 0.86]])
+    >>> np.round(lid_elevations(p, np.zeros(3), np.array([0]), np.array([1, 2]), np.array([3, 4])), 1).tolist()
+    [[30.0, 30.0]]
+    """
+    p = np.asarray(positions)
+    lam, phi = spherical(p[eye].astype(np.float64), centre)
+    out = np.full((len(eye), 2), 90.0)
+    for k, (margin, sign) in enumerate(((upper, 1.0), (lower, -1.0))):
+        if len(margin) < 2:
+            continue
+        m_lam, m_phi = spherical(p[margin].astype(np.float64), centre)
+        order = np.argsort(m_lam)
+        out[:, k] = sign * (np.interp(lam, m_lam[order], m_phi[order]) - phi)
+    return out.astype(np.float32)
+
+
 #: The upper lid's crease (the supratarsal fold, where the levator's fibres pull the lid skin
 #: in): its height above the lid margin at rest (dm), half-width (dm) and shade.
 LID_CREASE = (0.07, 0.012, 0.3)
