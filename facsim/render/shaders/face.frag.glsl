@@ -131,7 +131,7 @@ const float KEY_REFLECTION = 0.5;
 // The fill is a broad bounce card to the side: a larger, dimmer reflection (it shows where
 // a lowered lid hides the key's, as in photographs).
 const vec2 FILL_BOX = vec2(0.2, 0.3);
-const float FILL_REFLECTION = 1.1;
+const float FILL_REFLECTION = 0.6;
 // Coverage of a soft-edged rounded rectangle of half-size `size` (radians) centred on the
 // light direction `l`, seen along the reflected ray `refl` (for catch-lights).
 float softbox(vec3 refl, vec3 l, vec2 size) {
@@ -142,7 +142,7 @@ float softbox(vec3 refl, vec3 l, vec2 size) {
     float d = sqrt(sqrt(dot(q, q)));   // a superellipse: a rectangle with rounded corners
     return (1.0 - smoothstep(0.65, 1.3, d)) * (0.8 + 0.2 * (1.0 - min(d, 1.0))) * step(0.0, dot(refl, l));
 }
-const float ROOM_REFLECTION = 0.08;
+const float ROOM_REFLECTION = 0.035;
 // Along the lids (degrees of eyeball arc from the margins, facsim.render.geometry.lid_elevations):
 // the lower lid's wet rim and the tear line over it; the upper lid's shadow (depth, reach).
 const float WET_RIM = 1.6;
@@ -346,7 +346,7 @@ void main() {
     iris *= mix(1.0, 0.28, smoothstep(1.0 - LIMBUS_WIDTH, 1.0, t));   // limbal ring
     // The pupil is not ink: the lens behind it returns a little light (and the cornea in
     // front reflects the room, below).
-    vec3 pupil = max(u_pupil, vec3(0.012, 0.011, 0.011)) * mix(1.4, 0.8, smoothstep(0.0, 0.8, r / PUPIL_RADIUS));
+    vec3 pupil = max(u_pupil, vec3(0.006, 0.0055, 0.0055)) * mix(1.3, 0.8, smoothstep(0.0, 0.8, r / PUPIL_RADIUS));
     iris = mix(iris, pupil, pupil_mask);
     float theta = acos(clamp(e.z, -1.0, 1.0));
     // Off-white sclera (never paper white): a touch warmer and pinker toward the corners
@@ -380,7 +380,8 @@ void main() {
     // thin pink band, with the tear meniscus's bright line just above it; under the upper
     // lid the lash line and the lid itself shade the eyeball deeply (below).
     float px = max(fwidth(v_lids.y), 1e-3);
-    float rim = 1.0 - smoothstep(WET_RIM - 0.5 * px, WET_RIM + 0.5 * px, v_lids.y);
+    float rim = (1.0 - smoothstep(WET_RIM - 0.5 * px, WET_RIM + 0.5 * px, v_lids.y))
+              * smoothstep(-3.0, -2.0, v_lids.y);   // (the lid hides what lies further below)
     albedo = mix(albedo, u_sclera * vec3(0.72, 0.45, 0.42), 0.85 * rim * front);
     float tear_w = max(TEAR_WIDTH, px);
     float tear = exp(-pow((v_lids.y - WET_RIM - 0.5 * TEAR_WIDTH) / tear_w, 2.0)) * TEAR_WIDTH / tear_w;

@@ -51,7 +51,10 @@ void main() {
     // v_depth: 0 at the lid ... 1 at the lash tips: each lash tapers to a fine point, so
     // the lash line is dense at the lid margin (it gives the upper lid its dark edge) and the
     // tips fade instead of ending in spikes (lower lashes start part-way along, proxies.py).
-    alpha = clamp(tex.a * 1.25, 0.0, 1.0) * mix(1.0, 0.15, smoothstep(0.0, 1.0, v_depth)) * u_density;
+    // At the roots the strands overlap into the dense, dark line that outlines a real eye
+    // (the lash line): there the texture's gaps close up; the tips stay apart.
+    alpha = clamp(tex.a * mix(2.0, 1.2, smoothstep(0.0, 0.4, v_depth)), 0.0, 1.0)
+          * mix(1.0, 0.15, smoothstep(0.1, 1.0, v_depth)) * u_density;
 #endif
     if (alpha < 0.01) discard;
 #else
@@ -179,6 +182,9 @@ void main() {
     float dk = clamp(dot(n, u_key_dir) * 0.5 + 0.5, 0.0, 1.0);
     vec3 lit = dk * u_key_col + u_fill_col + hemisphere(n);
     vec3 radiance = albedo * lit * 0.8;
+#ifdef KIND_EYELASHES
+    radiance *= mix(0.55, 0.9, v_depth);   // lashes: darkest in the dense line at their roots
+#endif
 #endif
     f_color = vec4(finish(radiance).rgb, alpha);
 }
