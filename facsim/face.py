@@ -219,15 +219,13 @@ class Face:
         return occlusion
 
     def frame_occlusion(self, positions: np.ndarray) -> np.ndarray:
-        """:attr:`shading_occlusion` with the eyeballs shaded by the lids where ``positions`` put them."""
-        from facsim.render.geometry import lid_crease_shade, lid_shade
+        """:attr:`shading_occlusion` with the upper lids' creases deepened or smoothed where
+        ``positions`` put the lids (the lids' shade on the eyeballs comes from :meth:`frame_lids`)."""
+        from facsim.render.geometry import lid_crease_shade
 
         occlusion = np.array(self.shading_occlusion, np.float32, copy=True)
         positions = self._in_head_frame(positions)
-        for side, (centre, upper, lower) in self._lid_margins.items():
-            # Only the eyeball's front can show between the lids (at any gaze 61-64 give).
-            eye = self.head.eye_vertices[side][self.head.eye_local[:, 2] > -0.3]
-            occlusion[eye] *= lid_shade(positions, centre, eye, upper, lower)
+        for side, (centre, upper, _) in self._lid_margins.items():
             crease, weights, height = self._lid_creases[side]
             occlusion[crease] *= lid_crease_shade(positions, centre, crease, weights, upper, height)
         return occlusion
@@ -240,6 +238,7 @@ class Face:
         lids = np.full((len(positions), 2), 90.0, np.float32)
         p = self._in_head_frame(positions)
         for side, (centre, upper, lower) in self._lid_margins.items():
+            # Only the eyeball's front can show between the lids (at any gaze 61-64 give).
             eye = self.head.eye_vertices[side][self.head.eye_local[:, 2] > -0.3]
             lids[eye] = lid_elevations(p, centre, eye, upper, lower)
         return lids

@@ -149,6 +149,10 @@ const float WET_RIM = 1.6;
 const float TEAR_WIDTH = 0.7;
 const float TEAR_SHINE = 0.15;
 const vec2 UPPER_SHADOW = vec2(0.6, 2.5);
+// The lids' broader shade on the eyeball, as ambient occlusion (depth at the margin, reach in
+// degrees: ~0.28 mm each on hm08); the lower lid's is lighter and shorter.
+const vec2 UPPER_LID_SHADE = vec2(0.6, 8.0);
+const vec2 LOWER_LID_SHADE = vec2(0.2, 3.0);
 #endif
 
 #if defined(REGION_TEETH) || defined(REGION_TONGUE)
@@ -360,7 +364,7 @@ void main() {
                   * smoothstep(0.45, 0.85, theta) * (0.5 + 0.5 * abs(cos(angle)));
     vec3 sclera = u_sclera * vec3(0.86, 0.83, 0.79)
                 * mix(vec3(1.0), vec3(1.0, 0.8, 0.74), 0.7 * corner)
-                * mix(vec3(1.0), vec3(0.95, 0.55, 0.5), clamp(1.6 * vessels, 0.0, 0.8));
+                * mix(vec3(1.0), vec3(0.95, 0.55, 0.5), clamp(1.1 * vessels, 0.0, 0.6));
     // Caruncle and plica: a pink, fleshy, wet mound fills the inner corner (e.x toward the
     // nose: -x for the eye on the +x side of the head), a darker fold (the plica) between
     // it and the sclera.
@@ -382,18 +386,24 @@ void main() {
     float px = max(fwidth(v_lids.y), 1e-3);
     float rim = (1.0 - smoothstep(WET_RIM - 0.5 * px, WET_RIM + 0.5 * px, v_lids.y))
               * smoothstep(-3.0, -2.0, v_lids.y);   // (the lid hides what lies further below)
-    albedo = mix(albedo, u_sclera * vec3(0.72, 0.45, 0.42), 0.85 * rim * front);
+    // (Both fade out toward the canthi, where the lower margin turns up steeply and the
+    // caruncle takes over.)
+    float along_lower = front * (1.0 - smoothstep(0.45, 0.62, abs(e.x))) * (1.0 - smoothstep(-0.1, 0.1, e.y));
+    albedo = mix(albedo, u_sclera * vec3(0.72, 0.45, 0.42), 0.85 * rim * along_lower);
     float tear_w = max(TEAR_WIDTH, px);
-    float tear = exp(-pow((v_lids.y - WET_RIM - 0.5 * TEAR_WIDTH) / tear_w, 2.0)) * TEAR_WIDTH / tear_w;
+    float tear = exp(-pow((v_lids.y - WET_RIM - 0.5 * TEAR_WIDTH) / tear_w, 2.0)) * TEAR_WIDTH / tear_w * along_lower;
     float lash_shadow = 1.0 - UPPER_SHADOW.x * exp(-max(v_lids.x, 0.0) / UPPER_SHADOW.y);
+    // The lids' broad shade: the thick upper fold stands off the eyeball and hides much of
+    // the light above it; the lower lid a little of the light below.
+    occ *= (1.0 - UPPER_LID_SHADE.x * exp(-max(v_lids.x, 0.0) / UPPER_LID_SHADE.y))
+         * (1.0 - LOWER_LID_SHADE.x * exp(-max(v_lids.y, 0.0) / LOWER_LID_SHADE.y));
 #else
     float rim = 0.0, tear = 0.0, lash_shadow = 1.0;
 #endif
     // The eyeball sits in the lids' shade. The thick upper lid and its lashes shadow a band
     // under its margin and the lower lid a little above its own: that shade follows the lids
-    // in every frame and arrives in occ (Face.frame_occlusion, facsim.render.geometry.lid_shade),
-    // so 5 bares lit sclera and 43 closes the shadow away; the lash line's own, sharper
-    // shadow comes from v_lids above. Here only what the lids cannot say: the canthi shade
+    // in every frame (v_lids, above), so 5 bares lit sclera and 43 closes the shadow away.
+    // Here only what the lids cannot say: the canthi shade
     // the corners, and light falls off over the eyeball's curve toward the orbit (eye frame:
     // +y up, +x across the eye; at rest about e.y in [-0.2, 0.2] and e.x in [-0.65, 0.65]
     // show between the lids). The socket around it hides much of the sky: the whole eyeball

@@ -53,7 +53,7 @@ void main() {
     // tips fade instead of ending in spikes (lower lashes start part-way along, proxies.py).
     // At the roots the strands overlap into the dense, dark line that outlines a real eye
     // (the lash line): there the texture's gaps close up; the tips stay apart.
-    alpha = clamp(tex.a * mix(2.0, 1.2, smoothstep(0.0, 0.4, v_depth)), 0.0, 1.0)
+    alpha = clamp(tex.a * mix(1.7, 1.2, smoothstep(0.0, 0.4, v_depth)), 0.0, 1.0)
           * mix(1.0, 0.15, smoothstep(0.1, 1.0, v_depth)) * u_density;
 #endif
     if (alpha < 0.01) discard;
