@@ -146,6 +146,7 @@ const float ROOM_REFLECTION = 0.035;
 // Along the lids (degrees of eyeball arc from the margins, facsim.render.geometry.lid_elevations):
 // the lower lid's wet rim and the tear line over it; the upper lid's shadow (depth, reach).
 const float WET_RIM = 1.6;
+const vec3 WET_RIM_COLOR = vec3(0.5, 0.25, 0.23);   // moist lid tissue (linear), whatever the skin
 const float TEAR_WIDTH = 0.7;
 const float TEAR_SHINE = 0.15;
 const vec2 UPPER_SHADOW = vec2(0.6, 2.5);
@@ -389,7 +390,7 @@ void main() {
     // (Both fade out toward the canthi, where the lower margin turns up steeply and the
     // caruncle takes over.)
     float along_lower = front * (1.0 - smoothstep(0.45, 0.62, abs(e.x))) * (1.0 - smoothstep(-0.1, 0.1, e.y));
-    albedo = mix(albedo, u_sclera * vec3(0.72, 0.45, 0.42), 0.85 * rim * along_lower);
+    albedo = mix(albedo, WET_RIM_COLOR, rim * along_lower);
     float tear_w = max(TEAR_WIDTH, px);
     float tear = exp(-pow((v_lids.y - WET_RIM - 0.5 * TEAR_WIDTH) / tear_w, 2.0)) * TEAR_WIDTH / tear_w * along_lower;
     float lash_shadow = 1.0 - UPPER_SHADOW.x * exp(-max(v_lids.x, 0.0) / UPPER_SHADOW.y);
