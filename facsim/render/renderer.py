@@ -501,6 +501,7 @@ class Renderer:
             self._fix_winding(p)
             self._rebuild_draws()
         self._update_vertices(p, w_geo, phase, occ, lids)
+        self._set_eye_centres(p)
         self._creased = w_geo is not None and bool(w_geo.any())
         if appearance is not self._appearance:
             self._upload_appearance(appearance)
@@ -761,6 +762,18 @@ class Renderer:
             out[eye, 6] = gap[..., 0] if lids is not None else gap[0]
             out[eye, 8] = gap[..., 1] if lids is not None else gap[1]
         self._vbo_dynamic.write(out)
+
+    def _set_eye_centres(self, p: np.ndarray) -> None:
+        """The eyeballs' centres and radius this frame, for what the eyeball shader draws fixed
+        to the socket rather than to the turning eye (the caruncle, the canthi's shade)."""
+        if len(self._eyes) != 2 or "eyeball" not in self._programs:
+            return
+        centres = [p[eye].astype(np.float64).mean(axis=0) for eye in self._eyes]
+        radius = max(float(np.linalg.norm(p[eye] - c, axis=1).max()) for eye, c in zip(self._eyes, centres))
+        prog = self._programs["eyeball"]
+        _set_uniform(prog, "u_eye_a", tuple(float(x) for x in centres[0]))
+        _set_uniform(prog, "u_eye_b", tuple(float(x) for x in centres[1]))
+        _set_uniform(prog, "u_eye_radius", radius)
 
     def _set_camera(self, camera: Camera, lighting: Lighting) -> None:
         w, h = self.size

@@ -114,6 +114,12 @@ vec2 brow_hair(vec2 uv, float density) {
 uniform vec3 u_sclera;
 uniform vec3 u_iris;
 uniform vec3 u_pupil;
+// Both eyeballs' centres and radius this frame (Renderer._set_eye_centres; a lone eye: the
+// same point twice): what belongs to the socket (caruncle, canthi) is placed from them, not
+// from the eye's own frame, which turns with the gaze (61-64).
+uniform vec3 u_eye_a = vec3(1.0, 0.0, 0.0);
+uniform vec3 u_eye_b = vec3(-1.0, 0.0, 0.0);
+uniform float u_eye_radius = 1.0;
 // Radii as fractions of the eyeball radius, measured in the plane across the gaze axis
 // (length of eye_coord.xy on the front half). hm08's eyeballs are 1.59 cm in radius:
 // an iris 11.7 mm across (the adult mean) and a 4 mm pupil.
@@ -353,6 +359,15 @@ void main() {
     // front reflects the room, below).
     vec3 pupil = max(u_pupil, vec3(0.006, 0.0055, 0.0055)) * mix(1.3, 0.8, smoothstep(0.0, 0.8, r / PUPIL_RADIUS));
     iris = mix(iris, pupil, pupil_mask);
+    // The socket's frame: hx across the eye toward the nose (the other eye), hy up, in
+    // eyeball radii from this eye's centre.
+    bool on_a = distance(v_pos, u_eye_a) < distance(v_pos, u_eye_b);
+    vec3 centre = on_a ? u_eye_a : u_eye_b;
+    vec3 to_nose = (on_a ? u_eye_b : u_eye_a) - centre;
+    to_nose = length(to_nose) > 1e-6 ? normalize(to_nose) : vec3(-sign(v_pos.x), 0.0, 0.0);
+    vec3 socket = (v_pos - centre) / u_eye_radius;
+    float hx = dot(socket, to_nose);
+    float hy = socket.y;
     float theta = acos(clamp(e.z, -1.0, 1.0));
     // Off-white sclera (never paper white): a touch warmer and pinker toward the corners
     // (conjunctival vessels, strongest nasally and temporally), with faint, thin vessels
@@ -369,9 +384,8 @@ void main() {
     // Caruncle and plica: a pink, fleshy, wet mound fills the inner corner (e.x toward the
     // nose: -x for the eye on the +x side of the head), a darker fold (the plica) between
     // it and the sclera.
-    float nasal_x = -sign(v_pos.x) * e.x;
-    float nasal = front * smoothstep(CARUNCLE.x, CARUNCLE.y, nasal_x);
-    float plica = front * exp(-pow((nasal_x - CARUNCLE.x) / 0.03, 2.0));
+    float nasal = smoothstep(CARUNCLE.x, CARUNCLE.y, hx);
+    float plica = exp(-pow((hx - CARUNCLE.x) / 0.03, 2.0));
     sclera *= 1.0 - 0.25 * plica;
     sclera = mix(sclera, u_sclera * vec3(0.78, 0.42, 0.40) * (0.85 + 0.3 * value_noise(e.xy * 60.0, 0)), nasal);
     // The limbus blends softly into the sclera as a greyish ring (no cut-out edge).
@@ -389,7 +403,7 @@ void main() {
               * smoothstep(-3.0, -2.0, v_lids.y);   // (the lid hides what lies further below)
     // (Both fade out toward the canthi, where the lower margin turns up steeply and the
     // caruncle takes over.)
-    float along_lower = front * (1.0 - smoothstep(0.45, 0.62, abs(e.x))) * (1.0 - smoothstep(-0.1, 0.1, e.y));
+    float along_lower = (1.0 - smoothstep(0.45, 0.62, abs(hx))) * (1.0 - smoothstep(-0.1, 0.1, hy));
     albedo = mix(albedo, WET_RIM_COLOR, rim * along_lower);
     float tear_w = max(TEAR_WIDTH, px);
     float tear = exp(-pow((v_lids.y - WET_RIM - 0.5 * TEAR_WIDTH) / tear_w, 2.0)) * TEAR_WIDTH / tear_w * along_lower;
@@ -405,11 +419,11 @@ void main() {
     // under its margin and the lower lid a little above its own: that shade follows the lids
     // in every frame (v_lids, above), so 5 bares lit sclera and 43 closes the shadow away.
     // Here only what the lids cannot say: the canthi shade
-    // the corners, and light falls off over the eyeball's curve toward the orbit (eye frame:
-    // +y up, +x across the eye; at rest about e.y in [-0.2, 0.2] and e.x in [-0.65, 0.65]
-    // show between the lids). The socket around it hides much of the sky: the whole eyeball
+    // the corners, and light falls off over the eyeball's curve toward the orbit (socket
+    // frame: at rest about hy in [-0.2, 0.2] and hx in [-0.65, 0.65] show between the
+    // lids). The socket around it hides much of the sky: the whole eyeball
     // takes less ambient than the skin.
-    float lid_shade = 0.7 * (1.0 - 0.15 * smoothstep(-0.05, 0.3, e.y)) * (1.0 - 0.5 * smoothstep(0.32, 0.68, abs(e.x)))
+    float lid_shade = 0.7 * (1.0 - 0.15 * smoothstep(-0.05, 0.3, hy)) * (1.0 - 0.5 * smoothstep(0.32, 0.68, abs(hx)))
                     * lash_shadow;
     vec3 diffuse = diffuse_light(n, vec3(0.15), occ) * albedo * lid_shade;
     // Wet surface. The cornea bulges over the iris as a sphere of 1.33 iris radii (7.8 mm
