@@ -239,7 +239,7 @@ class Face:
         p = self._in_head_frame(positions)
         for side, (centre, upper, lower) in self._lid_margins.items():
             # Only the eyeball's front can show between the lids (at any gaze 61-64 give).
-            eye = self.head.eye_vertices[side][self.head.eye_local[:, 2] > -0.3]
+            eye = self.head.eye_vertices[side][self.head.eye_local[:, 2] > -0.1]
             lids[eye] = lid_elevations(p, centre, eye, upper, lower)
         return lids
 

@@ -196,7 +196,10 @@ def _faces_touching(face_uv: np.ndarray, mask: np.ndarray) -> np.ndarray:
 #: weighted over this many degrees of azimuth, softened over this many of elevation.
 MARGIN_SMOOTHING = (2.5, 1.0)
 #: Azimuth step (degrees) at which the margins' curves are sampled for distances to them.
-MARGIN_STEP = 0.5
+MARGIN_STEP = 1.0
+#: Eyeball vertices further than this (degrees) above or below a margin get their vertical
+#: distance to it, not the distance to its curve.
+MARGIN_NEAR = 12.0
 
 
 def margin_elevation(lam: np.ndarray, m_lam: np.ndarray, m_phi: np.ndarray, *, lowest: bool = True) -> np.ndarray:
@@ -253,13 +256,17 @@ def lid_elevations(positions: np.ndarray, centre: np.ndarray, eye: np.ndarray, u
         if len(margin) < 2:
             continue
         m_lam, m_phi = spherical(p[margin].astype(np.float64), centre)
-        side = np.sign(sign * (margin_elevation(lam, m_lam, m_phi, lowest=sign > 0) - phi))
+        vertical = sign * (margin_elevation(lam, m_lam, m_phi, lowest=sign > 0) - phi)
+        out[:, k] = vertical
+        # Only what lies near the margin needs the distance to its curve (the bands drawn
+        # from it are a few degrees wide); further off, straight up or down will do.
+        near = np.flatnonzero(np.abs(vertical) < MARGIN_NEAR)
         c_lam = np.arange(m_lam.min(), m_lam.max() + MARGIN_STEP, MARGIN_STEP)
         c_phi = margin_elevation(c_lam, m_lam, m_phi, lowest=sign > 0)
         # Equirectangular distances: the visible eye spans well under 60 degrees of elevation.
-        d_lam = (lam[:, None] - c_lam[None, :]) * np.cos(np.radians(0.5 * (phi[:, None] + c_phi[None, :])))
-        dist = np.sqrt((d_lam ** 2 + (phi[:, None] - c_phi[None, :]) ** 2).min(axis=1))
-        out[:, k] = np.where(side == 0, 1.0, side) * dist
+        d_lam = (lam[near, None] - c_lam[None, :]) * np.cos(np.radians(phi[near, None]))
+        dist = np.sqrt((d_lam ** 2 + (phi[near, None] - c_phi[None, :]) ** 2).min(axis=1))
+        out[near, k] = np.where(vertical[near] < 0.0, -1.0, 1.0) * np.minimum(dist, np.abs(vertical[near]))
     return out.astype(np.float32)
 
 
