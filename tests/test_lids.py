@@ -84,3 +84,19 @@ def test_the_lids_shade_on_the_eyeball_follows_the_upper_lid(face_of):
     assert (at_rest[:, 1] > 25.0).all() and (widened[:, 1] > 25.0).all()
     others = np.setdiff1d(np.arange(len(face.neutral)), np.concatenate(list(face.head.eye_vertices.values())))
     assert (face.frame_lids(face.neutral)[others] == 90.0).all()   # only eyeballs carry lid distances
+
+def test_lashes_turn_with_the_closing_lid(face_of):
+    """Upper lashes swing forward and down with a closing lid (no fence of spikes standing on a
+    closed lid) and sit exactly where their binding puts them at rest."""
+    face = face_of("ava")
+    lashes = next(b for b in face.proxies if b.proxy.kind == "eyelashes")
+    rest = face._proxy_positions(lashes, face.neutral)
+    assert np.allclose(rest, lashes.binding.positions(face.neutral), atol=1e-5)
+    roots, _, _ = face._lash_roots(id(lashes))
+    upper = np.isin(roots, np.concatenate([m[1] for m in face._lid_margins.values()]))
+    closed = np.asarray(face.deform("45E").positions)
+    turned = face._proxy_positions(lashes, closed)
+    rise = lambda p, geo: (p - geo[roots])[upper, 1]   # noqa: E731 — each vertex's height above its root
+    stiff = lashes.binding.positions(closed)
+    assert rise(turned, closed).mean() < 0.5 * rise(rest, face.neutral).mean()
+    assert rise(stiff, closed).mean() > rise(turned, closed).mean() + 0.005   # the plain binding kept them up

@@ -2,7 +2,7 @@
 // own program, so a fragment runs only its region's code: on llvmpipe both sides of a branch
 // cost, even when a uniform switches one off). Variants:
 //   REGION_SKIN (+ USE_UV, USE_WRINKLE; + USE_BROWS for triangles under painted brows),
-//   REGION_EYEBALL (+ USE_EYE), REGION_TEETH, REGION_TONGUE, REGION_MOUTH_INTERIOR,
+//   REGION_EYEBALL (+ USE_EYE, USE_LIDS), REGION_TEETH, REGION_TONGUE, REGION_MOUTH_INTERIOR,
 //   REGION_LASHES (+ USE_LASH).
 // All colour uniforms are linear RGB (render.py linearises the appearance's sRGB colours).
 
