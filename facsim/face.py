@@ -114,9 +114,52 @@ class Face:
         """This frame's :class:`facsim.render.proxies.ProxyDraw` s for geometry ``positions``."""
         from facsim.render.proxies import ProxyDraw
 
-        return [ProxyDraw(mesh, bound.binding.positions(positions), tuple(self.colors[bound.color_key]), bound.sheen,
-                          bound.density, bound.coil)
+        return [ProxyDraw(mesh, self._proxy_positions(bound, positions), tuple(self.colors[bound.color_key]),
+                          bound.sheen, bound.density, bound.coil)
                 for bound, mesh in zip(self.proxies, self.proxy_meshes)]
+
+    def _proxy_positions(self, bound, positions: np.ndarray) -> np.ndarray:
+        """A proxy's vertices on geometry ``positions``; lashes turn with their lids."""
+        if bound.proxy.kind != "eyelashes":
+            return bound.binding.positions(positions)
+        from facsim.engines.checks import head_rotation
+        from facsim.engines.lids import lashes_turned_with_lids
+
+        roots, eye_of, vectors = self._lash_roots(id(bound))
+        p = np.asarray(positions)
+        eyes = list(self.head.eye_vertices.values())
+        centres = np.array([p[v].mean(axis=0) for v in eyes])[eye_of]
+        rest_centres = np.array([self.neutral[v].mean(axis=0) for v in eyes])[eye_of]
+        rotation = head_rotation(self.neutral[self._skull], p[self._skull])
+        return lashes_turned_with_lids(p[roots], self.neutral[roots], vectors, centres, rest_centres, rotation)
+
+    def _lash_roots(self, key: int):
+        """(roots, eye index, root-to-vertex vectors) of a lash proxy's vertices on the neutral
+        face: each vertex's root is the nearest lid-margin vertex."""
+        if key not in self._lash_cache:
+            from scipy.spatial import cKDTree
+
+            bound = next(b for b in self.proxies if id(b) == key)
+            rest = bound.binding.positions(self.neutral)
+            margins = [np.concatenate([upper, lower]) for _, upper, lower in self._lid_margins.values()]
+            every = np.concatenate(margins)
+            nearest = cKDTree(self.neutral[every]).query(rest)[1]
+            eye_of = np.repeat(np.arange(len(margins)), [len(m) for m in margins])[nearest]
+            roots = every[nearest]
+            self._lash_cache[key] = (roots, eye_of, (rest - self.neutral[roots]).astype(np.float64))
+        return self._lash_cache[key]
+
+    @cached_property
+    def _lash_cache(self) -> dict:
+        return {}
+
+    @cached_property
+    def _skull(self) -> np.ndarray:
+        """Skin vertices that only the head's own motion moves (the scalp, well above the
+        brows), for its rotation (:func:`facsim.engines.checks.head_rotation`)."""
+        skin = np.asarray(self.neutral)[: self.head.skin_vertex_count]
+        top = np.flatnonzero(skin[:, 1] > skin[:, 1].max() - 0.6)
+        return top[:: max(1, len(top) // 400)]
 
     @cached_property
     def colors(self) -> dict:
@@ -176,17 +219,42 @@ class Face:
         return occlusion
 
     def frame_occlusion(self, positions: np.ndarray) -> np.ndarray:
-        """:attr:`shading_occlusion` with the eyeballs shaded by the lids where ``positions`` put them."""
-        from facsim.render.geometry import lid_crease_shade, lid_shade
+        """:attr:`shading_occlusion` with the upper lids' creases deepened or smoothed where
+        ``positions`` put the lids (the lids' shade on the eyeballs comes from :meth:`frame_lids`)."""
+        from facsim.render.geometry import lid_crease_shade
 
         occlusion = np.array(self.shading_occlusion, np.float32, copy=True)
-        for side, (centre, upper, lower) in self._lid_margins.items():
-            # Only the eyeball's front can show between the lids (at any gaze 61-64 give).
-            eye = self.head.eye_vertices[side][self.head.eye_local[:, 2] > -0.3]
-            occlusion[eye] *= lid_shade(positions, centre, eye, upper, lower)
+        positions = self._in_head_frame(positions)
+        for side, (centre, upper, _) in self._lid_margins.items():
             crease, weights, height = self._lid_creases[side]
             occlusion[crease] *= lid_crease_shade(positions, centre, crease, weights, upper, height)
         return occlusion
+
+    def frame_lids(self, positions: np.ndarray) -> np.ndarray:
+        """(N_geo, 2) degrees of arc below the upper lid's margin and above the lower's of each
+        eyeball vertex where ``positions`` put the lids (90 elsewhere): the renderer's ``lids``."""
+        from facsim.render.geometry import lid_elevations
+
+        lids = np.full((len(positions), 2), 90.0, np.float32)
+        p = self._in_head_frame(positions)
+        for side, (centre, upper, lower) in self._lid_margins.items():
+            # Only the eyeball's front can show between the lids (at any gaze 61-64 give).
+            eye = self.head.eye_vertices[side][self.head.eye_local[:, 2] > -0.1]
+            lids[eye] = lid_elevations(p, centre, eye, upper, lower)
+        return lids
+
+    def _in_head_frame(self, positions: np.ndarray) -> np.ndarray:
+        """``positions`` with the head's own turn (51-58) undone, so angles about the eyes
+        are measured as on the neutral head (elevations are about its up axis)."""
+        from facsim.engines.checks import head_rotation
+
+        p = np.asarray(positions, np.float64)
+        skull = self._skull
+        rotation = head_rotation(self.neutral[skull].astype(np.float64), p[skull])
+        if np.allclose(rotation, np.eye(3), atol=1e-6):
+            return np.asarray(positions)
+        now, rest = p[skull].mean(axis=0), self.neutral[skull].astype(np.float64).mean(axis=0)
+        return ((p - now) @ rotation + rest).astype(np.float32)
 
     @cached_property
     def _lid_creases(self) -> dict:
@@ -293,7 +361,7 @@ class Face:
         return self.renderer(options).render(
             positions, appearance=self.appearance, camera=camera,
             wrinkle=deformation.wrinkle, crease_phase=deformation.crease_phase, occlusion=self.frame_occlusion(positions),
-            proxies=self.proxy_draws(positions),
+            lids=self.frame_lids(positions), proxies=self.proxy_draws(positions),
         )
 
     def start_animation(self) -> Engine:

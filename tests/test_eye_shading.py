@@ -67,3 +67,17 @@ def test_a_catch_light_sits_on_the_iris(eye_pixels):
     lum_iris = _luminance(image[iris])
     assert lum_iris.max() > np.median(lum_iris) + 60  # a small bright catch-light ...
     assert (lum_iris > np.median(lum_iris) + 60).mean() < 0.05  # ... not a glossy sheet
+
+
+def test_the_upper_lid_and_lashes_shade_the_sclera_below_them(eye_pixels):
+    """Beside the iris, the sclera's top rows lie in the lash line's shadow: dark under the lid,
+    brightening toward the middle (it was an evenly lit, glassy white to the lid's edge)."""
+    image, sclera, iris = eye_pixels
+    lum = _luminance(image)
+    for side in (slice(0, SIZE // 2), slice(SIZE // 2, SIZE)):
+        mask = np.zeros_like(sclera)
+        mask[:, side] = sclera[:, side]
+        ys, xs = np.nonzero(mask)
+        beside = np.abs(xs - (np.nonzero(iris[:, side])[1].mean() + side.start)) < SIZE / 25
+        rows = [lum[y, xs[beside][ys[beside] == y]].mean() for y in range(ys[beside].min(), ys[beside].max() + 1)]
+        assert np.mean(rows[:3]) < 0.65 * max(rows), rows

@@ -68,15 +68,35 @@ def test_5_widens_and_43_closes_from_the_relaxed_rest(face_of, engine):
 
 
 def test_the_lids_shade_on_the_eyeball_follows_the_upper_lid(face_of):
-    """Sclera just above the iris is in the upper lid's shadow at rest and bared, lit, by 5."""
+    """Sclera just above the iris lies under the upper lid or in its shadow at rest (the shader
+    shades the eyeball by its distance below the margin, Face.frame_lids), bared by 5, covered
+    further by 43; the lower lid is far below it throughout."""
     face = face_of("ava")
     eye = face.head.eye_vertices["left"]
     local = face.head.eye_local
     band = eye[(local[:, 2] > 0.8) & (local[:, 1] > 0.3) & (local[:, 1] < 0.45) & (np.abs(local[:, 0]) < 0.15)]
     assert len(band) >= 2
-    from facsim.render.geometry import lid_shade
+    at_rest, widened, closed = (face.frame_lids(p)[band] for p in (face.neutral, face.deform("5E").positions,
+                                                                   face.deform("43E").positions))
+    assert at_rest[:, 0].mean() < 3.0                          # under the lid or within its shadow (degrees)
+    assert widened[:, 0].mean() > at_rest[:, 0].mean() + 10.0  # 5 raises the margin well above it
+    assert closed[:, 0].mean() < at_rest[:, 0].mean() - 20.0
+    assert (at_rest[:, 1] > 25.0).all() and (widened[:, 1] > 25.0).all()
+    others = np.setdiff1d(np.arange(len(face.neutral)), np.concatenate(list(face.head.eye_vertices.values())))
+    assert (face.frame_lids(face.neutral)[others] == 90.0).all()   # only eyeballs carry lid distances
 
-    centre, upper, lower = face._lid_margins["left"]
-    at_rest, widened = (lid_shade(p, centre, band, upper, lower) for p in (face.neutral, face.deform("5E").positions))
-    assert np.allclose(face.frame_occlusion(face.neutral)[band], face.shading_occlusion[band] * at_rest)
-    assert at_rest.mean() < 0.75 and widened.mean() > at_rest.mean() + 0.1, (at_rest, widened)
+def test_lashes_turn_with_the_closing_lid(face_of):
+    """Upper lashes swing forward and down with a closing lid (no fence of spikes standing on a
+    closed lid) and sit exactly where their binding puts them at rest."""
+    face = face_of("ava")
+    lashes = next(b for b in face.proxies if b.proxy.kind == "eyelashes")
+    rest = face._proxy_positions(lashes, face.neutral)
+    assert np.allclose(rest, lashes.binding.positions(face.neutral), atol=1e-5)
+    roots, _, _ = face._lash_roots(id(lashes))
+    upper = np.isin(roots, np.concatenate([m[1] for m in face._lid_margins.values()]))
+    closed = np.asarray(face.deform("45E").positions)
+    turned = face._proxy_positions(lashes, closed)
+    rise = lambda p, geo: (p - geo[roots])[upper, 1]   # noqa: E731 — each vertex's height above its root
+    stiff = lashes.binding.positions(closed)
+    assert rise(turned, closed).mean() < 0.5 * rise(rest, face.neutral).mean()
+    assert rise(stiff, closed).mean() > rise(turned, closed).mean() + 0.005   # the plain binding kept them up

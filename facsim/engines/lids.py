@@ -283,3 +283,33 @@ def closing_column(head, data, base_positions: np.ndarray, pattern: str, side: s
         return left
     mirror = head.mirror[: len(head.base_index)]
     return left[mirror] * np.array([-1.0, 1.0, 1.0], np.float32)
+
+
+
+def lashes_turned_with_lids(roots: np.ndarray, rest_roots: np.ndarray, vectors: np.ndarray, centres: np.ndarray,
+                            rest_centres: np.ndarray, rotation: np.ndarray | None = None) -> np.ndarray:
+    """Lash vertices that turn about the eyeball with the lid margin they grow from.
+
+    Lashes grow from the tarsal plate, which turns about the eyeball as the lid opens and
+    closes: a closing upper lid (43, 45, 7) swings its lashes from up-and-out to forward and
+    down instead of carrying them down still pointing up (a fence of spikes on the closed
+    lid). Each lash vertex hangs off its root on the margin: ``rest_roots`` (V, 3) and
+    ``vectors`` (V, 3, root to vertex) on the neutral face, ``roots`` (V, 3) now; the vector
+    turns about the head's horizontal axis through the eyeball (``centres``/``rest_centres``
+    (V, 3), each vertex's eye) by as much as the root's elevation changed, measured in the
+    head's frame (``rotation``, (3, 3) rest to now, from :func:`facsim.engines.checks.head_rotation`;
+    default none), then turns with the head.
+
+    >>> up = lashes_turned_with_lids(np.array([[0.0, 0.0, 1.0]]), np.array([[0.0, 0.7071, 0.7071]]),
+    ...                              np.array([[0.0, 0.1, 0.0]]), np.zeros((1, 3)), np.zeros((1, 3)))
+    >>> [round(float(x), 3) for x in up[0]]   # the root fell 45 degrees: the lash leans forward
+    [0.0, 0.071, 1.071]
+    """
+    turn_head = np.eye(3) if rotation is None else np.asarray(rotation, np.float64)
+    q = (np.asarray(roots, np.float64) - centres) @ turn_head        # now, in the head's rest frame
+    q0 = np.asarray(rest_roots, np.float64) - rest_centres
+    turn = np.arctan2(q[:, 1], q[:, 2]) - np.arctan2(q0[:, 1], q0[:, 2])
+    cos, sin = np.cos(turn), np.sin(turn)
+    o = np.asarray(vectors, np.float64)
+    turned = np.stack([o[:, 0], cos * o[:, 1] + sin * o[:, 2], -sin * o[:, 1] + cos * o[:, 2]], axis=1)
+    return (np.asarray(roots, np.float64) + turned @ turn_head.T).astype(np.float32)

@@ -190,38 +190,83 @@ def _faces_touching(face_uv: np.ndarray, mask: np.ndarray) -> np.ndarray:
 
 
 
-#: The upper lid's shadow on the eyeball: its depth just under the margin and its reach
-#: (degrees of eyeball arc, ~0.28 mm each on hm08); the lower lid's is lighter and shorter.
-UPPER_LID_SHADE = (0.6, 8.0)
-LOWER_LID_SHADE = (0.2, 3.0)
+#: A lid margin's vertices lie in two or three rows a few degrees of arc apart (its outer
+#: and inner edges); the eyeball shows up to the row nearest it. A margin's elevation is a
+#: soft envelope of its vertices (the lowest row of the upper lid, the highest of the lower):
+#: weighted over this many degrees of azimuth, softened over this many of elevation.
+MARGIN_SMOOTHING = (2.5, 1.0)
+#: Azimuth step (degrees) at which the margins' curves are sampled for distances to them.
+MARGIN_STEP = 1.0
+#: Eyeball vertices further than this (degrees) above or below a margin get their vertical
+#: distance to it, not the distance to its curve.
+MARGIN_NEAR = 12.0
 
 
-def lid_shade(positions: np.ndarray, centre: np.ndarray, eye: np.ndarray, upper: np.ndarray,
-              lower: np.ndarray) -> np.ndarray:
-    """Shade (N_eye,) in (0, 1] of one eyeball's vertices ``eye`` under its lids.
+def margin_elevation(lam: np.ndarray, m_lam: np.ndarray, m_phi: np.ndarray, *, lowest: bool = True) -> np.ndarray:
+    """A lid margin's elevation (degrees) at azimuths ``lam``, from its vertices' azimuths
+    ``m_lam`` and elevations ``m_phi``: the soft lower (``lowest``, the upper lid) or upper
+    envelope of the rows near each azimuth (:data:`MARGIN_SMOOTHING`), so the edge is as
+    smooth as a lid's and does not zigzag between the rows. Held at the end values beyond
+    the corners.
 
-    The upper lid is a thick fold that stands off the eyeball and carries the lashes: it
-    shades a band of the eyeball just below its margin; the lower lid, a little of the
-    eyeball just above it. Each eyeball vertex is compared with the margins' elevation
-    (about ``centre``) at its own azimuth, so the shadow follows the lids in every frame
-    (5 raises it with the lid, 43 closes it away). ``upper``/``lower`` are the margins'
-    skin vertices.
+    >>> m_lam, m_phi = np.array([-10.0, -1.0, 1.0, 10.0]), np.array([5.0, 4.0, 9.0, 5.0])
+    >>> [round(float(x), 1) for x in margin_elevation(np.array([0.0, 50.0]), m_lam, m_phi)]
+    [4.7, 5.0]
+    >>> [round(float(x), 1) for x in margin_elevation(np.array([0.0, 50.0]), m_lam, m_phi, lowest=False)]
+    [8.3, 5.0]
+    """
+    width, soft = MARGIN_SMOOTHING
+    sign = 1.0 if lowest else -1.0
+    lam = np.clip(np.asarray(lam, np.float64), m_lam.min(), m_lam.max())
+    log_w = -(((lam[:, None] - m_lam[None, :]) / width) ** 2) - sign * m_phi[None, :] / soft
+    top = log_w.max(axis=1, keepdims=True)
+    norm = -(((lam[:, None] - m_lam[None, :]) / width) ** 2)
+    top_n = norm.max(axis=1, keepdims=True)
+    log_mean = (np.log(np.exp(log_w - top).sum(axis=1)) + top[:, 0]) - (np.log(np.exp(norm - top_n).sum(axis=1)) + top_n[:, 0])
+    return -sign * soft * log_mean
+
+
+def lid_elevations(positions: np.ndarray, centre: np.ndarray, eye: np.ndarray, upper: np.ndarray,
+                   lower: np.ndarray) -> np.ndarray:
+    """How far (degrees of eyeball arc) each of one eyeball's vertices ``eye`` lies below its
+    upper lid's margin and above its lower lid's, about the eyeball's ``centre``.
+
+    (N_eye, 2) float32: column 0 is the distance to the upper margin, column 1 to the lower
+    one, both positive on the eyeball that shows between the lids (on its side of the margin)
+    and negative beyond. A distance is to the nearest point of the margin's curve
+    (:func:`margin_elevation` sampled along its azimuths), not straight up or down: near the
+    corners, where the margins turn steeply, a band drawn at a fixed distance hugs the lid
+    instead of cutting across the sclera. The eyeball shader draws what lies along the margins from them (the lash line's
+    shadow under the upper lid, the wet rim and tear line over the lower one): they follow
+    the lids in every frame (5 bares lit sclera, 43 closes the shadow away).
 
     >>> p = np.array([[0.0, 0, 1], [0.0, 0.5, 0.87], [0.1, 0.5, 0.86], [0.0, -0.5, 0.87], [0.1, -0.5, 0.86]])
-    >>> s = lid_shade(p, np.zeros(3), np.array([0]), np.array([1, 2]), np.array([3, 4]))
-    >>> 0.5 < float(s[0]) < 1.0
-    True
+    >>> [round(float(x)) for x in lid_elevations(p, np.zeros(3), np.array([0]), np.array([1, 2]), np.array([3, 4]))[0]]
+    [30, 30]
     """
     p = np.asarray(positions)
     lam, phi = spherical(p[eye].astype(np.float64), centre)
-    out = np.ones(len(eye))
-    for margin, (depth, reach), sign in ((upper, UPPER_LID_SHADE, 1.0), (lower, LOWER_LID_SHADE, -1.0)):
+    out = np.full((len(eye), 2), 90.0)
+    radius = np.linalg.norm(p[eye] - centre, axis=1).max()
+    for k, (margin, sign) in enumerate(((upper, 1.0), (lower, -1.0))):
+        # Margin vertices tucked in behind the eyeball's surface (at the canthi) are hidden
+        # by it: the edge the eye shows against is the lid's part in front of it.
+        outside = margin[np.linalg.norm(p[margin] - centre, axis=1) > 0.97 * radius]
+        margin = outside if len(outside) >= 2 else margin
         if len(margin) < 2:
             continue
         m_lam, m_phi = spherical(p[margin].astype(np.float64), centre)
-        order = np.argsort(m_lam)
-        inside = np.maximum(sign * (np.interp(lam, m_lam[order], m_phi[order]) - phi), 0.0)
-        out *= 1.0 - depth * np.exp(-inside / reach)
+        vertical = sign * (margin_elevation(lam, m_lam, m_phi, lowest=sign > 0) - phi)
+        out[:, k] = vertical
+        # Only what lies near the margin needs the distance to its curve (the bands drawn
+        # from it are a few degrees wide); further off, straight up or down will do.
+        near = np.flatnonzero(np.abs(vertical) < MARGIN_NEAR)
+        c_lam = np.arange(m_lam.min(), m_lam.max() + MARGIN_STEP, MARGIN_STEP)
+        c_phi = margin_elevation(c_lam, m_lam, m_phi, lowest=sign > 0)
+        # Equirectangular distances: the visible eye spans well under 60 degrees of elevation.
+        d_lam = (lam[near, None] - c_lam[None, :]) * np.cos(np.radians(phi[near, None]))
+        dist = np.sqrt((d_lam ** 2 + (phi[near, None] - c_phi[None, :]) ** 2).min(axis=1))
+        out[near, k] = np.where(vertical[near] < 0.0, -1.0, 1.0) * np.minimum(dist, np.abs(vertical[near]))
     return out.astype(np.float32)
 
 

@@ -84,6 +84,9 @@ HAIR_KEPT_MOVING = 0.25
 #: pixel around each pixel; the rest of the frame is copied as it is).
 CONTENT_MARGIN = 3
 
+#: Lid elevations (degrees) of eyeball vertices when no lids are given: far from both margins.
+_NO_LIDS = (90.0, 90.0)
+
 #: Smallest image side (pixels, after supersampling) at which skin pores are shaded.
 PORES_MIN_SIZE = 1024
 
@@ -96,7 +99,7 @@ _PASSES = {
     "mouth_interior": ("REGION_MOUTH_INTERIOR",),
     "teeth": ("REGION_TEETH", "USE_UV"),
     "tongue": ("REGION_TONGUE", "USE_UV"),
-    "eyeball": ("REGION_EYEBALL", "USE_EYE"),
+    "eyeball": ("REGION_EYEBALL", "USE_EYE", "USE_LIDS"),
     "lashes": ("REGION_LASHES", "USE_LASH"),
 }
 #: Shader variants for frames without creases (no wrinkle field): the skin skips the crease
@@ -227,6 +230,7 @@ class Renderer:
         self._hair_last = None    # (key, positions) of the last frame's hair
         self._hair_moving = None  # this frame: {layer: cards drawn over the kept pixels}, or None
         self._eyes = region_components(topology, "eyeball")
+        self._eye_render = np.flatnonzero(topology.region == REGIONS.index("eyeball"))
         self._lashes = region_components(topology, "lashes")
         self._lash_vertices = (np.concatenate(self._lashes) if self._lashes
                                else np.zeros(0, dtype=np.int64))
@@ -437,7 +441,7 @@ class Renderer:
     def render(self, positions: np.ndarray, *, appearance: Appearance, camera: Camera,
                wrinkle: np.ndarray | None = None, crease_phase: np.ndarray | None = None,
                occlusion: np.ndarray | None = None, lighting: Lighting | None = None,
-               proxies=()) -> np.ndarray:
+               proxies=(), lids: np.ndarray | None = None) -> np.ndarray:
         """Render one frame.
 
         Parameters
@@ -463,6 +467,10 @@ class Renderer:
         proxies : sequence of :class:`~facsim.render.proxies.ProxyDraw`
             Hair, eyebrow and eyelash cards drawn with their alpha textures (an
             alpha-tested pass, then the soft fringe blended back to front).
+        lids : (N_geo, 2) float, optional
+            Per eyeball vertex, degrees of arc below the upper lid's margin and above the
+            lower's (:func:`~facsim.render.geometry.lid_elevations`): the eyeballs get the
+            lash line's shadow and the wet lower rim along the lids. Default: no lids.
 
         Returns
         -------
@@ -487,10 +495,16 @@ class Renderer:
             w_geo = np.maximum(w_geo, 0.0)
         phase = _per_vertex("crease_phase", crease_phase, len(p_all), self._n_geo)
         occ = _per_vertex("occlusion", occlusion, len(p_all), self._n_geo)
+        if lids is not None:
+            lids = np.asarray(lids, dtype=np.float32)
+            if lids.shape != (len(p_all), 2):
+                raise ValueError(f"lids must be (N_geo, 2) like positions, got {lids.shape}")
+            lids = lids[: self._n_geo]
         if not self._winding_checked:
             self._fix_winding(p)
             self._rebuild_draws()
-        self._update_vertices(p, w_geo, phase, occ)
+        self._update_vertices(p, w_geo, phase, occ, lids)
+        self._set_eye_centres(p)
         self._creased = w_geo is not None and bool(w_geo.any())
         if appearance is not self._appearance:
             self._upload_appearance(appearance)
@@ -717,7 +731,7 @@ class Renderer:
             self._paint_tex.use(0)
 
     def _update_vertices(self, p: np.ndarray, wrinkle: np.ndarray | None, phase: np.ndarray | None,
-                         occlusion: np.ndarray | None) -> None:
+                         occlusion: np.ndarray | None, lids: np.ndarray | None = None) -> None:
         geo = self._geo_buffer
         normals = vertex_normals(p, self._geo_faces, self._normal_op)
         if wrinkle is not None and wrinkle.any():
@@ -743,7 +757,26 @@ class Renderer:
                                      self._render_op)
         else:
             out[:, 8] = 0.0
+        # The eyeballs' wrinkle and crease slots carry their distance below the upper lid and
+        # above the lower (USE_LIDS; nothing else reads those slots there).
+        eye = self._eye_render
+        if len(eye):
+            gap = _NO_LIDS if lids is None else lids[self.topology.render_to_geo[eye]]
+            out[eye, 6] = gap[..., 0] if lids is not None else gap[0]
+            out[eye, 8] = gap[..., 1] if lids is not None else gap[1]
         self._vbo_dynamic.write(out)
+
+    def _set_eye_centres(self, p: np.ndarray) -> None:
+        """The eyeballs' centres and radius this frame, for what the eyeball shader draws fixed
+        to the socket rather than to the turning eye (the caruncle, the canthi's shade)."""
+        if len(self._eyes) != 2 or "eyeball" not in self._programs:
+            return
+        centres = [p[eye].astype(np.float64).mean(axis=0) for eye in self._eyes]
+        radius = max(float(np.linalg.norm(p[eye] - c, axis=1).max()) for eye, c in zip(self._eyes, centres))
+        prog = self._programs["eyeball"]
+        _set_uniform(prog, "u_eye_a", tuple(float(x) for x in centres[0]))
+        _set_uniform(prog, "u_eye_b", tuple(float(x) for x in centres[1]))
+        _set_uniform(prog, "u_eye_radius", radius)
 
     def _set_camera(self, camera: Camera, lighting: Lighting) -> None:
         w, h = self.size

@@ -2,7 +2,7 @@
 // own program, so a fragment runs only its region's code: on llvmpipe both sides of a branch
 // cost, even when a uniform switches one off). Variants:
 //   REGION_SKIN (+ USE_UV, USE_WRINKLE; + USE_BROWS for triangles under painted brows),
-//   REGION_EYEBALL (+ USE_EYE), REGION_TEETH, REGION_TONGUE, REGION_MOUTH_INTERIOR,
+//   REGION_EYEBALL (+ USE_EYE, USE_LIDS), REGION_TEETH, REGION_TONGUE, REGION_MOUTH_INTERIOR,
 //   REGION_LASHES (+ USE_LASH).
 // All colour uniforms are linear RGB (render.py linearises the appearance's sRGB colours).
 
@@ -23,6 +23,9 @@ in float v_crease;
 #endif
 #ifdef USE_LASH
 in float v_lash;
+#endif
+#ifdef USE_LIDS
+in vec2 v_lids;   // degrees of eyeball arc below the upper lid's margin, above the lower's
 #endif
 
 out vec4 f_color;
@@ -153,6 +156,12 @@ vec2 brow_hair(vec2 uv, float density) {
 uniform vec3 u_sclera;
 uniform vec3 u_iris;
 uniform vec3 u_pupil;
+// Both eyeballs' centres and radius this frame (Renderer._set_eye_centres; a lone eye: the
+// same point twice): what belongs to the socket (caruncle, canthi) is placed from them, not
+// from the eye's own frame, which turns with the gaze (61-64).
+uniform vec3 u_eye_a = vec3(1.0, 0.0, 0.0);
+uniform vec3 u_eye_b = vec3(-1.0, 0.0, 0.0);
+uniform float u_eye_radius = 1.0;
 // Radii as fractions of the eyeball radius, measured in the plane across the gaze axis
 // (length of eye_coord.xy on the front half). hm08's eyeballs are 1.59 cm in radius:
 // an iris 11.7 mm across (the adult mean) and a 4 mm pupil.
@@ -161,6 +170,38 @@ const float PUPIL_RADIUS = 0.13;
 const float LIMBUS_WIDTH = 0.22;   // fraction of the iris annulus darkened at its rim
 const float CORNEA_RADIUS = 0.49;  // radius of the cornea's curvature, 1.33 iris radii
 const int IRIS_FIBRES = 96;        // radial noise cells around the iris
+const float COLLARETTE = 0.33;     // where the collarette lies across the iris annulus (0 pupil, 1 rim)
+const vec2 CARUNCLE = vec2(0.5, 0.58);   // nasal e.x where the caruncle begins and is full
+// The key's reflection in the cornea: the softbox's half-size (radians, across and up) and
+// strength; the room's faint reflection over the whole cornea.
+const vec2 SOFTBOX = vec2(0.22, 0.19);
+const float KEY_REFLECTION = 0.5;
+// The fill is a broad bounce card to the side: a larger, dimmer reflection (it shows where
+// a lowered lid hides the key's, as in photographs).
+const vec2 FILL_BOX = vec2(0.2, 0.3);
+const float FILL_REFLECTION = 0.6;
+// Coverage of a soft-edged rounded rectangle of half-size `size` (radians) centred on the
+// light direction `l`, seen along the reflected ray `refl` (for catch-lights).
+float softbox(vec3 refl, vec3 l, vec2 size) {
+    vec3 bu = normalize(cross(l, vec3(0.0, 1.0, 0.0)));
+    vec3 bv = cross(bu, l);
+    vec2 q = vec2(dot(refl, bu), dot(refl, bv)) / size;
+    q *= q;
+    float d = sqrt(sqrt(dot(q, q)));   // a superellipse: a rectangle with rounded corners
+    return (1.0 - smoothstep(0.65, 1.3, d)) * (0.8 + 0.2 * (1.0 - min(d, 1.0))) * step(0.0, dot(refl, l));
+}
+const float ROOM_REFLECTION = 0.035;
+// Along the lids (degrees of eyeball arc from the margins, facsim.render.geometry.lid_elevations):
+// the lower lid's wet rim and the tear line over it; the upper lid's shadow (depth, reach).
+const float WET_RIM = 1.6;
+const vec3 WET_RIM_COLOR = vec3(0.5, 0.25, 0.23);   // moist lid tissue (linear), whatever the skin
+const float TEAR_WIDTH = 0.7;
+const float TEAR_SHINE = 0.15;
+const vec2 UPPER_SHADOW = vec2(0.6, 2.5);
+// The lids' broader shade on the eyeball, as ambient occlusion (depth at the margin, reach in
+// degrees: ~0.28 mm each on hm08); the lower lid's is lighter and shorter.
+const vec2 UPPER_LID_SHADE = vec2(0.6, 8.0);
+const vec2 LOWER_LID_SHADE = vec2(0.2, 3.0);
 #endif
 
 #if defined(REGION_TEETH) || defined(REGION_TONGUE)
@@ -389,62 +430,124 @@ void main() {
     float t = clamp((r - PUPIL_RADIUS) / (IRIS_RADIUS - PUPIL_RADIUS), 0.0, 1.0);
     float angle = atan(e.y, e.x);
     float turns = (angle / (2.0 * PI) + 0.5) * float(IRIS_FIBRES);
-    // Stroma: fine radial fibres (long along the radius, narrow around it), coarser crypts,
+    // Stroma: fine radial fibres (long along the radius, narrow around it), coarser bundles,
     // faded to their mean where they would be finer than a pixel (small images stay calm).
+    float fibre_detail = clamp(1.6 - 0.6 * fwidth(turns), 0.0, 1.0);
     float fibre = 0.55 * value_noise(vec2(turns, t * 3.0), IRIS_FIBRES)
                 + 0.3 * value_noise(vec2(turns * 2.0, t * 1.5 + 3.0), IRIS_FIBRES * 2)
                 + 0.15 * value_noise(vec2(turns * 0.25, t * 6.0 + 11.0), IRIS_FIBRES / 4);
-    fibre = mix(0.5, fibre, clamp(1.6 - 0.6 * fwidth(turns), 0.0, 1.0));
-    // A little less saturated than the base colour (real irises are greyish), a lighter
-    // collarette ring a third of the way out, a dark pupillary ruff, and a dark limbal ring
-    // at the rim that blurs into the sclera.
+    fibre = mix(0.5, fibre, fibre_detail);
+    // The collarette, a third of the way out, is a wavy ridge (it zigzags around the iris):
+    // inside it the pupillary zone is darker and warmer, outside it the ciliary zone is
+    // broken by darker crypts; a dark ruff rims the pupil and a dark limbal ring the iris.
+    float wave = 0.05 * (value_noise(vec2(turns * 0.33, 0.5), IRIS_FIBRES / 3) - 0.5);
+    float collar_t = t - COLLARETTE - wave;
+    float inner = 1.0 - smoothstep(-0.03, 0.03, collar_t);
+    float ridge = exp(-pow(collar_t / 0.035, 2.0));
+    float crypt = smoothstep(0.68, 0.9, value_noise(vec2(turns * 0.5, t * 5.0 + 5.0), IRIS_FIBRES / 2))
+                * smoothstep(0.0, 0.1, collar_t) * (1.0 - smoothstep(0.7, 0.9, t)) * fibre_detail;
+    // A little less saturated than the base colour (real irises are greyish).
     vec3 base_iris = mix(u_iris, vec3(dot(u_iris, vec3(0.3, 0.55, 0.15))), 0.3);
-    vec3 iris = base_iris * (0.5 + 1.0 * fibre);
-    iris *= 1.0 + 0.35 * exp(-pow((t - 0.3) / 0.12, 2.0));
-    iris *= mix(0.45, 1.0, smoothstep(0.0, 0.08, t));
-    iris *= mix(1.0, 0.3, smoothstep(1.0 - LIMBUS_WIDTH, 1.0, t));
-    iris = mix(iris, u_pupil, pupil_mask);
+    vec3 iris = base_iris * (0.45 + 1.1 * fibre);
+    iris *= mix(vec3(1.0), vec3(0.72, 0.64, 0.52), 0.8 * inner);      // darker, warmer pupillary zone
+    iris *= 1.0 - 0.3 * ridge * fibre_detail;                          // the collarette's dark fold
+    iris *= 1.0 - 0.3 * crypt;
+    iris *= mix(0.45, 1.0, smoothstep(0.0, 0.08, t));                 // pupillary ruff
+    iris *= mix(1.0, 0.28, smoothstep(1.0 - LIMBUS_WIDTH, 1.0, t));   // limbal ring
+    // The pupil is not ink: the lens behind it returns a little light (and the cornea in
+    // front reflects the room, below).
+    vec3 pupil = max(u_pupil, vec3(0.006, 0.0055, 0.0055)) * mix(1.3, 0.8, smoothstep(0.0, 0.8, r / PUPIL_RADIUS));
+    iris = mix(iris, pupil, pupil_mask);
+    // The socket's frame: hx across the eye toward the nose (the other eye), hy up, in
+    // eyeball radii from this eye's centre.
+    bool on_a = distance(v_pos, u_eye_a) < distance(v_pos, u_eye_b);
+    vec3 centre = on_a ? u_eye_a : u_eye_b;
+    vec3 to_nose = (on_a ? u_eye_b : u_eye_a) - centre;
+    to_nose = length(to_nose) > 1e-6 ? normalize(to_nose) : vec3(-sign(v_pos.x), 0.0, 0.0);
+    vec3 socket = (v_pos - centre) / u_eye_radius;
+    float hx = dot(socket, to_nose);
+    float hy = socket.y;
     float theta = acos(clamp(e.z, -1.0, 1.0));
     // Off-white sclera (never paper white): a touch warmer and pinker toward the corners
-    // (conjunctival vessels, strongest nasally and temporally), with faint vessels there.
+    // (conjunctival vessels, strongest nasally and temporally), with faint, thin vessels
+    // that run from the corners toward the iris and fade out before they reach it.
     float corner = smoothstep(0.4, 0.8, theta) * (0.55 + 0.45 * abs(cos(angle)));
-    float vessels = smoothstep(0.7, 0.95, value_noise(vec2(angle * 9.0, theta * 14.0), 0)) * corner;
-    // (Issue 13, reviewers: "glossy, doll-like eyes" - the sclera a touch greyer and warmer,
-    // never brighter than the lit skin beside it.)
-    vec3 sclera = u_sclera * vec3(0.78, 0.75, 0.72)
-                * mix(vec3(1.0), vec3(1.0, 0.78, 0.72), 0.7 * corner + 0.5 * vessels);
-    // Caruncle and plica: a pink fleshy fold fills the inner corner (e.x toward the nose:
-    // -x for the eye on the +x side of the head).
-    float nasal = front * smoothstep(0.45, 0.63, -sign(v_pos.x) * e.x);
-    sclera = mix(sclera, u_sclera * vec3(0.82, 0.52, 0.5), 0.85 * nasal);
+    vec2 vp = vec2(angle * 7.0, theta * 2.5);
+    float vessel_n = value_noise(vp, 0) + 0.5 * value_noise(vp * 2.3 + 7.0, 0);
+    float vessel_w = 0.05 + fwidth(vessel_n);
+    float vessels = (1.0 - smoothstep(0.0, vessel_w, abs(vessel_n - 0.75))) * 0.05 / vessel_w
+                  * smoothstep(0.45, 0.85, theta) * (0.5 + 0.5 * abs(cos(angle)));
+    vec3 sclera = u_sclera * vec3(0.86, 0.83, 0.79)
+                * mix(vec3(1.0), vec3(1.0, 0.8, 0.74), 0.7 * corner)
+                * mix(vec3(1.0), vec3(0.95, 0.55, 0.5), clamp(1.1 * vessels, 0.0, 0.6));
+    // Caruncle and plica: a pink, fleshy, wet mound fills the inner corner (e.x toward the
+    // nose: -x for the eye on the +x side of the head), a darker fold (the plica) between
+    // it and the sclera.
+    float nasal = smoothstep(CARUNCLE.x, CARUNCLE.y, hx);
+    float plica = exp(-pow((hx - CARUNCLE.x) / 0.03, 2.0));
+    sclera *= 1.0 - 0.25 * plica;
+    sclera = mix(sclera, u_sclera * vec3(0.78, 0.42, 0.40) * (0.85 + 0.3 * value_noise(e.xy * 60.0, 0)), nasal);
     // The limbus blends softly into the sclera as a greyish ring (no cut-out edge).
     float limbal = front * exp(-pow((r - IRIS_RADIUS) / 0.035, 2.0));
     sclera *= 1.0 - 0.35 * limbal;
     float iris_soft = front * (1.0 - smoothstep(IRIS_RADIUS - aa - 0.015, IRIS_RADIUS + aa, r));
     vec3 albedo = mix(sclera, iris, max(iris_mask, 0.6 * iris_soft));
+#ifdef USE_LIDS
+    // Along the lids (v_lids: degrees of arc from each margin; ~1.7 px per degree at 1024²):
+    // the lower lid's wet inner rim, its margin rolled in against the eyeball, shows as a
+    // thin pink band, with the tear meniscus's bright line just above it; under the upper
+    // lid the lash line and the lid itself shade the eyeball deeply (below).
+    float px = max(fwidth(v_lids.y), 1e-3);
+    float rim = (1.0 - smoothstep(WET_RIM - 0.5 * px, WET_RIM + 0.5 * px, v_lids.y))
+              * smoothstep(-3.0, -2.0, v_lids.y);   // (the lid hides what lies further below)
+    // (Both fade out toward the canthi, where the lower margin turns up steeply and the
+    // caruncle takes over.)
+    float along_lower = (1.0 - smoothstep(0.45, 0.62, abs(hx))) * (1.0 - smoothstep(-0.1, 0.1, hy));
+    albedo = mix(albedo, WET_RIM_COLOR, rim * along_lower);
+    float tear_w = max(TEAR_WIDTH, px);
+    float tear = exp(-pow((v_lids.y - WET_RIM - 0.5 * TEAR_WIDTH) / tear_w, 2.0)) * TEAR_WIDTH / tear_w * along_lower;
+    float lash_shadow = 1.0 - UPPER_SHADOW.x * exp(-max(v_lids.x, 0.0) / UPPER_SHADOW.y);
+    // The lids' broad shade: the thick upper fold stands off the eyeball and hides much of
+    // the light above it; the lower lid a little of the light below.
+    occ *= (1.0 - UPPER_LID_SHADE.x * exp(-max(v_lids.x, 0.0) / UPPER_LID_SHADE.y))
+         * (1.0 - LOWER_LID_SHADE.x * exp(-max(v_lids.y, 0.0) / LOWER_LID_SHADE.y));
+#else
+    float rim = 0.0, tear = 0.0, lash_shadow = 1.0;
+#endif
     // The eyeball sits in the lids' shade. The thick upper lid and its lashes shadow a band
     // under its margin and the lower lid a little above its own: that shade follows the lids
-    // in every frame and arrives in occ (Face.frame_occlusion, facsim.render.geometry.lid_shade),
-    // so 5 bares lit sclera and 43 closes the shadow away. Here only what the lids cannot
-    // say: the canthi shade the corners, and light falls off over the eyeball's curve toward
-    // the orbit (eye frame: +y up, +x across the eye; at rest about e.y in [-0.2, 0.2] and
-    // e.x in [-0.65, 0.65] show between the lids).
-    // The socket around it hides much of the sky: the whole eyeball takes less ambient than
-    // the skin.
-    float lid_shade = 0.7 * (1.0 - 0.15 * smoothstep(-0.05, 0.3, e.y)) * (1.0 - 0.35 * smoothstep(0.3, 0.7, abs(e.x)));
+    // in every frame (v_lids, above), so 5 bares lit sclera and 43 closes the shadow away.
+    // Here only what the lids cannot say: the canthi shade
+    // the corners, and light falls off over the eyeball's curve toward the orbit (socket
+    // frame: at rest about hy in [-0.2, 0.2] and hx in [-0.65, 0.65] show between the
+    // lids). The socket around it hides much of the sky: the whole eyeball
+    // takes less ambient than the skin.
+    float lid_shade = 0.7 * (1.0 - 0.15 * smoothstep(-0.05, 0.3, hy)) * (1.0 - 0.5 * smoothstep(0.32, 0.68, abs(hx)))
+                    * lash_shadow;
     vec3 diffuse = diffuse_light(n, vec3(0.15), occ) * albedo * lid_shade;
-    // Wet surface: a small soft catch-light on the cornea only, a faint broad sheen
-    // elsewhere; no bright Fresnel rim (it made the eyes look like glass). The cornea bulges
-    // over the iris as a sphere of 1.33 iris radii (7.8 mm over an 11.7-mm iris), so its
-    // normal tilts faster than the eyeball's: the catch-light sits on the iris, not beside it.
-    // (The eye frame is the world's while head and gaze are at rest; the tilt is added to the
-    // world normal, exact at rest and close for the small turns of 51-58 and 61-64.)
+    // Wet surface. The cornea bulges over the iris as a sphere of 1.33 iris radii (7.8 mm
+    // over an 11.7-mm iris), so its normal tilts faster than the eyeball's: the catch-light
+    // sits on the iris, not beside it. (The eye frame is the world's while head and gaze are
+    // at rest; the tilt is added to the world normal, exact at rest and close for the small
+    // turns of 51-58 and 61-64.) It mirrors what lights the face: the key is a large
+    // softbox, so its catch-light is a soft-edged rounded rectangle, not a pin-point, and
+    // the room's faint glow lies over the whole cornea (the pupil is never ink black).
     float cornea = front * (1.0 - smoothstep(IRIS_RADIUS - 0.02, IRIS_RADIUS + 0.02, r));
     vec2 bulge = e.xy / CORNEA_RADIUS;
     vec3 corneal = vec3(bulge, sqrt(max(1.0 - dot(bulge, bulge), 0.0)));
     vec3 nc = normalize(n + (corneal - e) * cornea);
-    vec3 spec = specular_light(nc, v, 400.0) * 0.1 * cornea + specular_light(n, v, 40.0) * 0.025;
-    radiance = diffuse + spec * mix(0.4, 1.0, lid_shade) * occ;
+    vec3 refl = reflect(-v, nc);
+    float ndv = max(dot(nc, v), 0.0);
+    float fres = schlick(0.025, ndv) / 0.025;
+    vec3 room = mix(u_ground_col, u_sky_col, 0.5 + 0.5 * refl.y) * ROOM_REFLECTION;
+    vec3 boxes = softbox(refl, u_key_dir, SOFTBOX) * u_key_col
+               + softbox(refl, u_fill_dir, FILL_BOX) * u_fill_col * FILL_REFLECTION;
+    vec3 spec = (boxes * KEY_REFLECTION + room) * fres * mix(0.45, 1.0, cornea);
+    // The sclera and the lid's wet rim are wet too but less smooth (a broad sheen), and the
+    // tear meniscus catches a thin bright line of the key.
+    spec += specular_light(n, v, 40.0) * 0.03 + tear * u_key_col * TEAR_SHINE;
+    spec *= mix(0.5, 1.0, lash_shadow) * mix(0.4, 1.0, lid_shade / 0.7);
+    radiance = diffuse + spec * occ;
 #endif
 
     // Inside the mouth the lips and cheeks shade everything; occlusion baked on a closed

@@ -1,10 +1,16 @@
-// Face vertex shader. Variants (#defines from render.py): USE_UV, USE_EYE, USE_WRINKLE, USE_LASH.
+// Face vertex shader. Variants (#defines from render.py): USE_UV, USE_EYE, USE_WRINKLE, USE_LASH,
+// USE_LIDS (eyeballs: degrees below the upper lid's margin and above the lower's, carried in
+// the wrinkle and crease slots).
 // Regions that ignore occlusion let the compiler drop it (render.py tolerates that).
 in vec3 in_pos;      // world position (decimetres)
 in vec3 in_normal;   // smooth world normal, computed on geometry vertices in numpy
 in float in_occlusion;  // ambient visibility 0..1 (1 = open sky), per geometry vertex
-#if defined(USE_WRINKLE) || defined(USE_LASH)
-in float in_wrinkle;  // skin: wrinkle amount; lashes: root-to-tip coordinate
+#if defined(USE_WRINKLE) || defined(USE_LASH) || defined(USE_LIDS)
+in float in_wrinkle;  // skin: wrinkle amount; lashes: root-to-tip coordinate; eyeball: below the upper lid
+#endif
+#ifdef USE_LIDS
+in float in_crease;   // eyeball: above the lower lid
+out vec2 v_lids;
 #endif
 #ifdef USE_WRINKLE
 in float in_crease;   // position across the creases in crease spacings, see render.crease_phase
@@ -39,6 +45,9 @@ void main() {
 #endif
 #ifdef USE_LASH
     v_lash = in_wrinkle;
+#endif
+#ifdef USE_LIDS
+    v_lids = vec2(in_wrinkle, in_crease);
 #endif
 #ifdef USE_UV
     v_uv = in_uv;

@@ -46,12 +46,23 @@ void main() {
     // as eyebrow012 into a flat painted strip, issue 13), with a fine breakup across them.
     float grain = value_noise(v_uv * vec2(260.0, 260.0), 0);
     grain = mix(0.5, grain, clamp(2.0 - 1.5 * fwidth(v_uv.x * 260.0), 0.0, 1.0));
-    alpha = clamp(tex.a * 1.35, 0.0, 0.88) * (0.75 + 0.5 * grain) * thin * u_density;
+    // Strokes a pixel or two across and several long, along the brow (MakeHuman's brow
+    // textures run along u), wavering: they survive where the texture's own hairs have
+    // blurred into their mean (448-512² stimuli), so the brow reads as hairs over skin, not
+    // a painted strip. Faded out where even they would be finer than a pixel.
+    float stroke = value_noise(vec2(v_uv.x * 14.0, v_uv.y * 70.0 + 2.5 * value_noise(v_uv * 6.0, 0)), 0);
+    float stroke_detail = clamp(2.2 - 1.2 * fwidth(v_uv.y * 70.0), 0.0, 1.0);
+    alpha = clamp(tex.a * 1.45, 0.0, 0.93) * mix(1.0, 0.45 + 1.0 * stroke, 0.85 * stroke_detail)
+          * (0.75 + 0.5 * grain) * thin * u_density;
+    alpha = min(alpha, 1.0);
 #else
     // v_depth: 0 at the lid ... 1 at the lash tips: each lash tapers to a fine point, so
     // the lash line is dense at the lid margin (it gives the upper lid its dark edge) and the
     // tips fade instead of ending in spikes (lower lashes start part-way along, proxies.py).
-    alpha = clamp(tex.a * 1.25, 0.0, 1.0) * mix(1.0, 0.15, smoothstep(0.0, 1.0, v_depth)) * u_density;
+    // At the roots the strands overlap into the dense, dark line that outlines a real eye
+    // (the lash line): there the texture's gaps close up; the tips stay apart.
+    alpha = clamp(tex.a * mix(1.7, 1.2, smoothstep(0.0, 0.4, v_depth)), 0.0, 1.0)
+          * mix(1.0, 0.15, smoothstep(0.1, 1.0, v_depth)) * u_density;
 #endif
     if (alpha < 0.01) discard;
 #else
@@ -179,6 +190,11 @@ void main() {
     float dk = clamp(dot(n, u_key_dir) * 0.5 + 0.5, 0.0, 1.0);
     vec3 lit = dk * u_key_col + u_fill_col + hemisphere(n);
     vec3 radiance = albedo * lit * 0.8;
+#ifdef KIND_EYELASHES
+    radiance *= mix(0.55, 0.9, v_depth);   // lashes: darkest in the dense line at their roots
+#else
+    radiance *= mix(1.0, 0.8 + 0.4 * stroke, stroke_detail);   // brow hairs differ one from the next
+#endif
 #endif
     f_color = vec4(finish(radiance).rgb, alpha);
 }
