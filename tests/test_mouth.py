@@ -185,3 +185,19 @@ def test_the_muscle_engine_shows_the_same_teeth(face_of):
     image, teeth, _ = _mouth_pixels(face, "muscle", "10+25")
     assert teeth.sum() > 30
     assert np.median(_luminance(image[teeth])) > 130
+
+
+@pytest.mark.parametrize("expression", ["0", "12C"])
+def test_the_mouths_lining_never_shows_through_the_skin(face_of, expression):
+    # george's targets pulled the skin beside the nose wings onto hm08's lining (the
+    # vestibule climbs up there): its dark shading showed as black dots at 512 px. With
+    # the lips closed (rest, 12 without 25) no pixel of the inside of the mouth shows.
+    from facsim import Face
+
+    face = face_of("george")
+    deformation = face.deform(expression)
+    renders = []
+    for inside in ("#ffffff", "#000000"):
+        with Face(face.character.with_(colors={"mouth_interior": inside})) as marked:
+            renders.append(marked.render(deformation=deformation, size=512)[..., :3].astype(int))
+    assert (np.abs(renders[0] - renders[1]).max(axis=-1) > 3).sum() == 0

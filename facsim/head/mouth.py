@@ -42,6 +42,15 @@ COLUMN_REACH = 0.035
 #: A band vertex further than this (dm, in plan) from every root-row vertex is on the
 #: lingual slope (the band's inside, 8–13 mm in), not on the outer wall (within 3 mm).
 LINGUAL_REACH = 0.05
+#: The mouth's lining stays at least this far (dm) behind the skin in front of it. hm08's
+#: lining (the vestibule between the upper lip and the gums) climbs to the nose wings; some
+#: characters' targets pull the skin there onto it (george: 0.00 mm at rest, 0.2 mm through
+#: the skin in a smile), and the lining's dark shading showed as black dots beside the nose.
+#: 2 mm holds through every expression's relative motion there (under 1 mm, both engines).
+CAVITY_CLEARANCE = 0.02
+#: Lining vertices this close (dm) to the lips' inner rim are left alone: there the lining
+#: legitimately meets the lips.
+RIM_REACH = 0.08
 
 
 def rest_mouth(base_positions: np.ndarray, data, *, age: float = 25.0) -> np.ndarray:
@@ -56,6 +65,8 @@ def rest_mouth(base_positions: np.ndarray, data, *, age: float = 25.0) -> np.nda
     with the skull and the jaw as they carry hm08's own.
     """
     out = np.array(base_positions, np.float32, copy=True)
+    lining, skin_triangles = _lining_and_skin(data)
+    out[lining] = _behind_skin(out[lining], out[skin_triangles], CAVITY_CLEARANCE)
     young, old = UPPER_TEETH_DROP_AGES
     out[data.group_vertices(UPPER_TEETH), 1] -= UPPER_TEETH_DROP * float(np.clip((old - age) / (old - young), 0.0, 1.0))
     tongue = data.group_vertices(TONGUE)
@@ -67,6 +78,50 @@ def rest_mouth(base_positions: np.ndarray, data, *, age: float = 25.0) -> np.nda
         return out
     scale = max((target - bottom) / (top - bottom), 0.4)
     out[tongue, 1] = bottom + scale * (y - bottom)
+    return out
+
+
+def _lining_and_skin(data) -> tuple[np.ndarray, np.ndarray]:
+    """Base vertices of the mouth's lining away from the lips' rim, and the (T, 3) base
+    triangles of the skin around the mouth and nose (hm08's segmentation, as
+    :func:`facsim.head.mesh.build_head` labels the cavity)."""
+    from facsim.head.mesh import _label_quads
+
+    quads = np.asarray(data.quads)
+    body = data.quad_group == list(data.group_names).index("body")
+    mouth = body & _label_quads(data, ("mouth_cavity",))
+    cavity = np.unique(quads[mouth])
+    skin_quads = quads[body & ~mouth]
+    rim = np.intersect1d(cavity, skin_quads)
+    base = np.asarray(data.base_vertices)
+    far = np.linalg.norm(base[cavity][:, None] - base[rim][None], axis=2).min(axis=1) > RIM_REACH
+    lining = cavity[far & ~np.isin(cavity, rim)]
+    # Skin quads over the lining in plan (x, y), split in two triangles each.
+    lo, hi = base[cavity, :2].min(axis=0) - 0.05, base[cavity, :2].max(axis=0) + 0.05
+    corners = base[skin_quads][..., :2]
+    near = ((corners >= lo) & (corners <= hi)).all(axis=2).any(axis=1)
+    q = skin_quads[near]
+    return lining, np.concatenate([q[:, [0, 1, 2]], q[:, [0, 2, 3]]])
+
+
+def _behind_skin(points: np.ndarray, triangles: np.ndarray, clearance: float) -> np.ndarray:
+    """``points`` (N, 3) moved back along -z until each is ``clearance`` behind the
+    nearest skin surface in front of it (``triangles`` (T, 3, 3), seen along the face's
+    +z); points with no skin in front, or deep enough already, stay."""
+    a, b, c = triangles[:, 0], triangles[:, 1], triangles[:, 2]
+    e1, e2 = b - a, c - a
+    det = e1[:, 0] * e2[:, 1] - e2[:, 0] * e1[:, 1]
+    ok = np.abs(det) > 1e-12
+    a, e1, e2, det = a[ok], e1[ok], e2[ok], det[ok]
+    r = points[:, None, :2] - a[None, :, :2]
+    u = (r[..., 0] * e2[:, 1] - e2[:, 0] * r[..., 1]) / det
+    w = (e1[:, 0] * r[..., 1] - r[..., 0] * e1[:, 1]) / det
+    z = a[:, 2] + u * e1[:, 2] + w * e2[:, 2]
+    # Skin in front of the point, or that the point has pushed through (within the clearance).
+    hit = (u >= 0) & (w >= 0) & (u + w <= 1) & (z > points[:, None, 2] - clearance)
+    front = np.where(hit, z, np.inf).min(axis=1)
+    out = points.copy()
+    out[:, 2] = np.minimum(points[:, 2], front - clearance)
     return out
 
 
