@@ -176,7 +176,9 @@ class Face:
         return occlusion
 
     def frame_occlusion(self, positions: np.ndarray) -> np.ndarray:
-        """:attr:`shading_occlusion` with the eyeballs shaded by the lids where ``positions`` put them."""
+        """:attr:`shading_occlusion` with the eyeballs shaded by the lids where ``positions`` put them,
+        and the mouth lit by where the lips are (:func:`facsim.head.mouth.mouth_light`)."""
+        from facsim.head.mouth import mouth_light
         from facsim.render.geometry import lid_crease_shade, lid_shade
 
         occlusion = np.array(self.shading_occlusion, np.float32, copy=True)
@@ -186,7 +188,14 @@ class Face:
             occlusion[eye] *= lid_shade(positions, centre, eye, upper, lower)
             crease, weights, height = self._lid_creases[side]
             occlusion[crease] *= lid_crease_shade(positions, centre, crease, weights, upper, height)
+        mouth_light(self._mouth_rim, positions, occlusion)
         return occlusion
+
+    @cached_property
+    def _mouth_rim(self):
+        from facsim.head.mouth import mouth_rim
+
+        return mouth_rim(self.head, self.data, self.neutral)
 
     @cached_property
     def _lid_creases(self) -> dict:

@@ -16,6 +16,8 @@ Examples
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 #: Groups of hm08's mouth parts.
@@ -34,8 +36,13 @@ TONGUE_BELOW_TEETH = 0.012
 #: lengthens (Vig & Brundo 1978: from ~3.4 mm under 30 to ~0 past 60), so the drop fades
 #: out between the ages in :data:`UPPER_TEETH_DROP_AGES`: older faces show less upper and
 #: relatively more lower teeth, one of the cues that reads as age.
-UPPER_TEETH_DROP = 0.015
+UPPER_TEETH_DROP = 0.022
 UPPER_TEETH_DROP_AGES = (30.0, 60.0)
+#: The lower teeth rest this far (dm) lower than hm08 puts them. hm08's lower incisors reach
+#: the lips' meeting line, so every open mouth (25+26, surprise's 26) bared their whole
+#: crowns above the lower lip, a bright row of blocks; in photographs of open mouths the
+#: lower lip covers most of the lower teeth, and a jaw that drops shows their edges.
+LOWER_TEETH_DROP = 0.012
 #: Radius (dm, in plan) within which a tooth vertex's biting edge and root row are looked
 #: up: a column's rows lie within 3 mm of each other, columns 5–8 mm apart.
 COLUMN_REACH = 0.035
@@ -55,8 +62,9 @@ RIM_REACH = 0.08
 
 def rest_mouth(base_positions: np.ndarray, data, *, age: float = 25.0) -> np.ndarray:
     """Base positions (19158, 3) with the mouth's parts at rest: the upper teeth lowered by
-    :data:`UPPER_TEETH_DROP` (less with ``age`` in years) and the tongue lowered into the
-    floor of the mouth.
+    :data:`UPPER_TEETH_DROP` (less with ``age`` in years), the lower by
+    :data:`LOWER_TEETH_DROP`, the tongue lowered into the floor of the mouth, and the
+    mouth's lining kept :data:`CAVITY_CLEARANCE` behind the skin.
 
     The tongue is squashed toward its underside (about its lowest point) until its top
     sits :data:`TONGUE_BELOW_TEETH` under the lower incisors' edge; its tip and sides
@@ -69,6 +77,7 @@ def rest_mouth(base_positions: np.ndarray, data, *, age: float = 25.0) -> np.nda
     out[lining] = _behind_skin(out[lining], out[skin_triangles], CAVITY_CLEARANCE)
     young, old = UPPER_TEETH_DROP_AGES
     out[data.group_vertices(UPPER_TEETH), 1] -= UPPER_TEETH_DROP * float(np.clip((old - age) / (old - young), 0.0, 1.0))
+    out[data.group_vertices(LOWER_TEETH), 1] -= LOWER_TEETH_DROP
     tongue = data.group_vertices(TONGUE)
     lower = data.group_vertices(LOWER_TEETH)
     y = out[tongue, 1]
@@ -191,3 +200,144 @@ def mouth_depth_visibility(head, neutral: np.ndarray, *, falloff: float = 0.12):
     z = np.asarray(neutral)[interior, 2]
     depth = np.clip(z.max() - z, 0.0, None)
     return interior, np.exp(-depth / falloff).astype(np.float32)
+
+
+#: Ambient visibility the lips' inner surface reaches once the lips part, per ring of skin
+#: vertices from the rim (the wet mucosa the lips turn toward each other): the bake is
+#: taken on the closed mouth, where the rim is buried (visibility ~0), so an open mouth
+#: showed its lips' inner edge black, a hard outline.
+LIP_RING_VISIBILITY = (0.45, 0.6, 0.75)
+#: The lips have parted over this range of gap (dm) at a given x: 0.5 mm -> 4 mm.
+LIP_PARTING = (0.005, 0.04)
+@dataclass(frozen=True)
+class MouthRim:
+    """The lips' inner rim and the mouth's parts whose light depends on the lips per frame.
+
+    Attributes
+    ----------
+    upper, lower : (K,) int
+        Geometry indices of the upper and the lower lip's inner rim (skin vertices that
+        border the mouth's lining), each sorted by x at rest.
+    rings : tuple of (K_i,) int
+        The rim (ring 0) and the skin rings just outside it: the lips' inner surface.
+    upper_teeth, lower_teeth : (T,) int
+        Geometry indices of the teeth rows.
+    """
+
+    upper: np.ndarray
+    lower: np.ndarray
+    rings: tuple
+    upper_teeth: np.ndarray
+    lower_teeth: np.ndarray
+
+
+def mouth_rim(head, data, neutral: np.ndarray) -> MouthRim:
+    """The lips' inner rim of ``head`` told apart at rest (``neutral``, (N_geo, 3)): the rim
+    is a loop through the mouth's corners; its higher half is the upper lip's."""
+    from facsim.head.mesh import REGIONS
+
+    region = head.region
+    lining = region == REGIONS.index("mouth_interior")
+    skin = region == REGIONS.index("skin")
+    triangles = head.triangles
+    rings, inside = [], lining.copy()
+    for _ in LIP_RING_VISIBILITY:
+        ring = np.unique(triangles[inside[triangles].any(axis=1)])
+        ring = ring[skin[ring] & ~inside[ring]]
+        rings.append(ring)
+        inside[ring] = True
+    upper, lower = _split_rim(rings[0], triangles, np.asarray(neutral))
+    by_x = lambda idx: idx[np.argsort(np.asarray(neutral)[idx, 0])]  # noqa: E731
+    return MouthRim(upper=by_x(upper), lower=by_x(lower), rings=tuple(rings),
+                    upper_teeth=head.group_geometry(data, UPPER_TEETH),
+                    lower_teeth=head.group_geometry(data, LOWER_TEETH))
+
+
+def _split_rim(rim: np.ndarray, triangles: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The rim's two chains between the mouth's corners (its extreme x), upper first: the
+    closed lips touch at rest, so heights alone cannot tell them apart."""
+    from collections import deque
+
+    on = np.isin(triangles, rim)
+    links = {int(v): set() for v in rim}
+    for tri, mask in zip(triangles[on.sum(axis=1) >= 2], on[on.sum(axis=1) >= 2]):
+        ends = [int(v) for v, m in zip(tri, mask) if m]
+        for a in ends:
+            links[a].update(b for b in ends if b != a)
+    left, right = int(rim[np.argmin(p[rim, 0])]), int(rim[np.argmax(p[rim, 0])])
+
+    def path(banned):
+        came, todo = {left: None}, deque([left])
+        while todo:
+            v = todo.popleft()
+            for w in links[v]:
+                if w not in came and w not in banned:
+                    came[w] = v
+                    todo.append(w)
+        chain, v = [], right
+        while v is not None and v in came:
+            chain.append(v)
+            v = came[v]
+        return chain
+
+    first = path(set())
+    second = path(set(first[1:-1]))
+    chains = [np.array(first), np.array(second)]
+    # Rim vertices off both chains (a ragged rim) join the chain nearest them.
+    rest = np.setdiff1d(rim, np.concatenate(chains))
+    if len(rest):
+        both = np.concatenate(chains)
+        nearest = both[np.linalg.norm(p[rest][:, None] - p[both][None], axis=2).argmin(axis=1)]
+        for i, chain in enumerate(chains):
+            chains[i] = np.concatenate([chain, rest[np.isin(nearest, chain)]])
+    if p[chains[0], 1].mean() < p[chains[1], 1].mean():
+        chains.reverse()
+    return chains[0], chains[1]
+
+
+def mouth_light(rim: MouthRim, positions: np.ndarray, occlusion: np.ndarray) -> None:
+    """Light the mouth by where the lips are in this frame (in place on ``occlusion``,
+    (N_geo,), as baked on the closed mouth):
+
+    - the lips' inner surface opens to the light as the lips part at its x (the bake
+      buried it: an open mouth's lips had a black inner edge);
+    - each tooth vertex gets its height (dm) below the upper lip's edge at its x, not a
+      visibility: interpolated across a triangle it is that height per fragment (the lip's
+      edge is close to straight between the teeth's columns), so the teeth's shader draws
+      the lip's soft contact shadow right under its edge, millimetres wide, where the
+      band's vertices lie 8 mm apart. (The bake under closed lips means nothing for them.)
+
+    Measured in the mouth's own frame (x from corner to corner, y up across it), so a
+    turned or tilted head keeps it.
+    """
+    p = np.asarray(positions, np.float64)
+    x_axis = p[rim.upper[-1]] - p[rim.upper[0]]
+    x_axis /= max(np.linalg.norm(x_axis), 1e-9)
+    y_axis = np.array([0.0, 1.0, 0.0]) - x_axis[1] * x_axis
+    y_axis /= max(np.linalg.norm(y_axis), 1e-9)
+
+    def plane(idx):
+        q = p[idx]
+        return q @ x_axis, q @ y_axis
+
+    ux, uy = plane(rim.upper)
+    lx, ly = plane(rim.lower)
+    # Sorted by x at rest; an expression keeps that order nearly, np.interp wants it exactly.
+    ou, ol = np.argsort(ux), np.argsort(lx)
+    ux, uy, lx, ly = ux[ou], uy[ou], lx[ol], ly[ol]
+
+    def upper_edge(x):
+        return np.interp(x, ux, uy)
+
+    def lower_edge(x):
+        return np.interp(x, lx, ly)
+
+    lo, hi = LIP_PARTING
+    for ring, visibility in zip(rim.rings, LIP_RING_VISIBILITY):
+        x, _ = plane(ring)
+        parted = np.clip((upper_edge(x) - lower_edge(x) - lo) / (hi - lo), 0.0, 1.0)
+        parted = parted * parted * (3.0 - 2.0 * parted)
+        occlusion[ring] = np.maximum(occlusion[ring], visibility * parted)
+    for teeth in (rim.upper_teeth, rim.lower_teeth):
+        x, y = plane(teeth)
+        occlusion[teeth] = upper_edge(x) - y
