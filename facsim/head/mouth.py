@@ -209,6 +209,8 @@ def mouth_depth_visibility(head, neutral: np.ndarray, *, falloff: float = 0.12):
 LIP_RING_VISIBILITY = (0.45, 0.6, 0.75)
 #: The lips have parted over this range of gap (dm) at a given x: 0.5 mm -> 4 mm.
 LIP_PARTING = (0.005, 0.04)
+#: How many rings of skin around the rim count as the upper lip's free margin.
+UPPER_LIP_RINGS = 5
 @dataclass(frozen=True)
 class MouthRim:
     """The lips' inner rim and the mouth's parts whose light depends on the lips per frame.
@@ -220,6 +222,10 @@ class MouthRim:
         border the mouth's lining), each sorted by x at rest.
     rings : tuple of (K_i,) int
         The rim (ring 0) and the skin rings just outside it: the lips' inner surface.
+    upper_lip : (L,) int
+        The upper lip's skin near its rim (:data:`UPPER_LIP_RINGS` rings): its lowest
+        point over a tooth is the edge whose shadow the tooth takes (the rim itself lies
+        on the lip's inner side, above its free margin).
     upper_teeth, lower_teeth : (T,) int
         Geometry indices of the teeth rows.
     """
@@ -227,6 +233,7 @@ class MouthRim:
     upper: np.ndarray
     lower: np.ndarray
     rings: tuple
+    upper_lip: np.ndarray
     upper_teeth: np.ndarray
     lower_teeth: np.ndarray
 
@@ -241,14 +248,28 @@ def mouth_rim(head, data, neutral: np.ndarray) -> MouthRim:
     skin = region == REGIONS.index("skin")
     triangles = head.triangles
     rings, inside = [], lining.copy()
-    for _ in LIP_RING_VISIBILITY:
+    for _ in range(max(len(LIP_RING_VISIBILITY), UPPER_LIP_RINGS)):
         ring = np.unique(triangles[inside[triangles].any(axis=1)])
         ring = ring[skin[ring] & ~inside[ring]]
         rings.append(ring)
         inside[ring] = True
-    upper, lower = _split_rim(rings[0], triangles, np.asarray(neutral))
+    p = np.asarray(neutral)
+    upper, lower = _split_rim(rings[0], triangles, p)
+    # Ring by ring outward, a vertex belongs to the lip whose previous ring it touches (at
+    # the corners, where it touches both, to neither): the closed lips touch at rest.
+    side = np.zeros(len(region), np.int8)
+    corners = np.intersect1d(upper, lower)
+    side[np.setdiff1d(upper, corners)], side[np.setdiff1d(lower, corners)] = 1, 2
+    for ring in rings[1:UPPER_LIP_RINGS]:
+        touching = triangles[np.isin(triangles, ring).any(axis=1)]
+        for v in ring:
+            near = side[touching[(touching == v).any(axis=1)]]
+            up, down = (near == 1).any(), (near == 2).any()
+            side[v] = 1 if up and not down else 2 if down and not up else 0
+    upper_lip = np.flatnonzero(side == 1)
+    rings = rings[: len(LIP_RING_VISIBILITY)]
     by_x = lambda idx: idx[np.argsort(np.asarray(neutral)[idx, 0])]  # noqa: E731
-    return MouthRim(upper=by_x(upper), lower=by_x(lower), rings=tuple(rings),
+    return MouthRim(upper=by_x(upper), lower=by_x(lower), rings=tuple(rings), upper_lip=upper_lip,
                     upper_teeth=head.group_geometry(data, UPPER_TEETH),
                     lower_teeth=head.group_geometry(data, LOWER_TEETH))
 
@@ -338,6 +359,10 @@ def mouth_light(rim: MouthRim, positions: np.ndarray, occlusion: np.ndarray) -> 
         parted = np.clip((upper_edge(x) - lower_edge(x) - lo) / (hi - lo), 0.0, 1.0)
         parted = parted * parted * (3.0 - 2.0 * parted)
         occlusion[ring] = np.maximum(occlusion[ring], visibility * parted)
+    lip_x, lip_y = plane(rim.upper_lip)
     for teeth in (rim.upper_teeth, rim.lower_teeth):
         x, y = plane(teeth)
-        occlusion[teeth] = upper_edge(x) - y
+        # The upper lip's lowest point within a tooth column's reach of x.
+        over = np.abs(x[:, None] - lip_x[None]) < COLUMN_REACH
+        edge = np.where(over.any(axis=1), np.where(over, lip_y[None], np.inf).min(axis=1), upper_edge(x))
+        occlusion[teeth] = edge - y

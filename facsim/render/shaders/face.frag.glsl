@@ -374,11 +374,13 @@ void main() {
     float notch;
     if (kind <= 1) {
         float corner = clamp((side - 0.45) / 0.55, 0.0, 1.0);
-        notch = 0.10 * corner * corner + (kind == 1 ? mix(0.035, 0.012, lower) : 0.0);
+        notch = 0.06 * corner * corner + (kind == 1 ? mix(0.03, 0.012, lower) : 0.0);
     } else if (kind == 2) {
-        notch = 0.11 * pow(side, 1.6) - 0.01;
+        notch = 0.09 * pow(side, 1.6) - 0.01;
     } else {
-        notch = 0.03 + 0.08 * pow(side, 3.0) + 0.015 * float(kind - 3);
+        // (Shallow: the back teeth's cusps show only in the buccal corridor's shade, where a
+        // deep cut read as broken black teeth.)
+        notch = 0.03 + 0.04 * pow(side, 3.0) + 0.01 * float(kind - 3);
     }
     // A band without coordinates (all (0, 0): constant, so no derivative) stays whole.
     bool shaped = fwidth(v_uv.x) + fwidth(v_uv.y) > 0.0;
@@ -412,7 +414,7 @@ void main() {
     // that edge in this frame (facsim.head.mouth.mouth_light; 1 when nobody passes it). The
     // lower row stands back under the upper teeth and lip and faces up into the mouth:
     // darker, and mostly hidden.
-    float depth_shade = mix(1.0, 0.10, smoothstep(0.09, 0.34, arc));
+    float depth_shade = mix(1.0, 0.16, smoothstep(0.12, 0.36, arc));
     float lip_shadow = mix(0.34, 1.0, smoothstep(-0.002, 0.03, v_occlusion));
     float row_light = mix(1.0, 0.62, lower);
     // The inside of the arch faces the tongue and throat: it only catches light scattered in.
@@ -432,7 +434,7 @@ void main() {
     vec3 albedo = u_albedo * vec3(0.85, 0.72, 0.76) * papillae * groove;
     // The tongue lies in the shadow of the lips and upper teeth: dim at the tip, dark toward
     // the throat and at its sides against the teeth.
-    float mouth_shade = mix(0.6, 0.05, smoothstep(0.0, 0.3, along)) * mix(1.0, 0.5, smoothstep(0.4, 1.0, abs(across)));
+    float mouth_shade = mix(0.45, 0.05, smoothstep(0.0, 0.3, along)) * mix(1.0, 0.5, smoothstep(0.4, 1.0, abs(across)));
     // Moist: a soft sheen broken by the papillae, and a tighter glint on the film of saliva.
     vec3 spec = specular_light(n, v, 40.0) * 0.12 * papillae + specular_light(n, v, 90.0) * 0.3 * smoothstep(0.8, 1.1, papillae);
     radiance = (diffuse_light(n, vec3(0.3, 0.15, 0.1), 1.0) * 0.8 * albedo + spec) * mouth_shade;
