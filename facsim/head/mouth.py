@@ -206,9 +206,12 @@ def mouth_depth_visibility(head, neutral: np.ndarray, *, falloff: float = 0.12):
 #: vertices from the rim (the wet mucosa the lips turn toward each other): the bake is
 #: taken on the closed mouth, where the rim is buried (visibility ~0), so an open mouth
 #: showed its lips' inner edge black, a hard outline.
-LIP_RING_VISIBILITY = (0.45, 0.6, 0.75)
+LIP_RING_VISIBILITY = (0.2, 0.45, 0.7)
 #: The lips have parted over this range of gap (dm) at a given x: 0.5 mm -> 4 mm.
 LIP_PARTING = (0.005, 0.04)
+#: The tongue lies in the dark behind the teeth until the lips part this far (dm) at the
+#: midline, and takes the light the mouth lets in when they have parted this far.
+TONGUE_LIT_GAP = (0.003, 0.025)
 #: How many rings of skin around the rim count as the upper lip's free margin.
 UPPER_LIP_RINGS = 5
 @dataclass(frozen=True)
@@ -228,6 +231,8 @@ class MouthRim:
         on the lip's inner side, above its free margin).
     upper_teeth, lower_teeth : (T,) int
         Geometry indices of the teeth rows.
+    tongue : (G,) int
+        Geometry indices of the tongue.
     """
 
     upper: np.ndarray
@@ -236,6 +241,7 @@ class MouthRim:
     upper_lip: np.ndarray
     upper_teeth: np.ndarray
     lower_teeth: np.ndarray
+    tongue: np.ndarray
 
 
 def mouth_rim(head, data, neutral: np.ndarray) -> MouthRim:
@@ -271,7 +277,8 @@ def mouth_rim(head, data, neutral: np.ndarray) -> MouthRim:
     by_x = lambda idx: idx[np.argsort(np.asarray(neutral)[idx, 0])]  # noqa: E731
     return MouthRim(upper=by_x(upper), lower=by_x(lower), rings=tuple(rings), upper_lip=upper_lip,
                     upper_teeth=head.group_geometry(data, UPPER_TEETH),
-                    lower_teeth=head.group_geometry(data, LOWER_TEETH))
+                    lower_teeth=head.group_geometry(data, LOWER_TEETH),
+                    tongue=head.group_geometry(data, TONGUE))
 
 
 def _split_rim(rim: np.ndarray, triangles: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -327,6 +334,8 @@ def mouth_light(rim: MouthRim, positions: np.ndarray, occlusion: np.ndarray) -> 
       edge is close to straight between the teeth's columns), so the teeth's shader draws
       the lip's soft contact shadow right under its edge, millimetres wide, where the
       band's vertices lie 8 mm apart. (The bake under closed lips means nothing for them.)
+    - the tongue takes the light the parted lips let in (:data:`TONGUE_LIT_GAP`): seen
+      through the gaps between barely parted teeth it is dark, not a pink dot.
 
     Measured in the mouth's own frame (x from corner to corner, y up across it), so a
     turned or tilted head keeps it.
@@ -359,6 +368,9 @@ def mouth_light(rim: MouthRim, positions: np.ndarray, occlusion: np.ndarray) -> 
         parted = np.clip((upper_edge(x) - lower_edge(x) - lo) / (hi - lo), 0.0, 1.0)
         parted = parted * parted * (3.0 - 2.0 * parted)
         occlusion[ring] = np.maximum(occlusion[ring], visibility * parted)
+    lo, hi = TONGUE_LIT_GAP
+    lit = np.clip((upper_edge(0.0) - lower_edge(0.0) - lo) / (hi - lo), 0.0, 1.0)
+    occlusion[rim.tongue] = lit * lit * (3.0 - 2.0 * lit)
     lip_x, lip_y = plane(rim.upper_lip)
     for teeth in (rim.upper_teeth, rim.lower_teeth):
         x, y = plane(teeth)

@@ -398,7 +398,9 @@ void main() {
     // papillae reaching toward the biting edge between crowns. A smile rarely shows it;
     // where it shows it is pink, lit like the teeth (no dark band under the lip).
     float gum_edge = mix(0.66, 0.58, lower) + mix(0.16, 0.14, lower) * sin(PI * w);
-    float gum = smoothstep(gum_edge - 0.025, gum_edge + 0.025, max(h, 2.0 * lingual));  // the crowns are ~4 mm thick
+    // (Labial side only: the lingual gum lies deep in the arch's shade, and drawn pink it
+    // showed as red dots between the lower crowns when 16 bared them.)
+    float gum = smoothstep(gum_edge - 0.025, gum_edge + 0.025, h);
     // Ivory enamel: translucent at the edge (a little grey-blue where the dark mouth shows
     // through), warmer toward the neck where dentin shows, a little variation tooth to tooth.
     float tooth_id = float(kind) + 7.0 * step(0.0, v_uv.x) + 14.0 * lower;
@@ -418,7 +420,7 @@ void main() {
     float lip_shadow = mix(0.34, 1.0, smoothstep(-0.002, 0.03, v_occlusion));
     float row_light = mix(1.0, 0.62, lower);
     // The inside of the arch faces the tongue and throat: it only catches light scattered in.
-    float mouth_shade = depth_shade * lip_shadow * row_light * mix(1.0, 0.12, smoothstep(0.0, 0.25, lingual));
+    float mouth_shade = depth_shade * lip_shadow * row_light * mix(1.0, 0.12, smoothstep(0.0, 0.1, lingual));
     float wet = specular_light(n, v, 120.0).r * 0.35 + specular_light(n, v, 30.0).r * 0.05;
     vec3 spec = vec3(wet) * (1.0 - 0.6 * gum) * schlick(0.05, max(dot(n, v), 0.0)) * 3.0;
     // Enamel scatters light inside the tooth: a little of its own brightness beyond the lighting.
@@ -434,7 +436,9 @@ void main() {
     vec3 albedo = u_albedo * vec3(0.85, 0.72, 0.76) * papillae * groove;
     // The tongue lies in the shadow of the lips and upper teeth: dim at the tip, dark toward
     // the throat and at its sides against the teeth.
-    float mouth_shade = mix(0.45, 0.05, smoothstep(0.0, 0.3, along)) * mix(1.0, 0.5, smoothstep(0.4, 1.0, abs(across)));
+    // How much light the parted lips let in arrives in occ (facsim.head.mouth.mouth_light).
+    float mouth_shade = mix(0.45, 0.05, smoothstep(0.0, 0.3, along)) * mix(1.0, 0.5, smoothstep(0.4, 1.0, abs(across)))
+                      * mix(0.1, 1.0, occ);
     // Moist: a soft sheen broken by the papillae, and a tighter glint on the film of saliva.
     vec3 spec = specular_light(n, v, 40.0) * 0.12 * papillae + specular_light(n, v, 90.0) * 0.3 * smoothstep(0.8, 1.1, papillae);
     radiance = (diffuse_light(n, vec3(0.3, 0.15, 0.1), 1.0) * 0.8 * albedo + spec) * mouth_shade;
@@ -443,10 +447,13 @@ void main() {
 #ifdef REGION_MOUTH_INTERIOR
     // Mostly hidden and in the mouth's own shadow: dim, dark red, a little wet; falls off with
     // depth behind the lips (Face passes facsim.head.mouth.mouth_depth_visibility in occ) to
-    // a warm dark red, never black (light scatters through the cheeks and lips).
-    float mouth_shade = mix(0.05, 1.0, occ * occ);
+    // a warm, dull dark (light scattered through cheeks and lips), never black and never a
+    // saturated red (seen through the gaps between the teeth, red read as braces' bands).
+    float mouth_shade = occ * occ;
     vec3 spec = specular_light(n, v, 30.0) * 0.04;
-    radiance = (diffuse_light(n, vec3(0.3, 0.1, 0.1), 1.0) * u_albedo * 0.45 + spec) * mouth_shade;
+    vec3 deep = 0.05 * mix(vec3(dot(u_albedo, vec3(0.33))), u_albedo, 0.5);
+    radiance = (diffuse_light(n, vec3(0.3, 0.1, 0.1), 1.0) * u_albedo * 0.45 + spec) * mouth_shade
+             + deep * (1.0 - mouth_shade);
 #endif
 
 #ifdef REGION_LASHES
