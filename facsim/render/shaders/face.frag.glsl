@@ -425,6 +425,8 @@ void main() {
     vec3 spec = vec3(wet) * (1.0 - 0.6 * gum) * schlick(0.05, max(dot(n, v), 0.0)) * 3.0;
     // Enamel scatters light inside the tooth: a little of its own brightness beyond the lighting.
     radiance = ((diffuse_light(n, vec3(0.3, 0.25, 0.2), 1.0) * 0.9 + 0.16) * albedo + spec) * mouth_shade;
+    // What light reaches the back teeth has bounced off the cheeks' red lining: warm, not grey.
+    radiance *= mix(vec3(1.0, 0.6, 0.5), vec3(1.0), depth_shade);
 #endif
 
 #ifdef REGION_TONGUE
