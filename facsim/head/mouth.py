@@ -206,7 +206,7 @@ def mouth_depth_visibility(head, neutral: np.ndarray, *, falloff: float = 0.12):
 #: vertices from the rim (the wet mucosa the lips turn toward each other): the bake is
 #: taken on the closed mouth, where the rim is buried (visibility ~0), so an open mouth
 #: showed its lips' inner edge black, a hard outline.
-LIP_RING_VISIBILITY = (0.2, 0.45, 0.7)
+LIP_RING_VISIBILITY = (0.5, 0.65, 0.8)
 #: The lips have parted over this range of gap (dm) at a given x: 0.5 mm -> 4 mm.
 LIP_PARTING = (0.005, 0.04)
 #: The tongue lies in the dark behind the teeth until the lips part this far (dm) at the

@@ -453,7 +453,7 @@ void main() {
     // saturated red (seen through the gaps between the teeth, red read as braces' bands).
     float mouth_shade = occ * occ;
     vec3 spec = specular_light(n, v, 30.0) * 0.04;
-    vec3 deep = 0.05 * mix(vec3(dot(u_albedo, vec3(0.33))), u_albedo, 0.5);
+    vec3 deep = 0.12 * mix(vec3(dot(u_albedo, vec3(0.33))), u_albedo, 0.5);
     radiance = (diffuse_light(n, vec3(0.3, 0.1, 0.1), 1.0) * u_albedo * 0.45 + spec) * mouth_shade
              + deep * (1.0 - mouth_shade);
 #endif
