@@ -3,10 +3,12 @@ renderer shades teeth, tongue and oral cavity with.
 
 hm08's teeth are two crude bands (``helper-upper-teeth``/``helper-lower-teeth``, 68
 vertices each: an outer wall of three rows plus a lingual slope) and its tongue fills
-the closed mouth up to the palate. Nothing here adds per-frame work: the coordinates
-are static per vertex (the renderer uploads them once with the topology), and the
-tongue is lowered in the character's rest mesh, so both engines carry it with the jaw
-as they carry the lower teeth.
+the closed mouth up to the palate. The coordinates are static per vertex (the renderer
+uploads them once with the topology); the rest pose (teeth heights, tongue, the
+lining behind the skin) is set in the character's rest mesh, so both engines carry it
+with the jaw. Per frame, :func:`mouth_light` says where the lips are (a fraction of a
+millisecond): the upper lip's shadow on the teeth, the lips' inner surface opening to
+the light, the light the parted lips let in onto the tongue.
 
 Examples
 --------
