@@ -209,3 +209,25 @@ def test_the_mouths_lining_never_shows_through_the_skin(face_of, expression):
     lining = np.abs(renders[0] - renders[1]).max(axis=-1) > 3
     rim, _ = project(face.camera(size=(512, 512)), np.asarray(deformation.positions)[face._mouth_rim.upper], (512, 512))
     assert not lining[: int(rim[:, 1].min()) - 3].any()
+
+
+def test_the_mouths_light_follows_the_lips(face_of):
+    # Per frame (numpy only): closed lips keep their inner rim buried as baked and the tongue
+    # dark; parted lips open the rim to the light, light the tongue, and bare the upper
+    # teeth's biting edge millimetres below the upper lip's margin.
+    from facsim.head.mouth import LIP_RING_VISIBILITY, mouth_rim
+
+    face = face_of("ava")
+    rim = mouth_rim(face.head, face.data, face.neutral)
+    assert face.neutral[rim.upper, 1].mean() > face.neutral[rim.lower, 1].mean()
+    assert len(np.intersect1d(rim.upper, rim.lower)) == 2          # they meet at the corners
+    coords = teeth_coordinates(face.head, face.data, face.base_positions)
+    edge = rim.upper_teeth[(np.abs(coords[rim.upper_teeth, 1]) < 0.02)
+                           & (np.abs(face.neutral[rim.upper_teeth, 0]) < 0.1)]
+    rest = face.frame_occlusion(face.neutral)
+    np.testing.assert_allclose(rest[rim.rings[0]], face.shading_occlusion[rim.rings[0]])
+    assert rest[rim.tongue].max() < 0.05
+    smile = face.frame_occlusion(np.asarray(face.deform("6+12+25").positions))
+    assert smile[rim.rings[0]].max() == pytest.approx(LIP_RING_VISIBILITY[0])
+    assert smile[rim.tongue].min() > 0.9
+    assert np.median(smile[edge]) > np.median(rest[edge]) + 0.03   # 3 mm more of the teeth below the lip

@@ -18,7 +18,7 @@ Examples
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -235,6 +235,11 @@ class MouthRim:
         Geometry indices of the teeth rows.
     tongue : (G,) int
         Geometry indices of the tongue.
+    rest_gap : tuple of (K_i,) float
+        Per ring vertex, the gap (dm) between the rims at its x at rest: the lips touch in
+        front of their inner rims, which sit apart; only a wider gap parts the lips.
+    rest_gap_middle : float
+        The same in the mouth's middle.
     """
 
     upper: np.ndarray
@@ -244,6 +249,8 @@ class MouthRim:
     upper_teeth: np.ndarray
     lower_teeth: np.ndarray
     tongue: np.ndarray
+    rest_gap: tuple = ()
+    rest_gap_middle: float = 0.0
 
 
 def mouth_rim(head, data, neutral: np.ndarray) -> MouthRim:
@@ -277,10 +284,13 @@ def mouth_rim(head, data, neutral: np.ndarray) -> MouthRim:
     upper_lip = np.flatnonzero(side == 1)
     rings = rings[: len(LIP_RING_VISIBILITY)]
     by_x = lambda idx: idx[np.argsort(np.asarray(neutral)[idx, 0])]  # noqa: E731
-    return MouthRim(upper=by_x(upper), lower=by_x(lower), rings=tuple(rings), upper_lip=upper_lip,
-                    upper_teeth=head.group_geometry(data, UPPER_TEETH),
-                    lower_teeth=head.group_geometry(data, LOWER_TEETH),
-                    tongue=head.group_geometry(data, TONGUE))
+    rim = MouthRim(upper=by_x(upper), lower=by_x(lower), rings=tuple(rings), upper_lip=upper_lip,
+                   upper_teeth=head.group_geometry(data, UPPER_TEETH),
+                   lower_teeth=head.group_geometry(data, LOWER_TEETH),
+                   tongue=head.group_geometry(data, TONGUE))
+    plane, upper_edge, lower_edge, middle = _lips(rim, p)
+    gaps = tuple(np.maximum(upper_edge(x) - lower_edge(x), 0.0) for x in (plane(ring)[0] for ring in rings))
+    return replace(rim, rest_gap=gaps, rest_gap_middle=float(max(upper_edge(middle) - lower_edge(middle), 0.0)))
 
 
 def _split_rim(rim: np.ndarray, triangles: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -325,6 +335,28 @@ def _split_rim(rim: np.ndarray, triangles: np.ndarray, p: np.ndarray) -> tuple[n
     return chains[0], chains[1]
 
 
+def _lips(rim: MouthRim, positions: np.ndarray):
+    """The lips in the mouth's own frame (x from corner to corner, y up across it):
+    ``plane(indices) -> (x, y)``, the upper and the lower rim's height at x, and the x
+    of the mouth's middle."""
+    p = np.asarray(positions, np.float64)
+    x_axis = p[rim.upper[-1]] - p[rim.upper[0]]
+    x_axis /= max(np.linalg.norm(x_axis), 1e-9)
+    y_axis = np.array([0.0, 1.0, 0.0]) - x_axis[1] * x_axis
+    y_axis /= max(np.linalg.norm(y_axis), 1e-9)
+
+    def plane(idx):
+        q = p[idx]
+        return q @ x_axis, q @ y_axis
+
+    ux, uy = plane(rim.upper)
+    lx, ly = plane(rim.lower)
+    # Sorted by x at rest; an expression keeps that order nearly, np.interp wants it exactly.
+    ou, ol = np.argsort(ux), np.argsort(lx)
+    ux, uy, lx, ly = ux[ou], uy[ou], lx[ol], ly[ol]
+    return plane, (lambda x: np.interp(x, ux, uy)), (lambda x: np.interp(x, lx, ly)), 0.5 * (ux[0] + ux[-1])
+
+
 def mouth_light(rim: MouthRim, positions: np.ndarray, occlusion: np.ndarray) -> None:
     """Light the mouth by where the lips are in this frame (in place on ``occlusion``,
     (N_geo,), as baked on the closed mouth):
@@ -342,36 +374,16 @@ def mouth_light(rim: MouthRim, positions: np.ndarray, occlusion: np.ndarray) -> 
     Measured in the mouth's own frame (x from corner to corner, y up across it), so a
     turned or tilted head keeps it.
     """
-    p = np.asarray(positions, np.float64)
-    x_axis = p[rim.upper[-1]] - p[rim.upper[0]]
-    x_axis /= max(np.linalg.norm(x_axis), 1e-9)
-    y_axis = np.array([0.0, 1.0, 0.0]) - x_axis[1] * x_axis
-    y_axis /= max(np.linalg.norm(y_axis), 1e-9)
-
-    def plane(idx):
-        q = p[idx]
-        return q @ x_axis, q @ y_axis
-
-    ux, uy = plane(rim.upper)
-    lx, ly = plane(rim.lower)
-    # Sorted by x at rest; an expression keeps that order nearly, np.interp wants it exactly.
-    ou, ol = np.argsort(ux), np.argsort(lx)
-    ux, uy, lx, ly = ux[ou], uy[ou], lx[ol], ly[ol]
-
-    def upper_edge(x):
-        return np.interp(x, ux, uy)
-
-    def lower_edge(x):
-        return np.interp(x, lx, ly)
-
+    plane, upper_edge, lower_edge, middle = _lips(rim, positions)
     lo, hi = LIP_PARTING
-    for ring, visibility in zip(rim.rings, LIP_RING_VISIBILITY):
+    for ring, visibility, rest_gap in zip(rim.rings, LIP_RING_VISIBILITY, rim.rest_gap):
         x, _ = plane(ring)
-        parted = np.clip((upper_edge(x) - lower_edge(x) - lo) / (hi - lo), 0.0, 1.0)
+        # Parted beyond where the lips' inner rims sit at rest (they touch in front of them).
+        parted = np.clip((upper_edge(x) - lower_edge(x) - rest_gap - lo) / (hi - lo), 0.0, 1.0)
         parted = parted * parted * (3.0 - 2.0 * parted)
         occlusion[ring] = np.maximum(occlusion[ring], visibility * parted)
     lo, hi = TONGUE_LIT_GAP
-    lit = np.clip((upper_edge(0.0) - lower_edge(0.0) - lo) / (hi - lo), 0.0, 1.0)
+    lit = np.clip((upper_edge(middle) - lower_edge(middle) - rim.rest_gap_middle - lo) / (hi - lo), 0.0, 1.0)
     occlusion[rim.tongue] = lit * lit * (3.0 - 2.0 * lit)
     lip_x, lip_y = plane(rim.upper_lip)
     for teeth in (rim.upper_teeth, rim.lower_teeth):
