@@ -417,7 +417,7 @@ void main() {
     // lower row stands back under the upper teeth and lip and faces up into the mouth:
     // darker, and mostly hidden.
     float depth_shade = mix(1.0, 0.16, smoothstep(0.12, 0.36, arc));
-    float lip_shadow = mix(0.34, 1.0, smoothstep(-0.002, 0.03, v_occlusion));
+    float lip_shadow = mix(0.5, 1.0, smoothstep(-0.002, 0.022, v_occlusion));
     float row_light = mix(1.0, 0.62, lower);
     // The inside of the arch faces the tongue and throat: it only catches light scattered in.
     float mouth_shade = depth_shade * lip_shadow * row_light * mix(1.0, 0.12, smoothstep(0.0, 0.1, lingual));
