@@ -374,9 +374,9 @@ void main() {
     float notch;
     if (kind <= 1) {
         float corner = clamp((side - 0.45) / 0.55, 0.0, 1.0);
-        notch = 0.06 * corner * corner + (kind == 1 ? mix(0.03, 0.012, lower) : 0.0);
+        notch = 0.035 * corner * corner + (kind == 1 ? mix(0.02, 0.01, lower) : 0.0);
     } else if (kind == 2) {
-        notch = 0.09 * pow(side, 1.6) - 0.01;
+        notch = 0.06 * pow(side, 1.6) - 0.01;
     } else {
         // (Shallow: the back teeth's cusps show only in the buccal corridor's shade, where a
         // deep cut read as broken black teeth.)
