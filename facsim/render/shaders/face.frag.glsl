@@ -269,13 +269,15 @@ void main() {
     float ndv = max(dot(n, v), 0.0);
     float fres = mix(0.028, schlick(0.028, ndv), 0.55);
     float oil = detail.b * (1.0 - 0.35 * u_age) * mix(0.55, 1.3, patches) * (1.0 - lips);
-    float wet = lips * (1.0 - 0.5 * lip_line);
+    // Wet, but the film is broken by the furrows and by the lips' fine mottle: a continuous
+    // glossy band along the lip read as rubber.
+    float wet = lips * (1.0 - 0.85 * lip_line) * (0.55 + 0.45 * blotch);
     // (The fill is too weak to show in a broad lobe: key and rim only.)
     float broad_shine = mix(8.0, 14.0, oil);
     vec3 broad = (blinn(bumped, u_key_dir, v, broad_shine) * u_key_col
                   + blinn(bumped, u_rim_dir, v, broad_shine) * u_rim_col) * mix(0.2, 0.75, oil);
     vec3 tight = blinn(bumped, u_key_dir, v, mix(32.0, 70.0, wet)) * u_key_col
-               * (mix(0.08, 2.2, oil * oil) + 1.6 * wet);
+               * (mix(0.08, 2.2, oil * oil) + 1.2 * wet);
     vec3 spec = (broad + tight) * fres * (1.0 - hair) * (0.4 + 1.2 * grain);
     radiance = (diffuse + spec * contact) * cavity;
 #endif
