@@ -220,7 +220,9 @@ class Face:
 
     def frame_occlusion(self, positions: np.ndarray) -> np.ndarray:
         """:attr:`shading_occlusion` with the upper lids' creases deepened or smoothed where
-        ``positions`` put the lids (the lids' shade on the eyeballs comes from :meth:`frame_lids`)."""
+        ``positions`` put the lids (the lids' shade on the eyeballs comes from :meth:`frame_lids`),
+        and the mouth lit by where the lips are (:func:`facsim.head.mouth.mouth_light`)."""
+        from facsim.head.mouth import mouth_light
         from facsim.render.geometry import lid_crease_shade
 
         occlusion = np.array(self.shading_occlusion, np.float32, copy=True)
@@ -228,6 +230,7 @@ class Face:
         for side, (centre, upper, _) in self._lid_margins.items():
             crease, weights, height = self._lid_creases[side]
             occlusion[crease] *= lid_crease_shade(positions, centre, crease, weights, upper, height)
+        mouth_light(self._mouth_rim, positions, occlusion)
         return occlusion
 
     def frame_lids(self, positions: np.ndarray) -> np.ndarray:
@@ -255,6 +258,12 @@ class Face:
             return np.asarray(positions)
         now, rest = p[skull].mean(axis=0), self.neutral[skull].astype(np.float64).mean(axis=0)
         return ((p - now) @ rotation + rest).astype(np.float32)
+
+    @cached_property
+    def _mouth_rim(self):
+        from facsim.head.mouth import mouth_rim
+
+        return mouth_rim(self.head, self.data, self.neutral)
 
     @cached_property
     def _lid_creases(self) -> dict:

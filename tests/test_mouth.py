@@ -7,6 +7,7 @@ import pytest
 from facsim.head.mesh import REGIONS
 from facsim.head.mouth import (
     LOWER_ROW_OFFSET,
+    LOWER_TEETH_DROP,
     LOWER_TEETH,
     TONGUE,
     TONGUE_BELOW_TEETH,
@@ -75,7 +76,8 @@ def test_older_faces_rest_their_upper_teeth_higher(face_of):
     for age in (25.0, 45.0, 70.0):
         rested = rest_mouth(face.base_positions, data, age=age)
         overlap[age] = float(rested[lower, 1].max() - rested[upper, 1].min())   # how far the rows overlap
-        np.testing.assert_array_equal(rested[lower], face.base_positions[lower])
+        # (applied again to the rested mesh: the lower row drops once more, whatever the age)
+        np.testing.assert_allclose(rested[lower], face.base_positions[lower] - (0.0, LOWER_TEETH_DROP, 0.0), atol=1e-6)
     assert overlap[25.0] > overlap[45.0] > overlap[70.0]
 
 
@@ -181,7 +183,51 @@ def test_at_rest_the_lips_hide_the_teeth(face_of):
 
 
 def test_the_muscle_engine_shows_the_same_teeth(face_of):
+    # 16 pulls the lower lip off the lower teeth. (The muscle engine's 10 barely lifts the upper
+    # lip's inner rim, so its 10+25 shows at most the lower incisors' edges since they rest
+    # lower, :data:`facsim.head.mouth.LOWER_TEETH_DROP`.)
     face = face_of("ava", "muscle")
-    image, teeth, _ = _mouth_pixels(face, "muscle", "10+25")
+    image, teeth, _ = _mouth_pixels(face, "muscle", "10+16+25")
     assert teeth.sum() > 30
     assert np.median(_luminance(image[teeth])) > 130
+
+
+@pytest.mark.parametrize("expression", ["0", "12C", "6+12+25"])
+def test_the_mouths_lining_never_shows_through_the_skin(face_of, expression):
+    # george's targets pulled the skin beside the nose wings onto hm08's lining (the
+    # vestibule climbs up there): its dark shading showed as black dots at 512 px. No
+    # pixel of the inside of the mouth shows above the upper lip.
+    from facsim import Face
+    from facsim.render.camera import project
+
+    face = face_of("george")
+    deformation = face.deform(expression)
+    renders = []
+    for inside in ("#ffffff", "#000000"):
+        with Face(face.character.with_(colors={"mouth_interior": inside})) as marked:
+            renders.append(marked.render(deformation=deformation, size=512)[..., :3].astype(int))
+    lining = np.abs(renders[0] - renders[1]).max(axis=-1) > 3
+    rim, _ = project(face.camera(size=(512, 512)), np.asarray(deformation.positions)[face._mouth_rim.upper], (512, 512))
+    assert not lining[: int(rim[:, 1].min()) - 3].any()
+
+
+def test_the_mouths_light_follows_the_lips(face_of):
+    # Per frame (numpy only): closed lips keep their inner rim buried as baked and the tongue
+    # dark; parted lips open the rim to the light, light the tongue, and bare the upper
+    # teeth's biting edge millimetres below the upper lip's margin.
+    from facsim.head.mouth import LIP_RING_VISIBILITY, mouth_rim
+
+    face = face_of("ava")
+    rim = mouth_rim(face.head, face.data, face.neutral)
+    assert face.neutral[rim.upper, 1].mean() > face.neutral[rim.lower, 1].mean()
+    assert len(np.intersect1d(rim.upper, rim.lower)) == 2          # they meet at the corners
+    coords = teeth_coordinates(face.head, face.data, face.base_positions)
+    edge = rim.upper_teeth[(np.abs(coords[rim.upper_teeth, 1]) < 0.02)
+                           & (np.abs(face.neutral[rim.upper_teeth, 0]) < 0.1)]
+    rest = face.frame_occlusion(face.neutral)
+    np.testing.assert_allclose(rest[rim.rings[0]], face.shading_occlusion[rim.rings[0]])
+    assert rest[rim.tongue].max() < 0.05
+    smile = face.frame_occlusion(np.asarray(face.deform("6+12+25").positions))
+    assert smile[rim.rings[0]].max() == pytest.approx(LIP_RING_VISIBILITY[0])
+    assert smile[rim.tongue].min() > 0.9
+    assert np.median(smile[edge]) > np.median(rest[edge]) + 0.03   # 3 mm more of the teeth below the lip

@@ -3,10 +3,12 @@ renderer shades teeth, tongue and oral cavity with.
 
 hm08's teeth are two crude bands (``helper-upper-teeth``/``helper-lower-teeth``, 68
 vertices each: an outer wall of three rows plus a lingual slope) and its tongue fills
-the closed mouth up to the palate. Nothing here adds per-frame work: the coordinates
-are static per vertex (the renderer uploads them once with the topology), and the
-tongue is lowered in the character's rest mesh, so both engines carry it with the jaw
-as they carry the lower teeth.
+the closed mouth up to the palate. The coordinates are static per vertex (the renderer
+uploads them once with the topology); the rest pose (teeth heights, tongue, the
+lining behind the skin) is set in the character's rest mesh, so both engines carry it
+with the jaw. Per frame, :func:`mouth_light` says where the lips are (a fraction of a
+millisecond): the upper lip's shadow on the teeth, the lips' inner surface opening to
+the light, the light the parted lips let in onto the tongue.
 
 Examples
 --------
@@ -15,6 +17,8 @@ Examples
 >>> coords = teeth_coordinates(face.head, face.data, face.base_positions)  # doctest: +SKIP
 """
 from __future__ import annotations
+
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -34,20 +38,35 @@ TONGUE_BELOW_TEETH = 0.012
 #: lengthens (Vig & Brundo 1978: from ~3.4 mm under 30 to ~0 past 60), so the drop fades
 #: out between the ages in :data:`UPPER_TEETH_DROP_AGES`: older faces show less upper and
 #: relatively more lower teeth, one of the cues that reads as age.
-UPPER_TEETH_DROP = 0.015
+UPPER_TEETH_DROP = 0.022
 UPPER_TEETH_DROP_AGES = (30.0, 60.0)
+#: The lower teeth rest this far (dm) lower than hm08 puts them. hm08's lower incisors reach
+#: the lips' meeting line, so every open mouth (25+26, surprise's 26) bared their whole
+#: crowns above the lower lip, a bright row of blocks; in photographs of open mouths the
+#: lower lip covers most of the lower teeth, and a jaw that drops shows their edges.
+LOWER_TEETH_DROP = 0.012
 #: Radius (dm, in plan) within which a tooth vertex's biting edge and root row are looked
 #: up: a column's rows lie within 3 mm of each other, columns 5–8 mm apart.
 COLUMN_REACH = 0.035
 #: A band vertex further than this (dm, in plan) from every root-row vertex is on the
 #: lingual slope (the band's inside, 8–13 mm in), not on the outer wall (within 3 mm).
 LINGUAL_REACH = 0.05
+#: The mouth's lining stays at least this far (dm) behind the skin in front of it. hm08's
+#: lining (the vestibule between the upper lip and the gums) climbs to the nose wings; some
+#: characters' targets pull the skin there onto it (george: 0.00 mm at rest, 0.2 mm through
+#: the skin in a smile), and the lining's dark shading showed as black dots beside the nose.
+#: 2 mm holds through every expression's relative motion there (under 1 mm, both engines).
+CAVITY_CLEARANCE = 0.02
+#: Lining vertices this close (dm) to the lips' inner rim are left alone: there the lining
+#: legitimately meets the lips.
+RIM_REACH = 0.08
 
 
 def rest_mouth(base_positions: np.ndarray, data, *, age: float = 25.0) -> np.ndarray:
     """Base positions (19158, 3) with the mouth's parts at rest: the upper teeth lowered by
-    :data:`UPPER_TEETH_DROP` (less with ``age`` in years) and the tongue lowered into the
-    floor of the mouth.
+    :data:`UPPER_TEETH_DROP` (less with ``age`` in years), the lower by
+    :data:`LOWER_TEETH_DROP`, the tongue lowered into the floor of the mouth, and the
+    mouth's lining kept :data:`CAVITY_CLEARANCE` behind the skin.
 
     The tongue is squashed toward its underside (about its lowest point) until its top
     sits :data:`TONGUE_BELOW_TEETH` under the lower incisors' edge; its tip and sides
@@ -56,8 +75,11 @@ def rest_mouth(base_positions: np.ndarray, data, *, age: float = 25.0) -> np.nda
     with the skull and the jaw as they carry hm08's own.
     """
     out = np.array(base_positions, np.float32, copy=True)
+    lining, skin_triangles = _lining_and_skin(data)
+    out[lining] = _behind_skin(out[lining], out[skin_triangles], CAVITY_CLEARANCE)
     young, old = UPPER_TEETH_DROP_AGES
     out[data.group_vertices(UPPER_TEETH), 1] -= UPPER_TEETH_DROP * float(np.clip((old - age) / (old - young), 0.0, 1.0))
+    out[data.group_vertices(LOWER_TEETH), 1] -= LOWER_TEETH_DROP
     tongue = data.group_vertices(TONGUE)
     lower = data.group_vertices(LOWER_TEETH)
     y = out[tongue, 1]
@@ -67,6 +89,50 @@ def rest_mouth(base_positions: np.ndarray, data, *, age: float = 25.0) -> np.nda
         return out
     scale = max((target - bottom) / (top - bottom), 0.4)
     out[tongue, 1] = bottom + scale * (y - bottom)
+    return out
+
+
+def _lining_and_skin(data) -> tuple[np.ndarray, np.ndarray]:
+    """Base vertices of the mouth's lining away from the lips' rim, and the (T, 3) base
+    triangles of the skin around the mouth and nose (hm08's segmentation, as
+    :func:`facsim.head.mesh.build_head` labels the cavity)."""
+    from facsim.head.mesh import _label_quads
+
+    quads = np.asarray(data.quads)
+    body = data.quad_group == list(data.group_names).index("body")
+    mouth = body & _label_quads(data, ("mouth_cavity",))
+    cavity = np.unique(quads[mouth])
+    skin_quads = quads[body & ~mouth]
+    rim = np.intersect1d(cavity, skin_quads)
+    base = np.asarray(data.base_vertices)
+    far = np.linalg.norm(base[cavity][:, None] - base[rim][None], axis=2).min(axis=1) > RIM_REACH
+    lining = cavity[far & ~np.isin(cavity, rim)]
+    # Skin quads over the lining in plan (x, y), split in two triangles each.
+    lo, hi = base[cavity, :2].min(axis=0) - 0.05, base[cavity, :2].max(axis=0) + 0.05
+    corners = base[skin_quads][..., :2]
+    near = ((corners >= lo) & (corners <= hi)).all(axis=2).any(axis=1)
+    q = skin_quads[near]
+    return lining, np.concatenate([q[:, [0, 1, 2]], q[:, [0, 2, 3]]])
+
+
+def _behind_skin(points: np.ndarray, triangles: np.ndarray, clearance: float) -> np.ndarray:
+    """``points`` (N, 3) moved back along -z until each is ``clearance`` behind the
+    nearest skin surface in front of it (``triangles`` (T, 3, 3), seen along the face's
+    +z); points with no skin in front, or deep enough already, stay."""
+    a, b, c = triangles[:, 0], triangles[:, 1], triangles[:, 2]
+    e1, e2 = b - a, c - a
+    det = e1[:, 0] * e2[:, 1] - e2[:, 0] * e1[:, 1]
+    ok = np.abs(det) > 1e-12
+    a, e1, e2, det = a[ok], e1[ok], e2[ok], det[ok]
+    r = points[:, None, :2] - a[None, :, :2]
+    u = (r[..., 0] * e2[:, 1] - e2[:, 0] * r[..., 1]) / det
+    w = (e1[:, 0] * r[..., 1] - r[..., 0] * e1[:, 1]) / det
+    z = a[:, 2] + u * e1[:, 2] + w * e2[:, 2]
+    # Skin in front of the point, or that the point has pushed through (within the clearance).
+    hit = (u >= 0) & (w >= 0) & (u + w <= 1) & (z > points[:, None, 2] - clearance)
+    front = np.where(hit, z, np.inf).min(axis=1)
+    out = points.copy()
+    out[:, 2] = np.minimum(points[:, 2], front - clearance)
     return out
 
 
@@ -136,3 +202,193 @@ def mouth_depth_visibility(head, neutral: np.ndarray, *, falloff: float = 0.12):
     z = np.asarray(neutral)[interior, 2]
     depth = np.clip(z.max() - z, 0.0, None)
     return interior, np.exp(-depth / falloff).astype(np.float32)
+
+
+#: Ambient visibility the lips' inner surface reaches once the lips part, per ring of skin
+#: vertices from the rim (the wet mucosa the lips turn toward each other): the bake is
+#: taken on the closed mouth, where the rim is buried (visibility ~0), so an open mouth
+#: showed its lips' inner edge black, a hard outline.
+LIP_RING_VISIBILITY = (0.5, 0.65, 0.8)
+#: The lips have parted over this range of gap (dm) at a given x: 0.5 mm -> 4 mm.
+LIP_PARTING = (0.005, 0.04)
+#: The tongue lies in the dark behind the teeth until the lips part this far (dm) at the
+#: midline, and takes the light the mouth lets in when they have parted this far.
+TONGUE_LIT_GAP = (0.003, 0.025)
+#: How many rings of skin around the rim count as the upper lip's free margin.
+UPPER_LIP_RINGS = 5
+@dataclass(frozen=True)
+class MouthRim:
+    """The lips' inner rim and the mouth's parts whose light depends on the lips per frame.
+
+    Attributes
+    ----------
+    upper, lower : (K,) int
+        Geometry indices of the upper and the lower lip's inner rim (skin vertices that
+        border the mouth's lining), each sorted by x at rest.
+    rings : tuple of (K_i,) int
+        The rim (ring 0) and the skin rings just outside it: the lips' inner surface.
+    upper_lip : (L,) int
+        The upper lip's skin near its rim (:data:`UPPER_LIP_RINGS` rings): its lowest
+        point over a tooth is the edge whose shadow the tooth takes (the rim itself lies
+        on the lip's inner side, above its free margin).
+    upper_teeth, lower_teeth : (T,) int
+        Geometry indices of the teeth rows.
+    tongue : (G,) int
+        Geometry indices of the tongue.
+    rest_gap : tuple of (K_i,) float
+        Per ring vertex, the gap (dm) between the rims at its x at rest: the lips touch in
+        front of their inner rims, which sit apart; only a wider gap parts the lips.
+    rest_gap_middle : float
+        The same in the mouth's middle.
+    """
+
+    upper: np.ndarray
+    lower: np.ndarray
+    rings: tuple
+    upper_lip: np.ndarray
+    upper_teeth: np.ndarray
+    lower_teeth: np.ndarray
+    tongue: np.ndarray
+    rest_gap: tuple = ()
+    rest_gap_middle: float = 0.0
+
+
+def mouth_rim(head, data, neutral: np.ndarray) -> MouthRim:
+    """The lips' inner rim of ``head`` told apart at rest (``neutral``, (N_geo, 3)): the rim
+    is a loop through the mouth's corners; its higher half is the upper lip's."""
+    from facsim.head.mesh import REGIONS
+
+    region = head.region
+    lining = region == REGIONS.index("mouth_interior")
+    skin = region == REGIONS.index("skin")
+    triangles = head.triangles
+    rings, inside = [], lining.copy()
+    for _ in range(max(len(LIP_RING_VISIBILITY), UPPER_LIP_RINGS)):
+        ring = np.unique(triangles[inside[triangles].any(axis=1)])
+        ring = ring[skin[ring] & ~inside[ring]]
+        rings.append(ring)
+        inside[ring] = True
+    p = np.asarray(neutral)
+    upper, lower = _split_rim(rings[0], triangles, p)
+    # Ring by ring outward, a vertex belongs to the lip whose previous ring it touches (at
+    # the corners, where it touches both, to neither): the closed lips touch at rest.
+    side = np.zeros(len(region), np.int8)
+    corners = np.intersect1d(upper, lower)
+    side[np.setdiff1d(upper, corners)], side[np.setdiff1d(lower, corners)] = 1, 2
+    for ring in rings[1:UPPER_LIP_RINGS]:
+        touching = triangles[np.isin(triangles, ring).any(axis=1)]
+        for v in ring:
+            near = side[touching[(touching == v).any(axis=1)]]
+            up, down = (near == 1).any(), (near == 2).any()
+            side[v] = 1 if up and not down else 2 if down and not up else 0
+    upper_lip = np.flatnonzero(side == 1)
+    rings = rings[: len(LIP_RING_VISIBILITY)]
+    by_x = lambda idx: idx[np.argsort(np.asarray(neutral)[idx, 0])]  # noqa: E731
+    rim = MouthRim(upper=by_x(upper), lower=by_x(lower), rings=tuple(rings), upper_lip=upper_lip,
+                   upper_teeth=head.group_geometry(data, UPPER_TEETH),
+                   lower_teeth=head.group_geometry(data, LOWER_TEETH),
+                   tongue=head.group_geometry(data, TONGUE))
+    plane, upper_edge, lower_edge, middle = _lips(rim, p)
+    gaps = tuple(np.maximum(upper_edge(x) - lower_edge(x), 0.0) for x in (plane(ring)[0] for ring in rings))
+    return replace(rim, rest_gap=gaps, rest_gap_middle=float(max(upper_edge(middle) - lower_edge(middle), 0.0)))
+
+
+def _split_rim(rim: np.ndarray, triangles: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The rim's two chains between the mouth's corners (its extreme x), upper first: the
+    closed lips touch at rest, so heights alone cannot tell them apart."""
+    from collections import deque
+
+    on = np.isin(triangles, rim)
+    links = {int(v): set() for v in rim}
+    for tri, mask in zip(triangles[on.sum(axis=1) >= 2], on[on.sum(axis=1) >= 2]):
+        ends = [int(v) for v, m in zip(tri, mask) if m]
+        for a in ends:
+            links[a].update(b for b in ends if b != a)
+    left, right = int(rim[np.argmin(p[rim, 0])]), int(rim[np.argmax(p[rim, 0])])
+
+    def path(banned):
+        came, todo = {left: None}, deque([left])
+        while todo:
+            v = todo.popleft()
+            for w in links[v]:
+                if w not in came and w not in banned:
+                    came[w] = v
+                    todo.append(w)
+        chain, v = [], right
+        while v is not None and v in came:
+            chain.append(v)
+            v = came[v]
+        return chain
+
+    first = path(set())
+    second = path(set(first[1:-1]))
+    chains = [np.array(first), np.array(second)]
+    # Rim vertices off both chains (a ragged rim) join the chain nearest them.
+    rest = np.setdiff1d(rim, np.concatenate(chains))
+    if len(rest):
+        both = np.concatenate(chains)
+        nearest = both[np.linalg.norm(p[rest][:, None] - p[both][None], axis=2).argmin(axis=1)]
+        for i, chain in enumerate(chains):
+            chains[i] = np.concatenate([chain, rest[np.isin(nearest, chain)]])
+    if p[chains[0], 1].mean() < p[chains[1], 1].mean():
+        chains.reverse()
+    return chains[0], chains[1]
+
+
+def _lips(rim: MouthRim, positions: np.ndarray):
+    """The lips in the mouth's own frame (x from corner to corner, y up across it):
+    ``plane(indices) -> (x, y)``, the upper and the lower rim's height at x, and the x
+    of the mouth's middle."""
+    p = np.asarray(positions, np.float64)
+    x_axis = p[rim.upper[-1]] - p[rim.upper[0]]
+    x_axis /= max(np.linalg.norm(x_axis), 1e-9)
+    y_axis = np.array([0.0, 1.0, 0.0]) - x_axis[1] * x_axis
+    y_axis /= max(np.linalg.norm(y_axis), 1e-9)
+
+    def plane(idx):
+        q = p[idx]
+        return q @ x_axis, q @ y_axis
+
+    ux, uy = plane(rim.upper)
+    lx, ly = plane(rim.lower)
+    # Sorted by x at rest; an expression keeps that order nearly, np.interp wants it exactly.
+    ou, ol = np.argsort(ux), np.argsort(lx)
+    ux, uy, lx, ly = ux[ou], uy[ou], lx[ol], ly[ol]
+    return plane, (lambda x: np.interp(x, ux, uy)), (lambda x: np.interp(x, lx, ly)), 0.5 * (ux[0] + ux[-1])
+
+
+def mouth_light(rim: MouthRim, positions: np.ndarray, occlusion: np.ndarray) -> None:
+    """Light the mouth by where the lips are in this frame (in place on ``occlusion``,
+    (N_geo,), as baked on the closed mouth):
+
+    - the lips' inner surface opens to the light as the lips part at its x (the bake
+      buried it: an open mouth's lips had a black inner edge);
+    - each tooth vertex gets its height (dm) below the upper lip's edge at its x, not a
+      visibility: interpolated across a triangle it is that height per fragment (the lip's
+      edge is close to straight between the teeth's columns), so the teeth's shader draws
+      the lip's soft contact shadow right under its edge, millimetres wide, where the
+      band's vertices lie 8 mm apart. (The bake under closed lips means nothing for them.)
+    - the tongue takes the light the parted lips let in (:data:`TONGUE_LIT_GAP`): seen
+      through the gaps between barely parted teeth it is dark, not a pink dot.
+
+    Measured in the mouth's own frame (x from corner to corner, y up across it), so a
+    turned or tilted head keeps it.
+    """
+    plane, upper_edge, lower_edge, middle = _lips(rim, positions)
+    lo, hi = LIP_PARTING
+    for ring, visibility, rest_gap in zip(rim.rings, LIP_RING_VISIBILITY, rim.rest_gap):
+        x, _ = plane(ring)
+        # Parted beyond where the lips' inner rims sit at rest (they touch in front of them).
+        parted = np.clip((upper_edge(x) - lower_edge(x) - rest_gap - lo) / (hi - lo), 0.0, 1.0)
+        parted = parted * parted * (3.0 - 2.0 * parted)
+        occlusion[ring] = np.maximum(occlusion[ring], visibility * parted)
+    lo, hi = TONGUE_LIT_GAP
+    lit = np.clip((upper_edge(middle) - lower_edge(middle) - rim.rest_gap_middle - lo) / (hi - lo), 0.0, 1.0)
+    occlusion[rim.tongue] = lit * lit * (3.0 - 2.0 * lit)
+    lip_x, lip_y = plane(rim.upper_lip)
+    for teeth in (rim.upper_teeth, rim.lower_teeth):
+        x, y = plane(teeth)
+        # The upper lip's lowest point within a tooth column's reach of x.
+        over = np.abs(x[:, None] - lip_x[None]) < COLUMN_REACH
+        edge = np.where(over.any(axis=1), np.where(over, lip_y[None], np.inf).min(axis=1), upper_edge(x))
+        occlusion[teeth] = edge - y

@@ -403,13 +403,15 @@ void main() {
     float ndv = max(dot(n, v), 0.0);
     float fres = mix(0.028, schlick(0.028, ndv), 0.55);
     float oil = detail.b * (1.0 - 0.35 * u_age) * mix(0.55, 1.3, patches) * (1.0 - lips);
-    float wet = lips * (1.0 - 0.5 * lip_line);
+    // Wet, but the film is broken by the furrows and by the lips' fine mottle: a continuous
+    // glossy band along the lip read as rubber.
+    float wet = lips * (1.0 - 0.85 * lip_line) * (0.55 + 0.45 * blotch);
     // (The fill is too weak to show in a broad lobe: key and rim only.)
     float broad_shine = mix(8.0, 14.0, oil);
     vec3 broad = (blinn(bumped, u_key_dir, v, broad_shine) * u_key_col
                   + blinn(bumped, u_rim_dir, v, broad_shine) * u_rim_col) * mix(0.2, 0.75, oil);
     vec3 tight = blinn(bumped, u_key_dir, v, mix(32.0, 70.0, wet)) * u_key_col
-               * (mix(0.12, 3.2, oil * oil) + 1.6 * wet);
+               * (mix(0.12, 3.2, oil * oil) + 1.2 * wet);
     vec3 spec = (broad + tight) * fres * (1.0 - hair) * (0.6 + 0.8 * grain) * spec_break;
 #ifdef USE_WRINKLE
     // Light reaching a crevice's floor has passed through the skin around it: redder.
@@ -576,46 +578,59 @@ void main() {
     float notch;
     if (kind <= 1) {
         float corner = clamp((side - 0.45) / 0.55, 0.0, 1.0);
-        notch = 0.10 * corner * corner + (kind == 1 ? mix(0.035, 0.012, lower) : 0.0);
+        notch = 0.035 * corner * corner + (kind == 1 ? mix(0.02, 0.01, lower) : 0.0);
     } else if (kind == 2) {
-        notch = 0.11 * pow(side, 1.6) - 0.01;
+        notch = 0.06 * pow(side, 1.6) - 0.01;
     } else {
-        notch = 0.03 + 0.08 * pow(side, 3.0) + 0.015 * float(kind - 3);
+        // (Shallow: the back teeth's cusps show only in the buccal corridor's shade, where a
+        // deep cut read as broken black teeth.)
+        notch = 0.03 + 0.04 * pow(side, 3.0) + 0.01 * float(kind - 3);
     }
     // A band without coordinates (all (0, 0): constant, so no derivative) stays whole.
     bool shaped = fwidth(v_uv.x) + fwidth(v_uv.y) > 0.0;
     if (shaped && max(h, lingual) < notch) discard;
-    // Thin interproximal shadow, strongest toward the edge where crowns part, faded to a
-    // faint mean where it would be finer than a pixel, so teeth never look dirty.
+    // Each crown is convex: it turns away from the light toward its neighbours, and where two
+    // touch they leave a soft shadow (an embrasure, deeper toward the biting edge where crowns
+    // part) - never a dark line, which read as braces. Faded to a faint mean where it would be
+    // finer than a pixel.
     float gap_aa = fwidth(arc);
-    float gap_w = gap_aa + 0.003;
-    float gap = 1.0 - 0.45 * (1.0 - smoothstep(0.0, gap_w, min(arc - b0, b1 - arc)))
-                    * clamp(1.5 - 120.0 * gap_aa, 0.3, 1.0) * mix(1.0, 0.5, smoothstep(0.1, 0.5, h));
-    // Scalloped gum line: arched rootward over each crown, papillae reaching toward the
-    // biting edge between crowns.
-    float gum_edge = mix(0.58, 0.52, lower) + 0.16 * sin(PI * w);
-    float gum = smoothstep(gum_edge - 0.03, gum_edge + 0.03, max(h, 2.0 * lingual));  // the crowns are ~4 mm thick
-    // Ivory enamel: bluish translucent at the edge, warmer toward the neck where dentin shows,
-    // each crown rounded (brighter mid-crown), a little variation tooth to tooth.
+    float to_gap = min(arc - b0, b1 - arc);
+    float convex = 1.0 - 0.16 * pow(side, 3.0);
+    float gap = 1.0 - 0.26 * (1.0 - smoothstep(0.0, gap_aa + 0.006, to_gap))
+                    * clamp(1.5 - 120.0 * gap_aa, 0.3, 1.0) * mix(1.0, 0.45, smoothstep(0.1, 0.5, h));
+    // Scalloped gum line, arched rootward over each crown (crowns ~10 mm of the band's 16),
+    // papillae reaching toward the biting edge between crowns. A smile rarely shows it;
+    // where it shows it is pink, lit like the teeth (no dark band under the lip).
+    float gum_edge = mix(0.66, 0.58, lower) + mix(0.16, 0.14, lower) * sin(PI * w);
+    // (Labial side only: the lingual gum lies deep in the arch's shade, and drawn pink it
+    // showed as red dots between the lower crowns when 16 bared them.)
+    float gum = smoothstep(gum_edge - 0.025, gum_edge + 0.025, h);
+    // Ivory enamel: translucent at the edge (a little grey-blue where the dark mouth shows
+    // through), warmer toward the neck where dentin shows, a little variation tooth to tooth.
     float tooth_id = float(kind) + 7.0 * step(0.0, v_uv.x) + 14.0 * lower;
     float vary = fract(sin(tooth_id * 12.9898) * 43758.5453);
     vec3 enamel = u_albedo * (0.96 + 0.06 * vary);
-    enamel *= mix(vec3(0.80, 0.84, 0.90), vec3(1.0), smoothstep(notch, notch + 0.14, max(h, lingual)));
-    enamel *= mix(vec3(1.0), vec3(1.0, 0.94, 0.82), smoothstep(0.3, gum_edge, h));
-    enamel *= 0.84 + 0.16 * sin(PI * w);
-    vec3 gums = vec3(0.55, 0.20, 0.21) * (0.9 + 0.2 * value_noise(v_uv * vec2(60.0, 8.0), 0));
-    vec3 albedo = mix(enamel * gap, gums, gum);
+    enamel *= mix(vec3(0.82, 0.86, 0.92), vec3(1.0), smoothstep(notch, notch + 0.09, max(h, lingual)));
+    enamel *= mix(vec3(1.0), vec3(1.0, 0.94, 0.83), smoothstep(0.3, gum_edge, h));
+    vec3 gums = vec3(0.62, 0.27, 0.28) * (0.92 + 0.16 * value_noise(v_uv * vec2(60.0, 8.0), 0));
+    vec3 albedo = mix(enamel * gap * convex, gums, gum);
     // Light inside the mouth falls off with depth: the front teeth catch it, the back ones sit
-    // in the shadow of the cheeks (the dark buccal corridor), and the lips shade the crowns'
-    // necks. The lower row sits under the upper teeth and the upper lip: a little darker.
-    float depth_shade = mix(1.0, 0.10, smoothstep(0.12, 0.36, arc));
-    float lip_shade = mix(1.0, 0.55, smoothstep(0.35, 0.95, h)) * mix(1.0, 0.8, lower);
+    // in the shadow of the cheeks (the dark buccal corridor). The upper lip casts a soft
+    // contact shadow just under its edge: v_occlusion is the fragment's height (dm) below
+    // that edge in this frame (facsim.head.mouth.mouth_light; 1 when nobody passes it). The
+    // lower row stands back under the upper teeth and lip and faces up into the mouth:
+    // darker, and mostly hidden.
+    float depth_shade = mix(1.0, 0.16, smoothstep(0.12, 0.36, arc));
+    float lip_shadow = mix(0.5, 1.0, smoothstep(-0.002, 0.022, v_occlusion));
+    float row_light = mix(1.0, 0.62, lower);
     // The inside of the arch faces the tongue and throat: it only catches light scattered in.
-    float mouth_shade = depth_shade * lip_shade * mix(1.0, 0.15, smoothstep(0.05, 0.45, lingual));
+    float mouth_shade = depth_shade * lip_shadow * row_light * mix(1.0, 0.12, smoothstep(0.0, 0.1, lingual));
     float wet = specular_light(n, v, 120.0).r * 0.35 + specular_light(n, v, 30.0).r * 0.05;
     vec3 spec = vec3(wet) * (1.0 - 0.6 * gum) * schlick(0.05, max(dot(n, v), 0.0)) * 3.0;
     // Enamel scatters light inside the tooth: a little of its own brightness beyond the lighting.
     radiance = ((diffuse_light(n, vec3(0.3, 0.25, 0.2), 1.0) * 0.9 + 0.16) * albedo + spec) * mouth_shade;
+    // What light reaches the back teeth has bounced off the cheeks' red lining: warm, not grey.
+    radiance *= mix(vec3(1.0, 0.6, 0.5), vec3(1.0), depth_shade);
 #endif
 
 #ifdef REGION_TONGUE
@@ -627,17 +642,24 @@ void main() {
     vec3 albedo = u_albedo * vec3(0.85, 0.72, 0.76) * papillae * groove;
     // The tongue lies in the shadow of the lips and upper teeth: dim at the tip, dark toward
     // the throat and at its sides against the teeth.
-    float mouth_shade = mix(0.55, 0.03, smoothstep(0.0, 0.22, along)) * mix(1.0, 0.5, smoothstep(0.4, 1.0, abs(across)));
-    vec3 spec = specular_light(n, v, 40.0) * 0.12 * papillae;
+    // How much light the parted lips let in arrives in occ (facsim.head.mouth.mouth_light).
+    float mouth_shade = mix(0.45, 0.05, smoothstep(0.0, 0.3, along)) * mix(1.0, 0.5, smoothstep(0.4, 1.0, abs(across)))
+                      * mix(0.1, 1.0, occ);
+    // Moist: a soft sheen broken by the papillae, and a tighter glint on the film of saliva.
+    vec3 spec = specular_light(n, v, 40.0) * 0.12 * papillae + specular_light(n, v, 90.0) * 0.3 * smoothstep(0.8, 1.1, papillae);
     radiance = (diffuse_light(n, vec3(0.3, 0.15, 0.1), 1.0) * 0.8 * albedo + spec) * mouth_shade;
 #endif
 
 #ifdef REGION_MOUTH_INTERIOR
     // Mostly hidden and in the mouth's own shadow: dim, dark red, a little wet; falls off with
-    // depth behind the lips (Face passes facsim.head.mouth.mouth_depth_visibility in occ).
-    float mouth_shade = mix(0.015, 1.0, occ * occ);
+    // depth behind the lips (Face passes facsim.head.mouth.mouth_depth_visibility in occ) to
+    // a warm, dull dark (light scattered through cheeks and lips), never black and never a
+    // saturated red (seen through the gaps between the teeth, red read as braces' bands).
+    float mouth_shade = occ * occ;
     vec3 spec = specular_light(n, v, 30.0) * 0.04;
-    radiance = (diffuse_light(n, vec3(0.3, 0.1, 0.1), 1.0) * u_albedo * 0.45 + spec) * mouth_shade;
+    vec3 deep = 0.12 * mix(vec3(dot(u_albedo, vec3(0.33))), u_albedo, 0.5);
+    radiance = (diffuse_light(n, vec3(0.3, 0.1, 0.1), 1.0) * u_albedo * 0.45 + spec) * mouth_shade
+             + deep * (1.0 - mouth_shade);
 #endif
 
 #ifdef REGION_LASHES
