@@ -102,13 +102,26 @@ class Face:
         return bind_character_proxies(self.character, self.head, self.base_positions, self.neutral)
 
     @cached_property
+    def scalp(self):
+        """The fine hair on the skin under the hair's cards (a ``"scalp"`` BoundProxy), or None."""
+        from facsim.head.proxies import bind_scalp
+
+        hair = [b for b in self.proxies if b.proxy.kind == "hair"]
+        return bind_scalp(hair[0], self.head, self.neutral) if hair else None
+
+    @property
+    def _drawn_proxies(self) -> list:
+        """What the renderer draws: the scalp layer first (under every card), then the proxies."""
+        return ([self.scalp] if self.scalp is not None else []) + list(self.proxies)
+
+    @cached_property
     def proxy_meshes(self) -> list:
         """What the renderer uploads of each proxy (:class:`facsim.render.proxies.ProxyMesh`), in draw order."""
         from facsim.render.proxies import ProxyMesh
 
         return [ProxyMesh(b.proxy.name, b.proxy.kind, b.proxy.triangles, b.proxy.corner_vertex, b.proxy.uv,
                           b.proxy.texture, b.depth, b.neutral if b.proxy.kind == "hair" else None)
-                for b in self.proxies]
+                for b in self._drawn_proxies]
 
     def proxy_draws(self, positions: np.ndarray) -> list:
         """This frame's :class:`facsim.render.proxies.ProxyDraw` s for geometry ``positions``."""
@@ -116,7 +129,7 @@ class Face:
 
         return [ProxyDraw(mesh, bound.binding.positions(positions), tuple(self.colors[bound.color_key]), bound.sheen,
                           bound.density, bound.coil)
-                for bound, mesh in zip(self.proxies, self.proxy_meshes)]
+                for bound, mesh in zip(self._drawn_proxies, self.proxy_meshes)]
 
     @cached_property
     def colors(self) -> dict:
@@ -168,10 +181,13 @@ class Face:
         occlusion[skin] *= 1.0 - CONTACT_DEPTH * contact_shadow(self.head.base_vertices[self.head.base_index[skin]])
         interior, visibility = mouth_depth_visibility(self.head, self.neutral)
         occlusion[interior] = visibility
+        cover = np.zeros(len(self.neutral), np.float32)  # the scalp's hair density per vertex
+        if self.scalp is not None:
+            cover[self.scalp.binding.ref[:, 0]] = self.scalp.shade
         for bound in self.proxies:
             if bound.proxy.kind == "hair":
                 hair = bound.binding.positions(self.neutral)
-                occlusion[skin] *= hair_shadow(self.neutral[skin], hair,
+                occlusion[skin] *= hair_shadow(self.neutral[skin], hair, cover=cover[skin],
                                                triangles=bound.proxy.corner_vertex[bound.proxy.triangles])
         return occlusion
 

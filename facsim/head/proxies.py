@@ -381,13 +381,17 @@ class BoundProxy:
     color_key: str  # "hair", "brows" or "lashes" in the character's colours
     density: float = 1.0  # brows and lashes: how much of the skin their hairs cover (0 … 1)
     neutral: np.ndarray | None = None  # (V, 3) positions on the neutral face
+    shade: np.ndarray | None = None  # (V,) the scalp layer's hair density (see :attr:`depth`)
 
     @cached_property
     def depth(self) -> np.ndarray:
         """(V,) per-vertex shading coordinate for the renderer. Hair: 0 under the other
         layers … 1 in the open (:func:`hair_exposure`, self-shadowing). Lashes: 0 at the
         lid … 1 at the tips (tapering). Brows:
-        0 at each brow's head … 1 at its tail (:func:`along_brow`), where the hairs thin."""
+        0 at each brow's head … 1 at its tail (:func:`along_brow`), where the hairs thin.
+        Scalp: the hair's density on the skin (:mod:`facsim.head.scalp`)."""
+        if self.shade is not None:
+            return np.asarray(self.shade, np.float32)
         if self.proxy.kind == "eyebrows" and self.neutral is not None:
             return along_brow(self.neutral)
         if self.proxy.kind == "hair" and self.neutral is not None:
@@ -436,6 +440,30 @@ def bind_character_proxies(character, head, base_positions, neutral_geometry, *,
     return out
 
 
+def bind_scalp(hair: BoundProxy, head, neutral_geometry: np.ndarray) -> BoundProxy | None:
+    """The fine hair growing on the skin under ``hair``'s cards (:mod:`facsim.head.scalp`),
+    bound to those skin vertices, or None where the style covers no skin."""
+    from facsim.head.scalp import LIFT, scalp_layer, strand_texture_png
+
+    geo = np.asarray(neutral_geometry, np.float32)
+    eyes = np.concatenate([np.asarray(v) for v in head.eye_vertices.values()])
+    corners = hair.binding.positions(geo)[hair.proxy.corner_vertex]  # cards split at their UV seams
+    layer = scalp_layer(head, geo, corners, hair.proxy.triangles, hair.proxy.uv, eye_y=float(geo[eyes, 1].mean()))
+    if layer is None:
+        return None
+    vertices, triangles, density, uv, normals = layer
+    k = len(vertices)
+    weights = np.zeros((k, 3), np.float32)
+    weights[:, 0] = 1.0
+    ref = np.repeat(vertices[:, None], 3, axis=1).astype(np.int64)
+    proxy = Proxy(name=f"{hair.proxy.name}-scalp", kind="scalp",
+                  ref=np.asarray(head.base_index)[ref], weights=weights, offsets=LIFT * normals,
+                  triangles=triangles, corner_vertex=np.arange(k, dtype=np.int32), uv=uv,
+                  png=strand_texture_png(), author="facsim", license="CC0")
+    binding = FrameBinding(ref=ref, weights=weights, offsets=(LIFT * normals).astype(np.float32))
+    return BoundProxy(proxy, binding, "hair", 1.0, binding.positions(geo), shade=density)
+
+
 def card_samples(points: np.ndarray, triangles: np.ndarray, *, k: int = 4) -> np.ndarray:
     """Points spread over the cards (a barycentric grid of ``k`` steps per triangle), so
     distances to the hair are distances to its cards, not to its sparse vertices (cards
@@ -480,7 +508,7 @@ def hair_exposure(points: np.ndarray, triangles: np.ndarray, *, reach: float = 0
 
 
 def hair_shadow(skin_positions: np.ndarray, hair_positions: np.ndarray, *, strength: float = 0.6,
-                cast: float = 0.7, triangles: np.ndarray | None = None) -> np.ndarray:
+                cast: float = 0.7, triangles: np.ndarray | None = None, cover: np.ndarray | None = None) -> np.ndarray:
     """Ambient visibility factor (1 open … 1 - strength) per skin vertex under the hair.
 
     Skin within a few millimetres of hair cards is shadowed by them: the scalp shows
@@ -488,6 +516,11 @@ def hair_shadow(skin_positions: np.ndarray, hair_positions: np.ndarray, *, stren
     contact shadow, hair that hangs over the skin toward the light (above and in front:
     a fringe, the hairline's edge) casts a soft shadow of up to ``cast`` a little way down
     the forehead and temples.
+
+    ``cover`` (N,), the scalp's hair density (:mod:`facsim.head.scalp`), limits the contact
+    shadow to skin the hair grows from: cards tucked close to bare skin (sideburn cards
+    inside the cheek, the cards' edge over a receding hairline) no longer stain it with a
+    dark, reddish patch that ends in a seam.
     """
     from scipy.spatial import cKDTree
 
@@ -498,7 +531,7 @@ def hair_shadow(skin_positions: np.ndarray, hair_positions: np.ndarray, *, stren
     # just their vertices, or it falls through the gaps between vertices in blotches.
     tree = cKDTree(hair_positions if triangles is None else card_samples(hair_positions, triangles))
     t = np.clip((distance - 0.04) / (0.22 - 0.04), 0.0, 1.0)
-    contact = 1.0 - strength * (1.0 - t * t * (3 - 2 * t))
+    contact = 1.0 - strength * (1.0 - t * t * (3 - 2 * t)) * (1.0 if cover is None else np.asarray(cover))
     # March toward a light above and in front of the face (the studio key, averaged over
     # left and right so the bake suits every view); count the steps that pass hair.
     toward = np.array([0.0, 0.75, 0.66]) / np.hypot(0.75, 0.66)

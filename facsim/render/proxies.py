@@ -27,7 +27,7 @@ from facsim.render.geometry import normal_operator, vertex_normals
 from facsim.render.gl import _set_uniform, _shader_source
 from facsim.render.inputs import srgb_to_linear
 
-PROXY_KINDS = ("hair", "eyebrows", "eyelashes")
+PROXY_KINDS = ("hair", "eyebrows", "eyelashes", "scalp")
 #: Alpha at and above which a fragment belongs to the opaque (alpha-tested) pass.
 ALPHA_CUTOFF = 0.5
 
@@ -39,7 +39,9 @@ class ProxyMesh:
     Parameters
     ----------
     name : str
-    kind : {"hair", "eyebrows", "eyelashes"}
+    kind : {"hair", "eyebrows", "eyelashes", "scalp"}
+        ``"scalp"``: the fine hair on the skin under a hairstyle (facsim.head.scalp), drawn
+        blended before every card, its texture a tile repeated along the strands.
     triangles : (T, 3) int
         Triangles over render corners.
     corner_vertex : (R,) int
@@ -51,6 +53,7 @@ class ProxyMesh:
         are used: the colour comes from :attr:`ProxyDraw.color`.
     depth : (V,) float, optional
         Hair: 0 under the other layers … 1 in the open, for self-shadowing (default 1).
+        Scalp: the hair's density on the skin (0 bare … 1 full cover).
     rest : (V, 3) float, optional
         Hair: vertex positions at rest (the neutral face). Which cards neighbour which is
         read from them once, so a frame's shading never depends on the frames before it.
@@ -342,8 +345,11 @@ class ProxyLayer:
         # layers then fail the depth test before they are shaded), back to front for blending.
         self._ibo = {"OPAQUE": track(ctx.buffer(self._triangles.tobytes(), dynamic=True)),
                      "BLEND": track(ctx.buffer(self._triangles.tobytes(), dynamic=True))}
-        tex = shade_texture(np.asarray(mesh.texture), directions=mesh.kind == "hair",
-                            strands_only=mesh.kind == "hair")
+        if mesh.kind == "scalp":  # made for the renderer already (facsim.head.scalp.strand_texture)
+            tex = np.ascontiguousarray(np.asarray(mesh.texture)[::-1])
+        else:
+            tex = shade_texture(np.asarray(mesh.texture), directions=mesh.kind == "hair",
+                                strands_only=mesh.kind == "hair")
         # Strand direction in UV: most styles' textures run along v throughout (their
         # root bands' cross-wise features would only mislead the texture's own direction
         # field); where they do not (a ponytail's radiating crown), the field steers the
@@ -359,6 +365,10 @@ class ProxyLayer:
         self.texture = track(ctx.texture((tex.shape[1], tex.shape[0]), 4, tex.tobytes()))
         self.texture.build_mipmaps()  # an input texture, never rendered into
         self.texture.filter = (ctx.LINEAR_MIPMAP_LINEAR, ctx.LINEAR)
+        self.texture.repeat_x = self.texture.repeat_y = mesh.kind == "scalp"
+        # The scalp layer lies on the skin, under every card: blended only, back faces culled.
+        self.has_opaque_pass = mesh.kind != "scalp"
+        self.culled = mesh.kind == "scalp"
         self.programs, self.vaos = {}, {}
         self._last = None  # (camera position, vertex positions) of the last upload
         self._smooth = None  # hair: neighbour-averaging operator over corners (from mesh.rest)

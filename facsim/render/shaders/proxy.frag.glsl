@@ -27,6 +27,42 @@ float strand_diffuse(vec3 t, vec3 l) {
 }
 
 
+#ifdef KIND_SCALP
+// The fine hair growing on the skin under a hairstyle's cards (facsim/head/scalp.py): drawn
+// blended over the skin before the cards, so the scalp between and beyond them is covered by
+// hair of the cards' colour, thinning over a centimetre at the hairline into single hairs with
+// the skin between them, instead of ending in a seam of bare, shadowed skin.
+// v_uv: strand coordinates in texture tiles (u across, v along the hair's flow); v_depth: the
+// hair's density there (0 bare ... 1 full cover). tex: R brightness, G each strand's rank, A cover.
+void main() {
+#ifdef PASS_OPAQUE
+    discard;
+#endif
+    vec4 tex = texture(u_texture, v_uv);
+    // Texels of the tile per pixel across the strands: above ~2 single hairs are finer than
+    // a pixel and only their mean cover can show.
+    float texels = fwidth(v_uv.x) * 256.0;
+    // An irregular hairline: the density wanders with clumps a few millimetres wide, so the
+    // edge of the cover is not the mesh's polygon.
+    float wander = value_noise(v_uv * vec2(5.0, 1.7) + 11.0, 0) - 0.5;
+    float dens = clamp(v_depth + 0.55 * wander * (1.0 - v_depth) * smoothstep(0.0, 0.25, v_depth), 0.0, 1.0);
+    float single = smoothstep(tex.g - 0.06, tex.g + 0.06, dens);
+    float keep = mix(single, dens, smoothstep(1.0, 3.0, texels));
+    float alpha = clamp(tex.a * 1.7, 0.0, 1.0) * keep * mix(0.65, 0.95, dens);
+    if (alpha < 0.01) discard;
+    vec3 n = normalize(v_normal);
+    vec3 t = normalize(v_tangent);
+    float kl = clamp(dot(n, u_key_dir) * 0.5 + 0.5, 0.0, 1.0);
+    float dk = mix(strand_diffuse(t, u_key_dir), 1.0, 0.3) * kl * kl * 1.25;
+    float df = clamp(dot(n, u_fill_dir) * 0.5 + 0.5, 0.0, 1.0);
+    vec3 lit = dk * u_key_col + df * u_fill_col + hemisphere(n) * 0.8;
+    // The roots under full cover lie in the cards' shadow; the hairline's fine hairs in the open.
+    float light_hair = sqrt(clamp(dot(u_color, vec3(0.2126, 0.7152, 0.0722)), 0.0, 1.0));
+    float shade = mix(1.0, mix(0.45, 0.75, light_hair), smoothstep(0.3, 1.0, v_depth));
+    vec3 albedo = u_color * (0.55 + 0.9 * tex.r) * shade;
+    f_color = vec4(finish(albedo * lit).rgb, alpha);
+}
+#else
 void main() {
     vec4 tex = texture(u_texture, v_uv);
     float alpha = tex.a;
@@ -182,3 +218,4 @@ void main() {
 #endif
     f_color = vec4(finish(radiance).rgb, alpha);
 }
+#endif

@@ -1,0 +1,235 @@
+"""The scalp's own hair: a fine layer on the skin under a hairstyle's cards.
+
+MakeHuman's hair is a few dozen textured cards floating a few millimetres over the scalp.
+Where they end (the hairline) or part, the skin between and beyond them showed bare and,
+shadowed by the cards, reddish: a seam around a painted helmet (issue 13: "a visible hairline
+seam on the old man"). Real hair grows out of the skin: from the hairline inward it thickens
+over a centimetre or so from single fine hairs to full cover, and the scalp only shows
+through where the hair is sparse.
+
+This module builds that layer as plain data for the renderer (one more proxy, kind
+``"scalp"``): the skin triangles under the hair, lifted a fraction of a millimetre, with
+
+- a **density** per vertex (0 bare … 1 full cover): 1 where cards lie over the skin within
+  a short reach, falling off smoothly past the cards' edge (:func:`scalp_density`);
+- **strand coordinates** as UVs, ``u`` across the strands and ``v`` along them, which follow
+  the direction the cards' own strands run (:func:`strand_coordinates`), so a tiling texture
+  of fine hairs (:func:`strand_texture`) lies along the hair's flow.
+
+The layer is bound to the skin vertices it covers, so it follows every frame exactly as the
+skin does (head motion, and the forehead under AU 1 and 2 carries the hairline's fine hairs).
+"""
+from __future__ import annotations
+
+import io
+from functools import lru_cache
+
+import numpy as np
+
+from facsim.head.surface import smoothstep, vertex_normals
+
+#: How far (dm) over the skin a card may lie and still count as growing from it.
+REACH = 0.12
+#: Distance (dm) from a ray to a card sample that counts as passing through the card.
+CARD_RADIUS = 0.035
+#: Width (dm) of the hairline's gradient from bare skin to full cover.
+HAIRLINE_WIDTH = 0.09
+#: Height (dm) of the layer over the skin: enough not to fight it in the depth buffer.
+LIFT = 0.004
+#: One texture tile's size (dm) across and along the strands.
+TILE = (0.15, 0.3)
+
+
+def hairline_height(normals: np.ndarray, eye_y: float) -> np.ndarray:
+    """(N,) height (dm) below which skin facing along ``normals`` grows no scalp hair.
+
+    ``hairline_above_eyes_mm`` in ``facsim/data/hair.yaml`` gives it over the forehead (skin
+    facing forward, +z), the temples (sideways, ±x) and the nape (backward); between them
+    it blends by the way the skin faces. Cards hanging over skin below it (a fringe over the
+    forehead, long hair beside the cheeks) do not grow from it.
+    """
+    from facsim.head.proxies import hair_table
+
+    table = hair_table()["scalp"]["hairline_above_eyes_mm"]
+    n = np.asarray(normals, np.float64)
+    w = np.stack([np.clip(n[:, 2], 0, None), np.abs(n[:, 0]), np.clip(-n[:, 2], 0, None)], axis=1) ** 2 + 1e-6
+    mm = (w @ np.array([table["front"], table["side"], table["back"]], np.float64)) / w.sum(axis=1)
+    return eye_y + 0.01 * mm
+
+
+def scalp_density(skin: np.ndarray, normals: np.ndarray, cards: np.ndarray, triangles: np.ndarray,
+                  *, floor_y=None) -> np.ndarray:
+    """(N,) hair density on the skin (0 bare … 1 full cover) under a hairstyle's cards.
+
+    A skin vertex is under the hair when its outward normal passes through a card within
+    :data:`REACH`. The cover is then averaged over :data:`HAIRLINE_WIDTH` along the skin,
+    so it thickens over that width from the cards' edge inward instead of stopping at it.
+
+    Parameters
+    ----------
+    skin : (N, 3) float
+        Skin vertices on the neutral face (dm).
+    normals : (N, 3) float
+        Their unit outward normals.
+    cards : (P, 3) float
+        Hair vertices; ``triangles`` (T, 3) index them.
+    floor_y : float or (N,) float, optional
+        Skin below this height is never scalp (:func:`hairline_height`).
+    """
+    from scipy.spatial import cKDTree
+
+    from facsim.head.proxies import card_samples
+
+    skin = np.asarray(skin, np.float64)
+    tree = cKDTree(card_samples(cards, triangles))
+    hits = np.zeros(len(skin))
+    for d in np.linspace(0.005, REACH, 8):
+        near = tree.query(skin + d * normals, k=1, distance_upper_bound=CARD_RADIUS)[0]
+        hits = np.maximum(hits, np.isfinite(near))
+    if floor_y is not None:
+        hits *= skin[:, 1] > floor_y
+    # Averaged over the skin within the hairline's width (Gaussian weights): 0.5 on the
+    # cards' edge, full a half-width inside it.
+    pairs = cKDTree(skin).query_pairs(HAIRLINE_WIDTH, output_type="ndarray")
+    i = np.concatenate([pairs[:, 0], pairs[:, 1], np.arange(len(skin))])
+    j = np.concatenate([pairs[:, 1], pairs[:, 0], np.arange(len(skin))])
+    w = np.exp(-np.sum((skin[i] - skin[j]) ** 2, axis=1) / (2.0 * (0.4 * HAIRLINE_WIDTH) ** 2))
+    mean = np.bincount(i, weights=w * hits[j], minlength=len(skin)) / np.bincount(i, weights=w, minlength=len(skin))
+    return smoothstep(0.12, 0.7, mean).astype(np.float32)
+
+
+def flow_directions(skin: np.ndarray, normals: np.ndarray, cards: np.ndarray, card_triangles: np.ndarray,
+                    card_uv: np.ndarray) -> np.ndarray:
+    """(N, 3) unit direction the hair runs over each skin vertex, in the skin's tangent plane.
+
+    Taken from the nearest card's strands (dP/dv: MakeHuman's hair textures run along v),
+    all pointing away from a point high over the crown (roots to tips), so neighbouring
+    directions agree and can be averaged.
+    """
+    from scipy.spatial import cKDTree
+
+    p = np.asarray(cards, np.float64)[card_triangles]
+    uv = np.asarray(card_uv, np.float64)[card_triangles]
+    e1, e2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+    d1, d2 = uv[:, 1] - uv[:, 0], uv[:, 2] - uv[:, 0]
+    det = d1[:, 0] * d2[:, 1] - d2[:, 0] * d1[:, 1]
+    det = np.where(np.abs(det) < 1e-12, 1e-12, det)
+    tv = (-d2[:, :1] * e1 + d1[:, :1] * e2) / det[:, None]
+    tv /= np.linalg.norm(tv, axis=1, keepdims=True) + 1e-12
+    centres = p.mean(axis=1)
+    above = centres.mean(axis=0) + np.array([0.0, 1.5, 0.0])
+    tv[np.einsum("ij,ij->i", tv, centres - above) < 0] *= -1
+    _, nearest = cKDTree(centres).query(skin, k=6)
+    t = tv[nearest].sum(axis=1)
+    t -= np.einsum("ij,ij->i", t, normals)[:, None] * normals
+    bad = np.linalg.norm(t, axis=1) < 1e-6  # no agreement: down the head, away from the crown
+    t[bad] = skin[bad] - above
+    t -= np.einsum("ij,ij->i", t, normals)[:, None] * normals
+    return (t / (np.linalg.norm(t, axis=1, keepdims=True) + 1e-12)).astype(np.float32)
+
+
+def strand_coordinates(points: np.ndarray, normals: np.ndarray, flow: np.ndarray,
+                       triangles: np.ndarray) -> np.ndarray:
+    """(N, 2) coordinates (dm) across and along the strands whose gradients best follow
+    ``flow`` (least squares over the mesh's edges, as a stripe pattern is fitted to a
+    direction field), so a texture tiled in them lies along the hair."""
+    from scipy.sparse import coo_matrix, vstack
+    from scipy.sparse.linalg import lsqr
+
+    n = len(points)
+    t = np.asarray(flow, np.float64)
+    b = np.cross(np.asarray(normals, np.float64), t)
+    edges = np.unique(np.sort(np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]]),
+                              axis=1), axis=0)
+    i, j = edges[:, 0], edges[:, 1]
+    e = np.asarray(points, np.float64)[j] - np.asarray(points, np.float64)[i]
+    rows = np.arange(len(edges))
+    d = coo_matrix((np.r_[-np.ones(len(edges)), np.ones(len(edges))], (np.r_[rows, rows], np.r_[i, j])),
+                   shape=(len(edges), n))
+    tie = coo_matrix((np.full(n, 1e-3), (np.arange(n), np.arange(n))), shape=(n, n))  # fixes the offsets
+    a = vstack([d, tie]).tocsr()
+    out = np.empty((n, 2), np.float32)
+    for k, axis in enumerate((b, t)):
+        target = np.einsum("ij,ij->i", e, 0.5 * (axis[i] + axis[j]))
+        out[:, k] = lsqr(a, np.r_[target, np.zeros(n)], atol=1e-8, btol=1e-8, iter_lim=4000)[0]
+    return out
+
+
+@lru_cache(maxsize=1)
+def strand_texture(size: int = 256, seed: int = 13) -> np.ndarray:
+    """(size, size, 4) uint8 RGBA tile of fine hairs running along v (image rows), periodic
+    in both directions: R brightness (0.5 = mean), G each strand's random rank (0 … 1; the
+    shader keeps the strands whose rank is under the local density, so a sparse hairline shows
+    single hairs), B unused, A coverage."""
+    rng = np.random.default_rng(seed)
+    fu = np.fft.fftfreq(size)[None, :]
+    fv = np.fft.fftfreq(size)[:, None]
+
+    def field(width_u: float, width_v: float) -> np.ndarray:
+        """Periodic Gaussian-filtered noise: ``width_*`` the correlation length in texels."""
+        noise = np.fft.fft2(rng.standard_normal((size, size)))
+        f = np.real(np.fft.ifft2(noise * np.exp(-2.0 * np.pi ** 2 * ((fu * width_u) ** 2 + (fv * width_v) ** 2))))
+        return (f - f.mean()) / (f.std() + 1e-12)
+
+    strands = field(1.2, 40.0)      # thin across, long along: single hairs
+    ends = field(6.0, 12.0)         # where strands stop and start
+    rank = field(2.0, 60.0)         # per-strand rank, constant along each hair
+    alpha = smoothstep(-0.2, 0.9, strands) * smoothstep(-1.6, -0.6, ends)
+    rank = 0.5 + 0.5 * np.tanh(0.9 * rank)
+    bright = 0.5 + 0.12 * np.tanh(field(1.5, 30.0))
+    out = np.empty((size, size, 4), np.uint8)
+    out[..., 0] = np.clip(bright * 255 + 0.5, 0, 255)
+    out[..., 1] = np.clip(rank * 255 + 0.5, 0, 255)
+    out[..., 2] = 128
+    out[..., 3] = np.clip(alpha * 255 + 0.5, 0, 255)
+    return out
+
+
+def strand_texture_png() -> bytes:
+    """:func:`strand_texture` as PNG bytes (how proxies carry their textures)."""
+    from PIL import Image
+
+    buf = io.BytesIO()
+    Image.fromarray(strand_texture(), "RGBA").save(buf, format="PNG")
+    return buf.getvalue()
+
+
+def scalp_layer(head, neutral_geometry: np.ndarray, cards: np.ndarray, card_triangles: np.ndarray,
+                card_uv: np.ndarray, *, eye_y: float):
+    """The scalp hair layer under a hairstyle, or None where the hair covers no skin.
+
+    ``eye_y`` is the height of the eyes' centres (the hairline is placed from it).
+
+    Returns
+    -------
+    vertices : (K,) int
+        Skin geometry vertices the layer covers (its vertex ``i`` lies over ``vertices[i]``).
+    triangles : (M, 3) int
+        Its triangles over those K vertices (the skin's own, outward wound as the skin).
+    density : (K,) float32
+        Hair density (0 … 1) per vertex.
+    uv : (K, 2) float32
+        Strand coordinates in texture tiles (:data:`TILE`).
+    normals : (K, 3) float32
+        The skin's outward normals there at neutral (the layer is lifted along them).
+    """
+    n_skin = head.skin_vertex_count
+    geo = np.asarray(neutral_geometry, np.float64)
+    tris = np.asarray(head.topology.geo_faces)
+    tris = tris[np.all(tris < n_skin, axis=1)]
+    skin = geo[:n_skin]
+    normals = vertex_normals(skin, tris).astype(np.float64)
+    if np.einsum("ij,ij->i", normals, skin - skin.mean(axis=0)).mean() < 0:  # wound inward: turn it
+        tris, normals = tris[:, ::-1], -normals
+    density = scalp_density(skin, normals, cards, card_triangles, floor_y=hairline_height(normals, eye_y))
+    keep = tris[(density[tris] > 0.0).any(axis=1)]
+    if not len(keep):
+        return None
+    vertices = np.unique(keep)
+    local = np.full(n_skin, -1, np.int64)
+    local[vertices] = np.arange(len(vertices))
+    triangles = local[keep]
+    flow = flow_directions(skin[vertices], normals[vertices], cards, card_triangles, card_uv)
+    uv = strand_coordinates(skin[vertices], normals[vertices], flow, triangles) / np.asarray(TILE, np.float32)
+    return vertices, triangles.astype(np.int32), density[vertices], uv.astype(np.float32), \
+        normals[vertices].astype(np.float32)
