@@ -120,16 +120,36 @@ class Face:
         from facsim.render.proxies import ProxyMesh
 
         return [ProxyMesh(b.proxy.name, b.proxy.kind, b.proxy.triangles, b.proxy.corner_vertex, b.proxy.uv,
-                          b.proxy.texture, b.depth, b.neutral if b.proxy.kind == "hair" else None)
+                          b.proxy.texture, b.depth, b.neutral if b.proxy.kind == "hair" else None,
+                          self._card_cover(b) if b.proxy.kind == "hair" else None)
                 for b in self._drawn_proxies]
+
+    def _card_cover(self, bound) -> np.ndarray | None:
+        """The scalp's hair density under ``bound``'s cards (:func:`facsim.head.scalp.card_cover`)."""
+        from facsim.head.scalp import card_cover
+
+        if self.scalp is None:
+            return None
+        density = np.zeros(self.head.skin_vertex_count, np.float32)
+        density[self.scalp.binding.ref[:, 0]] = self.scalp.shade
+        return card_cover(bound.neutral, self.neutral[: self.head.skin_vertex_count], density)
 
     def proxy_draws(self, positions: np.ndarray) -> list:
         """This frame's :class:`facsim.render.proxies.ProxyDraw` s for geometry ``positions``."""
         from facsim.render.proxies import ProxyDraw
 
+        pigment, white, grey = self._hair_greying
         return [ProxyDraw(mesh, bound.binding.positions(positions), tuple(self.colors[bound.color_key]), bound.sheen,
-                          bound.density, bound.coil)
+                          bound.density, bound.coil,
+                          *((pigment, white, grey) if bound.color_key == "hair" else (None, None, 0.0)))
                 for bound, mesh in zip(self._drawn_proxies, self.proxy_meshes)]
+
+    @cached_property
+    def _hair_greying(self) -> tuple:
+        """Greying scalp hair's strand colours (:func:`facsim.head.proxies.hair_greying`)."""
+        from facsim.head.proxies import hair_greying
+
+        return hair_greying(self.character, self.colors)
 
     @cached_property
     def colors(self) -> dict:

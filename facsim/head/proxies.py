@@ -410,15 +410,43 @@ class BoundProxy:
     @property
     def sheen(self) -> float:
         """Strength of the strand highlights (``sheen:`` in ``facsim/data/hair.yaml``, default 1)."""
-        return float(hair_table().get("sheen", {}).get(self.proxy.name, 1.0))
+        return float(hair_table().get("sheen", {}).get(self.style, 1.0))
 
     @property
     def coil(self) -> float:
         """How coily the hair is, 0 straight … 1 coily (``coil:`` in ``facsim/data/hair.yaml``, default 0)."""
-        return float(hair_table().get("coil", {}).get(self.proxy.name, 0.0))
+        return float(hair_table().get("coil", {}).get(self.style, 0.0))
+
+    @property
+    def style(self) -> str:
+        """The proxy's name; a scalp layer's is its hairstyle's (it is that hair's roots)."""
+        return self.proxy.name.removesuffix(SCALP_SUFFIX)
 
 
 COLOR_KEY = {"hair": "hair", "eyebrows": "brows", "eyelashes": "lashes"}
+#: A scalp layer's name is its hairstyle's with this suffix (:func:`bind_scalp`).
+SCALP_SUFFIX = "-scalp"
+
+
+def hair_greying(character, colors: dict) -> tuple[tuple, tuple, float]:
+    """(pigment, white, fraction): the sRGB colours of a greying character's pigmented and
+    white scalp hairs and the fraction of white ones, so greying hair is drawn as salt and
+    pepper (a grey cap of one flat colour reads as a cap, issue 13). ``colors["hair"]`` is
+    their mean (:func:`facsim.head.appearance.character_colors`: a linear mix of the young
+    colour and ``GREY_HAIR``); a character whose hair colour is set outright keeps it
+    (fraction 0)."""
+    from facsim.head.appearance import GREY_HAIR, character_colors
+    from facsim.head.colour import hex_to_rgb, linear_to_srgb, srgb_to_linear
+
+    young = character_colors(character.with_(age=min(character.age, 40.0)))["hair"]
+    mean, pigment = srgb_to_linear(colors["hair"]), srgb_to_linear(young)
+    white = srgb_to_linear(hex_to_rgb(GREY_HAIR))
+    # mean = (1 - f) pigment + f white: the fraction from the three channels (least squares).
+    span = white - pigment
+    f = float(np.clip(np.dot(mean - pigment, span) / max(float(np.dot(span, span)), 1e-9), 0.0, 1.0))
+    if f < 0.02:
+        return tuple(colors["hair"]), tuple(colors["hair"]), 0.0
+    return tuple(linear_to_srgb(pigment).tolist()), tuple(linear_to_srgb(white).tolist()), f
 
 
 def bind_character_proxies(character, head, base_positions, neutral_geometry, *, library=None) -> list[BoundProxy]:
@@ -456,7 +484,7 @@ def bind_scalp(hair: BoundProxy, head, neutral_geometry: np.ndarray) -> BoundPro
     weights = np.zeros((k, 3), np.float32)
     weights[:, 0] = 1.0
     ref = np.repeat(vertices[:, None], 3, axis=1).astype(np.int64)
-    proxy = Proxy(name=f"{hair.proxy.name}-scalp", kind="scalp",
+    proxy = Proxy(name=hair.proxy.name + SCALP_SUFFIX, kind="scalp",
                   ref=np.asarray(head.base_index)[ref], weights=weights, offsets=LIFT * normals,
                   triangles=triangles, corner_vertex=np.arange(k, dtype=np.int32), uv=uv,
                   png=strand_texture_png(), author="facsim", license="CC0")
@@ -531,7 +559,7 @@ def hair_shadow(skin_positions: np.ndarray, hair_positions: np.ndarray, *, stren
     # just their vertices, or it falls through the gaps between vertices in blotches.
     tree = cKDTree(hair_positions if triangles is None else card_samples(hair_positions, triangles))
     t = np.clip((distance - 0.04) / (0.22 - 0.04), 0.0, 1.0)
-    contact = 1.0 - strength * (1.0 - t * t * (3 - 2 * t)) * (1.0 if cover is None else np.asarray(cover))
+    contact = 1.0 - strength * (1.0 - t * t * (3 - 2 * t)) * (1.0 if cover is None else np.asarray(cover) ** 2)
     # March toward a light above and in front of the face (the studio key, averaged over
     # left and right so the bake suits every view); count the steps that pass hair.
     toward = np.array([0.0, 0.75, 0.66]) / np.hypot(0.75, 0.66)

@@ -33,11 +33,11 @@ REACH = 0.12
 #: Distance (dm) from a ray to a card sample that counts as passing through the card.
 CARD_RADIUS = 0.035
 #: Width (dm) of the hairline's gradient from bare skin to full cover.
-HAIRLINE_WIDTH = 0.09
+HAIRLINE_WIDTH = 0.06
 #: Height (dm) of the layer over the skin: enough not to fight it in the depth buffer.
 LIFT = 0.004
 #: One texture tile's size (dm) across and along the strands.
-TILE = (0.15, 0.3)
+TILE = (0.1, 0.2)
 
 
 def hairline_height(normals: np.ndarray, eye_y: float) -> np.ndarray:
@@ -95,7 +95,7 @@ def scalp_density(skin: np.ndarray, normals: np.ndarray, cards: np.ndarray, tria
     j = np.concatenate([pairs[:, 1], pairs[:, 0], np.arange(len(skin))])
     w = np.exp(-np.sum((skin[i] - skin[j]) ** 2, axis=1) / (2.0 * (0.4 * HAIRLINE_WIDTH) ** 2))
     mean = np.bincount(i, weights=w * hits[j], minlength=len(skin)) / np.bincount(i, weights=w, minlength=len(skin))
-    return smoothstep(0.12, 0.7, mean).astype(np.float32)
+    return smoothstep(0.2, 0.65, mean).astype(np.float32)
 
 
 def flow_directions(skin: np.ndarray, normals: np.ndarray, cards: np.ndarray, card_triangles: np.ndarray,
@@ -157,10 +157,14 @@ def strand_coordinates(points: np.ndarray, normals: np.ndarray, flow: np.ndarray
 
 @lru_cache(maxsize=1)
 def strand_texture(size: int = 256, seed: int = 13) -> np.ndarray:
-    """(size, size, 4) uint8 RGBA tile of fine hairs running along v (image rows), periodic
-    in both directions: R brightness (0.5 = mean), G each strand's random rank (0 … 1; the
-    shader keeps the strands whose rank is under the local density, so a sparse hairline shows
-    single hairs), B unused, A coverage."""
+    """(size, size, 4) uint8 RGBA tile of fine hair running along v (image rows), periodic
+    in both directions.
+
+    R: brightness (0.5 = mean). G: rank (0 … 1, uniform) of small tufts a fraction of a
+    millimetre wide and several long; the shader keeps the tufts whose rank is under the
+    local density, so a thinning hairline breaks into separate tufts and single hairs rather
+    than fading like a film. B: unused. A: the hairs' cover inside a tuft.
+    """
     rng = np.random.default_rng(seed)
     fu = np.fft.fftfreq(size)[None, :]
     fv = np.fft.fftfreq(size)[:, None]
@@ -171,15 +175,15 @@ def strand_texture(size: int = 256, seed: int = 13) -> np.ndarray:
         f = np.real(np.fft.ifft2(noise * np.exp(-2.0 * np.pi ** 2 * ((fu * width_u) ** 2 + (fv * width_v) ** 2))))
         return (f - f.mean()) / (f.std() + 1e-12)
 
-    strands = field(1.2, 40.0)      # thin across, long along: single hairs
-    ends = field(6.0, 12.0)         # where strands stop and start
-    rank = field(2.0, 60.0)         # per-strand rank, constant along each hair
-    alpha = smoothstep(-0.2, 0.9, strands) * smoothstep(-1.6, -0.6, ends)
-    rank = 0.5 + 0.5 * np.tanh(0.9 * rank)
-    bright = 0.5 + 0.12 * np.tanh(field(1.5, 30.0))
+    tufts = field(16.0, 50.0)  # about 0.6 mm across, 4 mm along (TILE)
+    rank = np.empty(size * size)
+    rank[np.argsort(tufts, axis=None)] = np.linspace(0.0, 1.0, size * size)  # uniform ranks
+    strands = field(1.5, 20.0)
+    alpha = 0.6 + 0.4 * smoothstep(-0.8, 0.6, strands)
+    bright = 0.5 + 0.2 * np.tanh(field(6.0, 60.0)) + 0.08 * np.tanh(field(1.5, 20.0))  # streaks along the flow
     out = np.empty((size, size, 4), np.uint8)
     out[..., 0] = np.clip(bright * 255 + 0.5, 0, 255)
-    out[..., 1] = np.clip(rank * 255 + 0.5, 0, 255)
+    out[..., 1] = np.clip(rank.reshape(size, size) * 255 + 0.5, 0, 255)
     out[..., 2] = 128
     out[..., 3] = np.clip(alpha * 255 + 0.5, 0, 255)
     return out
@@ -233,3 +237,26 @@ def scalp_layer(head, neutral_geometry: np.ndarray, cards: np.ndarray, card_tria
     uv = strand_coordinates(skin[vertices], normals[vertices], flow, triangles) / np.asarray(TILE, np.float32)
     return vertices, triangles.astype(np.int32), density[vertices], uv.astype(np.float32), \
         normals[vertices].astype(np.float32)
+
+
+def card_cover(cards: np.ndarray, skin: np.ndarray, density: np.ndarray, *, reach: float = 0.06) -> np.ndarray:
+    """(V,) the scalp's hair density under each card vertex, for the cards to thin with it.
+
+    Cards within ``reach`` of the skin over a thinning hairline (0 < density < 1) take its
+    density, so they break up into strands there and fade into the scalp layer's fine hairs;
+    cards away from the skin, over full cover or over bare skin the scalp layer leaves alone
+    (a fringe over the forehead) keep 1.
+
+    Parameters
+    ----------
+    cards : (V, 3) float
+        Hair vertices on the neutral face.
+    skin, density : (N, 3), (N,) float
+        Skin vertices and the scalp's hair density there (0 where none grows).
+    """
+    from scipy.spatial import cKDTree
+
+    distance, nearest = cKDTree(np.asarray(skin, np.float64)).query(np.asarray(cards, np.float64))
+    d = np.asarray(density, np.float64)[nearest]
+    thinning = (1.0 - d) * smoothstep(0.0, 0.15, d) * smoothstep(reach, 0.5 * reach, distance)
+    return (1.0 - thinning).astype(np.float32)

@@ -58,6 +58,10 @@ class ProxyMesh:
         Hair: vertex positions at rest (the neutral face). Which cards neighbour which is
         read from them once, so a frame's shading never depends on the frames before it.
         Without them strand directions are not averaged across cards.
+    cover : (V,) float, optional
+        Hair: the scalp's hair density under each vertex (1 full … 0 bare; default 1).
+        Cards over a thinning hairline break up into strands, so they fade into the scalp
+        layer's fine hairs instead of ending in a cut edge.
     """
 
     name: str
@@ -68,6 +72,7 @@ class ProxyMesh:
     texture: np.ndarray
     depth: np.ndarray | None = None
     rest: np.ndarray | None = None
+    cover: np.ndarray | None = None
 
     def __post_init__(self):
         if self.kind not in PROXY_KINDS:
@@ -88,7 +93,8 @@ class ProxyDraw:
     """One proxy in one frame: its mesh, vertex positions (V, 3), sRGB colour, sheen
     (strength of the strand highlights: 1 for straight hair, less for coily hair),
     density (brows and lashes: how much of the skin their hairs cover, 0 … 1) and coil
-    (hair: 0 straight … 1 coily, which shows fine even curls instead of strands and clumps)."""
+    (hair: 0 straight … 1 coily, which shows fine even curls instead of strands and clumps),
+    and for greying hair its strands' two colours and the fraction of white ones."""
 
     mesh: ProxyMesh
     positions: np.ndarray
@@ -96,6 +102,12 @@ class ProxyDraw:
     sheen: float = 1.0
     density: float = 1.0
     coil: float = 0.0
+    #: Greying hair (hair and scalp): the sRGB colours of its pigmented and white strands and
+    #: the fraction of white ones; ``color`` is their mean. Drawn strand by strand (salt and
+    #: pepper) where strands are resolved, as their mean where they are finer than a pixel.
+    pigment: tuple[float, float, float] | None = None
+    white: tuple[float, float, float] | None = None
+    grey: float = 0.0
 
 
 def shade_texture(texture: np.ndarray, *, directions: bool = False, strands_only: bool = False) -> np.ndarray:
@@ -340,7 +352,9 @@ class ProxyLayer:
         self._buffer[:, 10] = (card_outline(np.asarray(mesh.corner_vertex)[self._triangles])[mesh.corner_vertex]
                                if mesh.kind == "hair" else 0.0)
         self._vbo = track(ctx.buffer(reserve=self._buffer.nbytes, dynamic=True))
-        self._uv = track(ctx.buffer(np.ascontiguousarray(mesh.uv, np.float32).tobytes()))
+        cover = np.ones(mesh.vertex_count, np.float32) if mesh.cover is None else np.asarray(mesh.cover, np.float32)
+        static = np.column_stack([np.asarray(mesh.uv, np.float32), cover[mesh.corner_vertex]])
+        self._uv = track(ctx.buffer(np.ascontiguousarray(static, np.float32).tobytes()))
         # Two orders of the same triangles: front to back for the alpha-tested pass (hidden
         # layers then fail the depth test before they are shaded), back to front for blending.
         self._ibo = {"OPAQUE": track(ctx.buffer(self._triangles.tobytes(), dynamic=True)),
@@ -387,11 +401,11 @@ class ProxyLayer:
             self.programs[stage] = prog
             self.vaos[stage] = track(ctx.vertex_array(
                 prog, [(self._vbo, "3f 3f 3f 1f 1f", "in_pos", "in_normal", "in_tangent", "in_depth", "in_edge"),
-                       (self._uv, "2f", "in_uv")],
+                       (self._uv, "2f 1f", "in_uv", "in_cover")],
                 index_buffer=self._ibo[stage], index_element_size=4, skip_errors=True))
         self.vaos["SUBSET"] = track(ctx.vertex_array(
             self.programs["OPAQUE"], [(self._vbo, "3f 3f 3f 1f 1f", "in_pos", "in_normal", "in_tangent", "in_depth", "in_edge"),
-                                      (self._uv, "2f", "in_uv")],
+                                      (self._uv, "2f 1f", "in_uv", "in_cover")],
             index_buffer=self._ibo["SUBSET"], index_element_size=4, skip_errors=True))
 
     def update(self, draw: ProxyDraw, camera_position: np.ndarray) -> None:
@@ -402,7 +416,10 @@ class ProxyLayer:
                              f"got {positions.shape}")
         camera_position = np.asarray(camera_position, np.float32)
         color = tuple(float(x) for x in srgb_to_linear(draw.color))
-        look = (color, float(draw.sheen), float(draw.density), float(draw.coil))
+        grey = float(draw.grey) if draw.pigment is not None and draw.white is not None else 0.0
+        pigment = tuple(float(x) for x in srgb_to_linear(draw.pigment)) if grey > 0 else color
+        white = tuple(float(x) for x in srgb_to_linear(draw.white)) if grey > 0 else color
+        look = (color, float(draw.sheen), float(draw.density), float(draw.coil), pigment, white, grey)
         if self.look != look:
             self.look = look
             for prog in self.programs.values():
@@ -410,6 +427,9 @@ class ProxyLayer:
                 _set_uniform(prog, "u_sheen", look[1])
                 _set_uniform(prog, "u_density", look[2])
                 _set_uniform(prog, "u_coil", look[3])
+                _set_uniform(prog, "u_pigment", pigment)
+                _set_uniform(prog, "u_white", white)
+                _set_uniform(prog, "u_grey", grey)
         # Hair mostly sits still (only 51-58 and the brow skin move it): skip the upload and
         # the sort when nothing moved since the last frame.
         if (self._last is not None and np.array_equal(self._last[0], camera_position)

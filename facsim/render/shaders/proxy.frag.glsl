@@ -10,6 +10,7 @@ in vec3 v_tangent;
 in float v_depth;
 in float v_edge;
 in vec2 v_uv;
+in float v_cover;
 
 uniform sampler2D u_texture;  // R: strand brightness (0.5 = mean), GB: strand direction in UV, A: coverage
 uniform vec3 u_color;         // linear RGB
@@ -17,8 +18,21 @@ uniform float u_along_v;      // 1: the texture's strands run along v everywhere
 uniform float u_sheen;        // strand highlight strength (1 straight hair, less for coily)
 uniform float u_density;      // brows and lashes: how much of the skin their hairs cover
 uniform float u_coil;         // hair: 0 straight ... 1 coily
+uniform vec3 u_pigment;       // greying hair: its pigmented strands' colour (linear RGB) ...
+uniform vec3 u_white;         // ... its white strands' ...
+uniform float u_grey;         // ... and the fraction of white strands (u_color is their mean)
 
 out vec4 f_color;
+
+// Greying hair: the fraction of white strands wanders from clump to clump (clump: clump
+// coordinates), so grey hair shows darker and lighter locks, salt and pepper at the scale
+// of clumps, rather than one flat grey; where clumps are finer than a pixel, the mean colour.
+vec3 hair_colour(vec2 clump) {
+    if (u_grey <= 0.0) return u_color;
+    float local = clamp(u_grey + 0.6 * (value_noise(clump, 0) - 0.5), 0.0, 1.0);
+    vec3 c = mix(u_pigment, u_white, local);
+    return mix(c, u_color, clamp(0.5 * max(fwidth(clump.x), fwidth(clump.y)) - 0.25, 0.0, 1.0));
+}
 
 // Kajiya-Kay: light scattered by a thin cylinder along t.
 float strand_diffuse(vec3 t, vec3 l) {
@@ -38,17 +52,19 @@ void main() {
 #ifdef PASS_OPAQUE
     discard;
 #endif
-    vec4 tex = texture(u_texture, v_uv);
-    // Texels of the tile per pixel across the strands: above ~2 single hairs are finer than
-    // a pixel and only their mean cover can show.
-    float texels = fwidth(v_uv.x) * 256.0;
-    // An irregular hairline: the density wanders with clumps a few millimetres wide, so the
-    // edge of the cover is not the mesh's polygon.
-    float wander = value_noise(v_uv * vec2(5.0, 1.7) + 11.0, 0) - 0.5;
-    float dens = clamp(v_depth + 0.55 * wander * (1.0 - v_depth) * smoothstep(0.0, 0.25, v_depth), 0.0, 1.0);
-    float single = smoothstep(tex.g - 0.06, tex.g + 0.06, dens);
-    float keep = mix(single, dens, smoothstep(1.0, 3.0, texels));
-    float alpha = clamp(tex.a * 1.7, 0.0, 1.0) * keep * mix(0.65, 0.95, dens);
+    // Coily hair grows in small round curls, not long strands: the tile's tufts squashed round.
+    vec2 suv = u_coil > 0.5 ? v_uv * vec2(2.0, 6.0) : v_uv;
+    vec4 tex = texture(u_texture, suv);
+    // Tufts (tex.g: their rank) are kept where their rank is under the density: a thinning
+    // hairline breaks into separate tufts and single hairs. Their edges soften where a tuft
+    // nears a pixel across (the rank's screen-space change), never alias.
+    float w = 0.04 + 1.5 * fwidth(tex.g);
+    float dens = v_depth * 1.08 - 0.04;
+    float keep = smoothstep(tex.g - w, tex.g + w, dens);
+    // Tufts finer than a pixel (texels of the tile per pixel across the strands) show only
+    // as their mean cover.
+    keep = mix(keep, clamp(dens, 0.0, 1.0), smoothstep(16.0, 40.0, fwidth(suv.x) * 256.0));
+    float alpha = tex.a * keep * 0.92;
     if (alpha < 0.01) discard;
     vec3 n = normalize(v_normal);
     vec3 t = normalize(v_tangent);
@@ -59,7 +75,13 @@ void main() {
     // The roots under full cover lie in the cards' shadow; the hairline's fine hairs in the open.
     float light_hair = sqrt(clamp(dot(u_color, vec3(0.2126, 0.7152, 0.0722)), 0.0, 1.0));
     float shade = mix(1.0, mix(0.45, 0.75, light_hair), smoothstep(0.3, 1.0, v_depth));
-    vec3 albedo = u_color * (0.55 + 0.9 * tex.r) * shade;
+    float curl = 1.0;
+    if (u_coil > 0.5) {  // and each curl shows its own light and shade
+        vec2 kp = suv * 600.0;
+        curl = 0.55 + 0.9 * mix(0.5, value_noise(kp, 0), clamp(1.8 - 1.4 * fwidth(kp.x), 0.0, 1.0));
+        alpha *= curl * 0.9;
+    }
+    vec3 albedo = hair_colour(suv * vec2(8.0, 2.0)) * (0.55 + 0.9 * tex.r) * shade * curl;
     f_color = vec4(finish(albedo * lit).rgb, alpha);
 }
 #else
@@ -100,7 +122,7 @@ void main() {
 #ifdef PASS_OPAQUE
     if (alpha < ALPHA_CUTOFF) discard;
 #else
-    if (alpha < 0.02 || (alpha >= ALPHA_CUTOFF && v_edge < 0.1 && dot(n, v) >= 0.28)) discard;
+    if (alpha < 0.02 || (alpha >= ALPHA_CUTOFF && v_edge < 0.1 && v_cover > 0.999 && dot(n, v) >= 0.28)) discard;
 #endif
     // Strand coordinates: across the strands (u) many, along them (v) few. Each noise fades
     // to its mean where it would be finer than a pixel, so small images do not shimmer.
@@ -125,6 +147,11 @@ void main() {
     float fray = outline * (1.0 - strand_mask) * 0.9;
     fray = 1.0 - (1.0 - fray) * (1.0 - smoothstep(0.45, 0.75, v_edge + 0.7 * (0.5 - rag)));
     alpha *= 1.0 - fray * (1.0 - u_coil);
+    // Over a thinning hairline (v_cover < 1, see facsim/head/scalp.py) the cards break up into
+    // strands and clumps, fewer the thinner the cover, so they fade into the scalp's fine hairs.
+    // Coily hair thins in round curls, not in strands along the card.
+    float thin_at = u_coil > 0.5 ? value_noise(v_uv * 90.0 + 3.0, 0) : rag;
+    alpha *= smoothstep(thin_at - 0.2, thin_at + 0.2, 1.3 * v_cover - 0.15);
 #endif
 #ifdef PASS_OPAQUE
     if (alpha < ALPHA_CUTOFF) discard;
@@ -157,12 +184,17 @@ void main() {
     if (u_coil > 0.0) {
         // Coily hair: at any distance its curls blend into a fine, even, matte texture; the
         // texture's tufts keep a little of their contrast, fine isotropic curls add the rest.
+        // (The texture's own tufts are mirrored from card to card; at full contrast their
+        // repeats drew a tiled pattern on the cap, so they keep less of it, and curls a few
+        // millimetres across break it up.)
         vec2 kp = v_uv * 300.0;
         float kink = mix(0.5, value_noise(kp, 0), clamp(1.8 - 1.4 * fwidth(kp.x), 0.0, 1.0));
-        strand = mix(strand, (0.6 + 0.8 * tex.r) * (0.62 + 0.76 * kink), u_coil);
+        vec2 lp = v_uv * 70.0 + 5.0;
+        float lock = mix(0.5, value_noise(lp, 0), clamp(1.8 - 1.4 * fwidth(lp.x), 0.0, 1.0));
+        strand = mix(strand, (0.75 + 0.5 * tex.r) * (0.62 + 0.76 * kink) * (0.7 + 0.6 * lock), u_coil);
     }
 #endif
-    albedo = u_color * strand;
+    albedo = hair_colour(u_coil > 0.5 ? v_uv * 40.0 : v_uv * vec2(45.0, 1.2) + 7.0) * strand;
     // Depth in the volume: layers near the scalp lie under the outer ones and get little
     // light (roots and the under-layers darker), the gaps between clumps are darker still.
     // Light hair (blond, grey) scatters light on through the strands, so its inner layers
