@@ -179,7 +179,9 @@ void main() {
     // Strand-scale brightness: the texture's own strands (tex.r: its painted light removed,
     // see shade_texture) and three scales of procedural strands, so neighbouring strands and
     // clumps differ the way real hair does, the same on every card.
-    float strand = (0.45 + 1.1 * tex.r) * (0.7 + 0.6 * fine) * (0.78 + 0.44 * mid) * (0.86 + 0.28 * clump);
+    // (The texture's strands and the widest scale stop at each card's edge: on long01's crown,
+    // at full strength they drew the rows of cards, so they keep less weight.)
+    float strand = (0.62 + 0.76 * tex.r) * (0.7 + 0.6 * fine) * (0.76 + 0.48 * mid) * (0.92 + 0.16 * clump);
 #ifdef PASS_OPAQUE
     if (u_coil > 0.0) {
         // Coily hair: at any distance its curls blend into a fine, even, matte texture; the
