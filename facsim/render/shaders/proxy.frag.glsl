@@ -59,7 +59,10 @@ void main() {
     // hairline breaks into separate tufts and single hairs. Their edges soften where a tuft
     // nears a pixel across (the rank's screen-space change), never alias.
     float w = 0.04 + 1.5 * fwidth(tex.g);
-    float dens = v_depth * 1.08 - 0.04;
+    // The hairline wanders by a few millimetres (clumps grow forward, gaps recede), so its
+    // tufts do not line up along the mesh's edge like teeth.
+    float wander = value_noise(v_uv * vec2(2.5, 0.8) + 11.0, 0) - 0.5;
+    float dens = v_depth * 1.08 - 0.04 + 2.2 * wander * v_depth * (1.0 - v_depth);
     float keep = smoothstep(tex.g - w, tex.g + w, dens);
     // Tufts finer than a pixel (texels of the tile per pixel across the strands) show only
     // as their mean cover.
