@@ -476,7 +476,8 @@ def bind_scalp(hair: BoundProxy, head, neutral_geometry: np.ndarray) -> BoundPro
     geo = np.asarray(neutral_geometry, np.float32)
     eyes = np.concatenate([np.asarray(v) for v in head.eye_vertices.values()])
     corners = hair.binding.positions(geo)[hair.proxy.corner_vertex]  # cards split at their UV seams
-    layer = scalp_layer(head, geo, corners, hair.proxy.triangles, hair.proxy.uv, eye_y=float(geo[eyes, 1].mean()))
+    layer = scalp_layer(head, geo, corners, hair.proxy.triangles, hair.proxy.uv, eye_y=float(geo[eyes, 1].mean()),
+                        eye_z=float(geo[eyes, 2].mean()))
     if layer is None:
         return None
     vertices, triangles, density, uv, normals = layer

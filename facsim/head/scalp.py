@@ -40,12 +40,13 @@ LIFT = 0.004
 TILE = (0.1, 0.2)
 
 
-def hairline_height(normals: np.ndarray, eye_y: float) -> np.ndarray:
-    """(N,) height (dm) below which skin facing along ``normals`` grows no scalp hair.
+def hairline_height(normals: np.ndarray, skin_z: np.ndarray, eye_y: float, eye_z: float) -> np.ndarray:
+    """(N,) height (dm) below which skin facing along ``normals`` (at depths ``skin_z``)
+    grows no scalp hair.
 
     ``hairline_above_eyes_mm`` in ``facsim/data/hair.yaml`` gives it over the forehead (skin
-    facing forward, +z), the temples (sideways, ±x) and the nape (backward); between them
-    it blends by the way the skin faces. Cards hanging over skin below it (a fringe over the
+    facing forward, +z), the temples (sideways, ±x, near the eyes), the sideburns (sideways,
+    near the ears) and the nape (backward); between them it blends by the way the skin faces. Cards hanging over skin below it (a fringe over the
     forehead, long hair beside the cheeks) do not grow from it.
     """
     from facsim.head.proxies import hair_table
@@ -53,7 +54,9 @@ def hairline_height(normals: np.ndarray, eye_y: float) -> np.ndarray:
     table = hair_table()["scalp"]["hairline_above_eyes_mm"]
     n = np.asarray(normals, np.float64)
     w = np.stack([np.clip(n[:, 2], 0, None), np.abs(n[:, 0]), np.clip(-n[:, 2], 0, None)], axis=1) ** 2 + 1e-6
-    mm = (w @ np.array([table["front"], table["side"], table["back"]], np.float64)) / w.sum(axis=1)
+    # Skin facing sideways is temple near the eyes and sideburn near the ear.
+    side = np.interp(np.asarray(skin_z, np.float64), (eye_z - 0.8, eye_z - 0.45), (table["sideburn"], table["temple"]))
+    mm = (w[:, 0] * table["front"] + w[:, 1] * side + w[:, 2] * table["back"]) / w.sum(axis=1)
     return eye_y + 0.01 * mm
 
 
@@ -99,13 +102,17 @@ def scalp_density(skin: np.ndarray, normals: np.ndarray, cards: np.ndarray, tria
 
 
 def flow_directions(skin: np.ndarray, normals: np.ndarray, cards: np.ndarray, card_triangles: np.ndarray,
-                    card_uv: np.ndarray) -> np.ndarray:
+                    card_uv: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     """(N, 3) unit direction the hair runs over each skin vertex, in the skin's tangent plane.
 
-    Taken from the nearest card's strands (dP/dv: MakeHuman's hair textures run along v),
-    all pointing away from a point high over the crown (roots to tips), so neighbouring
-    directions agree and can be averaged.
+    Taken from the nearest cards' strands (dP/dv: MakeHuman's hair textures run along v)
+    as an axis, not an arrow (the cards' v runs either way), averaged with the neighbours
+    (``triangles`` over the N vertices) and then given one sense by walking the mesh, each
+    vertex agreeing with the one it was reached from: strand coordinates need directions
+    that agree locally, whichever way the hair is combed.
     """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import breadth_first_order, connected_components
     from scipy.spatial import cKDTree
 
     p = np.asarray(cards, np.float64)[card_triangles]
@@ -116,15 +123,26 @@ def flow_directions(skin: np.ndarray, normals: np.ndarray, cards: np.ndarray, ca
     det = np.where(np.abs(det) < 1e-12, 1e-12, det)
     tv = (-d2[:, :1] * e1 + d1[:, :1] * e2) / det[:, None]
     tv /= np.linalg.norm(tv, axis=1, keepdims=True) + 1e-12
-    centres = p.mean(axis=1)
-    above = centres.mean(axis=0) + np.array([0.0, 1.5, 0.0])
-    tv[np.einsum("ij,ij->i", tv, centres - above) < 0] *= -1
-    _, nearest = cKDTree(centres).query(skin, k=6)
-    t = tv[nearest].sum(axis=1)
-    t -= np.einsum("ij,ij->i", t, normals)[:, None] * normals
-    bad = np.linalg.norm(t, axis=1) < 1e-6  # no agreement: down the head, away from the crown
-    t[bad] = skin[bad] - above
-    t -= np.einsum("ij,ij->i", t, normals)[:, None] * normals
+    _, nearest = cKDTree(p.mean(axis=1)).query(skin, k=6)
+    tensor = np.einsum("nki,nkj->nij", tv[nearest], tv[nearest])       # axes, sign-free
+    n = len(skin)
+    edges = np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]])
+    adjacency = coo_matrix((np.ones(2 * len(edges)), (np.r_[edges[:, 0], edges[:, 1]], np.r_[edges[:, 1], edges[:, 0]])),
+                           shape=(n, n)).tocsr()
+    adjacency.data[:] = 1.0
+    for _ in range(2):  # a little smoothing along the skin
+        tensor = tensor + (adjacency @ tensor.reshape(n, 9)).reshape(n, 3, 3) * 0.5
+    proj = np.eye(3)[None] - np.einsum("ni,nj->nij", normals, normals)
+    tensor = proj @ tensor @ proj
+    t = np.linalg.eigh(tensor)[1][:, :, -1]                             # the principal axis
+    # One sense: walk each connected piece of the layer, agreeing with the predecessor.
+    _, piece = connected_components(adjacency, directed=False)
+    for k in np.unique(piece):
+        seed = int(np.flatnonzero(piece == k)[0])
+        order, parent = breadth_first_order(adjacency, seed, directed=False, return_predecessors=True)
+        for v in order[1:]:
+            if np.dot(t[v], t[parent[v]]) < 0:
+                t[v] = -t[v]
     return (t / (np.linalg.norm(t, axis=1, keepdims=True) + 1e-12)).astype(np.float32)
 
 
@@ -199,10 +217,10 @@ def strand_texture_png() -> bytes:
 
 
 def scalp_layer(head, neutral_geometry: np.ndarray, cards: np.ndarray, card_triangles: np.ndarray,
-                card_uv: np.ndarray, *, eye_y: float):
+                card_uv: np.ndarray, *, eye_y: float, eye_z: float):
     """The scalp hair layer under a hairstyle, or None where the hair covers no skin.
 
-    ``eye_y`` is the height of the eyes' centres (the hairline is placed from it).
+    ``eye_y``, ``eye_z``: the eyes' centres' height and depth (the hairline is placed from them).
 
     Returns
     -------
@@ -225,7 +243,7 @@ def scalp_layer(head, neutral_geometry: np.ndarray, cards: np.ndarray, card_tria
     normals = vertex_normals(skin, tris).astype(np.float64)
     if np.einsum("ij,ij->i", normals, skin - skin.mean(axis=0)).mean() < 0:  # wound inward: turn it
         tris, normals = tris[:, ::-1], -normals
-    density = scalp_density(skin, normals, cards, card_triangles, floor_y=hairline_height(normals, eye_y))
+    density = scalp_density(skin, normals, cards, card_triangles, floor_y=hairline_height(normals, skin[:, 2], eye_y, eye_z))
     keep = tris[(density[tris] > 0.0).any(axis=1)]
     if not len(keep):
         return None
@@ -233,7 +251,7 @@ def scalp_layer(head, neutral_geometry: np.ndarray, cards: np.ndarray, card_tria
     local = np.full(n_skin, -1, np.int64)
     local[vertices] = np.arange(len(vertices))
     triangles = local[keep]
-    flow = flow_directions(skin[vertices], normals[vertices], cards, card_triangles, card_uv)
+    flow = flow_directions(skin[vertices], normals[vertices], cards, card_triangles, card_uv, triangles)
     uv = strand_coordinates(skin[vertices], normals[vertices], flow, triangles) / np.asarray(TILE, np.float32)
     return vertices, triangles.astype(np.int32), density[vertices], uv.astype(np.float32), \
         normals[vertices].astype(np.float32)

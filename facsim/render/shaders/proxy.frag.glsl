@@ -62,7 +62,7 @@ void main() {
     // The hairline wanders by a few millimetres (clumps grow forward, gaps recede), so its
     // tufts do not line up along the mesh's edge like teeth.
     float wander = value_noise(v_uv * vec2(2.5, 0.8) + 11.0, 0) - 0.5;
-    float dens = v_depth * 1.08 - 0.04 + 2.2 * wander * v_depth * (1.0 - v_depth);
+    float dens = v_depth * 1.08 - 0.04 + 1.3 * wander * v_depth * (1.0 - v_depth);
     float keep = smoothstep(tex.g - w, tex.g + w, dens);
     // Tufts finer than a pixel (texels of the tile per pixel across the strands) show only
     // as their mean cover.
@@ -77,7 +77,7 @@ void main() {
     vec3 lit = dk * u_key_col + df * u_fill_col + hemisphere(n) * 0.8;
     // The roots under full cover lie in the cards' shadow; the hairline's fine hairs in the open.
     float light_hair = sqrt(clamp(dot(u_color, vec3(0.2126, 0.7152, 0.0722)), 0.0, 1.0));
-    float shade = mix(1.0, mix(0.45, 0.75, light_hair), smoothstep(0.3, 1.0, v_depth));
+    float shade = mix(0.9, mix(0.35, 0.7, light_hair), smoothstep(0.3, 1.0, v_depth));
     float curl = 1.0;
     if (u_coil > 0.5) {  // and each curl shows its own light and shade
         vec2 kp = suv * 600.0;
