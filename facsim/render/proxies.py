@@ -353,7 +353,13 @@ class ProxyLayer:
                                if mesh.kind == "hair" else 0.0)
         self._vbo = track(ctx.buffer(reserve=self._buffer.nbytes, dynamic=True))
         cover = np.ones(mesh.vertex_count, np.float32) if mesh.cover is None else np.asarray(mesh.cover, np.float32)
-        static = np.column_stack([np.asarray(mesh.uv, np.float32), cover[mesh.corner_vertex]])
+        # Where each corner was on the neutral face: coily hair's curls are placed in this space
+        # (isotropic, so any orientation will do), running on across the cards' edges and the
+        # texture's mirrored layout, and moving with the hair.
+        rest = (np.zeros((mesh.vertex_count, 3), np.float32) if mesh.rest is None
+                else np.asarray(mesh.rest, np.float32))
+        static = np.column_stack([np.asarray(mesh.uv, np.float32), cover[mesh.corner_vertex],
+                                  rest[mesh.corner_vertex]])
         self._uv = track(ctx.buffer(np.ascontiguousarray(static, np.float32).tobytes()))
         # Two orders of the same triangles: front to back for the alpha-tested pass (hidden
         # layers then fail the depth test before they are shaded), back to front for blending.
@@ -401,11 +407,11 @@ class ProxyLayer:
             self.programs[stage] = prog
             self.vaos[stage] = track(ctx.vertex_array(
                 prog, [(self._vbo, "3f 3f 3f 1f 1f", "in_pos", "in_normal", "in_tangent", "in_depth", "in_edge"),
-                       (self._uv, "2f 1f", "in_uv", "in_cover")],
+                       (self._uv, "2f 1f 3f", "in_uv", "in_cover", "in_rest")],
                 index_buffer=self._ibo[stage], index_element_size=4, skip_errors=True))
         self.vaos["SUBSET"] = track(ctx.vertex_array(
             self.programs["OPAQUE"], [(self._vbo, "3f 3f 3f 1f 1f", "in_pos", "in_normal", "in_tangent", "in_depth", "in_edge"),
-                                      (self._uv, "2f 1f", "in_uv", "in_cover")],
+                                      (self._uv, "2f 1f 3f", "in_uv", "in_cover", "in_rest")],
             index_buffer=self._ibo["SUBSET"], index_element_size=4, skip_errors=True))
 
     def update(self, draw: ProxyDraw, camera_position: np.ndarray) -> None:

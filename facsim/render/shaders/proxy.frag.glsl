@@ -11,6 +11,7 @@ in float v_depth;
 in float v_edge;
 in vec2 v_uv;
 in float v_cover;
+in vec3 v_rest;
 
 uniform sampler2D u_texture;  // R: strand brightness (0.5 = mean), GB: strand direction in UV, A: coverage
 uniform vec3 u_color;         // linear RGB
@@ -32,6 +33,21 @@ vec3 hair_colour(vec2 clump) {
     float local = clamp(u_grey + 0.6 * (value_noise(clump, 0) - 0.5), 0.0, 1.0);
     vec3 c = mix(u_pigment, u_white, local);
     return mix(c, u_color, clamp(0.5 * max(fwidth(clump.x), fwidth(clump.y)) - 0.25, 0.0, 1.0));
+}
+
+// Value noise in 3D, [0, 1], faded to its mean where its cells are finer than a pixel.
+float value_noise3(vec3 p) {
+    vec3 i = floor(p);
+    vec3 f = p - i;
+    vec3 u = f * f * (3.0 - 2.0 * f);
+    ivec3 c = ivec3(i);
+    int z0 = 7919 * c.z, z1 = 7919 * (c.z + 1);
+    float a = mix(mix(hash2(ivec2(c.x, c.y + z0)), hash2(ivec2(c.x + 1, c.y + z0)), u.x),
+                  mix(hash2(ivec2(c.x, c.y + 1 + z0)), hash2(ivec2(c.x + 1, c.y + 1 + z0)), u.x), u.y);
+    float b = mix(mix(hash2(ivec2(c.x, c.y + z1)), hash2(ivec2(c.x + 1, c.y + z1)), u.x),
+                  mix(hash2(ivec2(c.x, c.y + 1 + z1)), hash2(ivec2(c.x + 1, c.y + 1 + z1)), u.x), u.y);
+    float n = mix(a, b, u.z);
+    return mix(0.5, n, clamp(2.0 - 1.4 * length(fwidth(p)), 0.0, 1.0));
 }
 
 // Kajiya-Kay: light scattered by a thin cylinder along t.
@@ -150,6 +166,12 @@ void main() {
     float fray = outline * (1.0 - strand_mask) * 0.9;
     fray = 1.0 - (1.0 - fray) * (1.0 - smoothstep(0.45, 0.75, v_edge + 0.7 * (0.5 - rag)));
     alpha *= 1.0 - fray * (1.0 - u_coil);
+    if (u_coil > 0.0) {
+        // Coily hair's outline breaks up in curls (placed on the neutral face, see below):
+        // the volume's edge is a halo of curls with the background between them, not a rim.
+        float halo = value_noise3(v_rest * 70.0 + 2.0);
+        alpha *= 1.0 - u_coil * outline * (1.0 - smoothstep(0.35, 0.65, halo)) * 0.95;
+    }
     // Over a thinning hairline (v_cover < 1, see facsim/head/scalp.py) the cards break up into
     // strands and clumps, fewer the thinner the cover, so they fade into the scalp's fine hairs.
     // Coily hair thins in round curls, not in strands along the card.
@@ -192,11 +214,12 @@ void main() {
         // (The texture's own tufts are mirrored from card to card; at full contrast their
         // repeats drew a tiled pattern on the cap, so they keep less of it, and curls a few
         // millimetres across break it up.)
-        vec2 kp = v_uv * 300.0;
-        float kink = mix(0.5, value_noise(kp, 0), clamp(1.8 - 1.4 * fwidth(kp.x), 0.0, 1.0));
-        vec2 lp = v_uv * 70.0 + 5.0;
-        float lock = mix(0.5, value_noise(lp, 0), clamp(1.8 - 1.4 * fwidth(lp.x), 0.0, 1.0));
-        strand = mix(strand, (0.75 + 0.5 * tex.r) * (0.62 + 0.76 * kink) * (0.7 + 0.6 * lock), u_coil);
+        // Curls a millimetre and a few millimetres across, placed on the neutral face (v_rest),
+        // not in the cards' UVs: the texture is laid out mirrored from card to card, and its
+        // tufts at full contrast drew that tiling on the cap (ngozi's grey afro read as a cap).
+        float kink = value_noise3(v_rest * 110.0);
+        float curls = value_noise3(v_rest * 35.0 + 5.0);
+        strand = mix(strand, (0.82 + 0.36 * tex.r) * (0.6 + 0.8 * kink) * (0.62 + 0.76 * curls), u_coil);
     }
 #endif
     albedo = hair_colour(u_coil > 0.5 ? v_uv * 40.0 : v_uv * vec2(45.0, 1.2) + 7.0) * strand;
