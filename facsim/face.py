@@ -121,7 +121,7 @@ class Face:
 
         return [ProxyMesh(b.proxy.name, b.proxy.kind, b.proxy.triangles, b.proxy.corner_vertex, b.proxy.uv,
                           b.proxy.texture, b.depth, b.neutral if b.proxy.kind == "hair" else None,
-                          self._card_cover(b) if b.proxy.kind == "hair" else None)
+                          self._card_cover(b) if b.proxy.kind == "hair" else None, b.coil > 0.0)
                 for b in self._drawn_proxies]
 
     def _card_cover(self, bound) -> np.ndarray | None:

@@ -62,6 +62,9 @@ class ProxyMesh:
         Hair: the scalp's hair density under each vertex (1 full … 0 bare; default 1).
         Cards over a thinning hairline break up into strands, so they fade into the scalp
         layer's fine hairs instead of ending in a cut edge.
+    coily : bool
+        Hair and scalp: drawn with the coily-hair shader variant (curls instead of strands;
+        :attr:`ProxyDraw.coil` sets how strongly).
     """
 
     name: str
@@ -73,6 +76,7 @@ class ProxyMesh:
     depth: np.ndarray | None = None
     rest: np.ndarray | None = None
     cover: np.ndarray | None = None
+    coily: bool = False
 
     def __post_init__(self):
         if self.kind not in PROXY_KINDS:
@@ -399,7 +403,8 @@ class ProxyLayer:
         # A subset of the triangles (front to back) for callers that keep part of the pass as pixels.
         self._ibo["SUBSET"] = track(ctx.buffer(reserve=max(self._triangles.nbytes, 12), dynamic=True))
         for stage in ("OPAQUE", "BLEND"):
-            defines = {f"PASS_{stage}": "", f"KIND_{mesh.kind.upper()}": "", "ALPHA_CUTOFF": f"{ALPHA_CUTOFF:.3f}"}
+            defines = {f"PASS_{stage}": "", f"KIND_{mesh.kind.upper()}": "", "ALPHA_CUTOFF": f"{ALPHA_CUTOFF:.3f}",
+                       **({"COILY": ""} if mesh.coily else {})}
             prog = track(ctx.program(vertex_shader=_shader_source("proxy.vert.glsl", defines),
                                      fragment_shader=_shader_source("proxy.frag.glsl", defines)))
             _set_uniform(prog, "u_texture", 1)

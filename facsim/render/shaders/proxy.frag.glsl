@@ -1,6 +1,7 @@
 // Proxy fragment shader: hair, eyebrow and eyelash cards cut out by their texture's alpha.
 // Variants (#defines from facsim/render/proxies.py): PASS_OPAQUE (alpha-tested, writes depth) or
-// PASS_BLEND (the soft fringe, blended back to front); KIND_HAIR, KIND_EYEBROWS, KIND_EYELASHES.
+// PASS_BLEND (the soft fringe, blended back to front); KIND_HAIR, KIND_EYEBROWS, KIND_EYELASHES,
+// KIND_SCALP; COILY for coily hair (its curls cost llvmpipe time even where a uniform skips them).
 
 #include "common.glsl"
 
@@ -69,7 +70,11 @@ void main() {
     discard;
 #endif
     // Coily hair grows in small round curls, not long strands: the tile's tufts squashed round.
-    vec2 suv = u_coil > 0.5 ? v_uv * vec2(2.0, 6.0) : v_uv;
+#ifdef COILY
+    vec2 suv = v_uv * vec2(2.0, 6.0);
+#else
+    vec2 suv = v_uv;
+#endif
     vec4 tex = texture(u_texture, suv);
     // Tufts (tex.g: their rank) are kept where their rank is under the density: a thinning
     // hairline breaks into separate tufts and single hairs. Their edges soften where a tuft
@@ -95,11 +100,13 @@ void main() {
     float light_hair = sqrt(clamp(dot(u_color, vec3(0.2126, 0.7152, 0.0722)), 0.0, 1.0));
     float shade = mix(0.9, mix(0.35, 0.7, light_hair), smoothstep(0.3, 1.0, v_depth));
     float curl = 1.0;
-    if (u_coil > 0.5) {  // and each curl shows its own light and shade
+#ifdef COILY
+    {  // and each curl shows its own light and shade
         vec2 kp = suv * 600.0;
         curl = 0.55 + 0.9 * mix(0.5, value_noise(kp, 0), clamp(1.8 - 1.4 * fwidth(kp.x), 0.0, 1.0));
         alpha *= curl * 0.9;
     }
+#endif
     vec3 albedo = hair_colour(suv * vec2(8.0, 2.0)) * (0.55 + 0.9 * tex.r) * shade * curl;
     f_color = vec4(finish(albedo * lit).rgb, alpha);
 }
@@ -166,16 +173,22 @@ void main() {
     float fray = outline * (1.0 - strand_mask) * 0.9;
     fray = 1.0 - (1.0 - fray) * (1.0 - smoothstep(0.45, 0.75, v_edge + 0.7 * (0.5 - rag)));
     alpha *= 1.0 - fray * (1.0 - u_coil);
-    if (u_coil > 0.0) {
+#ifdef COILY
+    {
         // Coily hair's outline breaks up in curls (placed on the neutral face, see below):
         // the volume's edge is a halo of curls with the background between them, not a rim.
         float halo = value_noise3(v_rest * 70.0 + 2.0);
         alpha *= 1.0 - u_coil * outline * (1.0 - smoothstep(0.35, 0.65, halo)) * 0.95;
     }
+#endif
     // Over a thinning hairline (v_cover < 1, see facsim/head/scalp.py) the cards break up into
     // strands and clumps, fewer the thinner the cover, so they fade into the scalp's fine hairs.
     // Coily hair thins in round curls, not in strands along the card.
-    float thin_at = u_coil > 0.5 ? value_noise(v_uv * 90.0 + 3.0, 0) : rag;
+#ifdef COILY
+    float thin_at = value_noise(v_uv * 90.0 + 3.0, 0);
+#else
+    float thin_at = rag;
+#endif
     alpha *= smoothstep(thin_at - 0.2, thin_at + 0.2, 1.3 * v_cover - 0.15);
 #endif
 #ifdef PASS_OPAQUE
@@ -208,21 +221,24 @@ void main() {
     // at full strength they drew the rows of cards, so they keep less weight.)
     float strand = (0.62 + 0.76 * tex.r) * (0.7 + 0.6 * fine) * (0.76 + 0.48 * mid) * (0.92 + 0.16 * clump);
 #ifdef PASS_OPAQUE
-    if (u_coil > 0.0) {
-        // Coily hair: at any distance its curls blend into a fine, even, matte texture; the
-        // texture's tufts keep a little of their contrast, fine isotropic curls add the rest.
-        // (The texture's own tufts are mirrored from card to card; at full contrast their
-        // repeats drew a tiled pattern on the cap, so they keep less of it, and curls a few
-        // millimetres across break it up.)
-        // Curls a millimetre and a few millimetres across, placed on the neutral face (v_rest),
-        // not in the cards' UVs: the texture is laid out mirrored from card to card, and its
-        // tufts at full contrast drew that tiling on the cap (ngozi's grey afro read as a cap).
+#ifdef COILY
+    {
+        // Coily hair: at any distance its curls blend into a fine, even, matte texture. The
+        // texture's tufts keep a little of their contrast (it is laid out mirrored from card
+        // to card, and at full contrast drew that tiling on the cap: ngozi's grey afro read as
+        // a cap); curls a millimetre and a few millimetres across, placed on the neutral face
+        // (v_rest) rather than in the cards' UVs, add the rest.
         float kink = value_noise3(v_rest * 110.0);
         float curls = value_noise3(v_rest * 35.0 + 5.0);
         strand = mix(strand, (0.82 + 0.36 * tex.r) * (0.6 + 0.8 * kink) * (0.62 + 0.76 * curls), u_coil);
     }
 #endif
-    albedo = hair_colour(u_coil > 0.5 ? v_uv * 40.0 : v_uv * vec2(45.0, 1.2) + 7.0) * strand;
+#endif
+#ifdef COILY
+    albedo = hair_colour(v_uv * 40.0) * strand;
+#else
+    albedo = hair_colour(v_uv * vec2(45.0, 1.2) + 7.0) * strand;
+#endif
     // Depth in the volume: layers near the scalp lie under the outer ones and get little
     // light (roots and the under-layers darker), the gaps between clumps are darker still.
     // Light hair (blond, grey) scatters light on through the strands, so its inner layers
