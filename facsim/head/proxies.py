@@ -536,6 +536,10 @@ def hair_exposure(points: np.ndarray, triangles: np.ndarray, *, reach: float = 0
     return np.clip(1.0 - blocked / 2.5, 0.0, 1.0).astype(np.float32)
 
 
+#: Height (dm) over the skin from which hair casts a shadow (:func:`hair_shadow`).
+CAST_MIN_HEIGHT = 0.08
+
+
 def hair_shadow(skin_positions: np.ndarray, hair_positions: np.ndarray, *, strength: float = 0.6,
                 cast: float = 0.7, triangles: np.ndarray | None = None, cover: np.ndarray | None = None) -> np.ndarray:
     """Ambient visibility factor (1 open … 1 - strength) per skin vertex under the hair.
@@ -558,7 +562,13 @@ def hair_shadow(skin_positions: np.ndarray, hair_positions: np.ndarray, *, stren
     distance = cKDTree(hair_positions).query(skin_positions, k=4)[0].mean(axis=1)
     # The cast shadow needs the cards' surfaces (``triangles`` over ``hair_positions``), not
     # just their vertices, or it falls through the gaps between vertices in blotches.
-    tree = cKDTree(hair_positions if triangles is None else card_samples(hair_positions, triangles))
+    samples = hair_positions if triangles is None else card_samples(hair_positions, triangles)
+    # Only hair standing off the skin casts a shadow beyond its contact shadow (a fringe over
+    # the forehead). Cards lying on the skin (temples, sideburns) would otherwise shadow the
+    # cheeks below them in a dark patch down to the jaw, through the head they lie on.
+    skin_tree = cKDTree(skin_positions)
+    off_skin = skin_tree.query(samples)[0] > CAST_MIN_HEIGHT
+    tree = cKDTree(samples[off_skin] if off_skin.any() else samples[:1] + 1e3)
     t = np.clip((distance - 0.04) / (0.22 - 0.04), 0.0, 1.0)
     contact = 1.0 - strength * (1.0 - t * t * (3 - 2 * t)) * (1.0 if cover is None else np.asarray(cover) ** 2)
     # March toward a light above and in front of the face (the studio key, averaged over
@@ -570,8 +580,12 @@ def hair_shadow(skin_positions: np.ndarray, hair_positions: np.ndarray, *, stren
     # the last step's reach are left out of the search: the inf they give counts as open).
     marched = distance < steps[-1] + 0.2
     for step in steps if cast > 0 else ():
-        near, _ = tree.query(skin_positions[marched] + step * toward, k=1, distance_upper_bound=0.12)
-        blocked[marched] += smoothstep(0.12, 0.05, near)
+        point = skin_positions[marched] + step * toward
+        near, _ = tree.query(point, k=1, distance_upper_bound=0.12)
+        # Steps that run along the skin (up a cheek or temple) are in the head's own shade,
+        # not the hair's: only steps out in the open count.
+        open_air = smoothstep(0.02, 0.06, skin_tree.query(point, distance_upper_bound=0.06)[0])
+        blocked[marched] += smoothstep(0.12, 0.05, near) * open_air
     shadow = 1.0 - cast * np.clip(blocked / 2.5, 0.0, 1.0)
     return np.minimum(contact, shadow).astype(np.float32)
 
