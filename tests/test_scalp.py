@@ -119,3 +119,14 @@ def test_greying_hair_is_drawn_as_pigmented_and_white_strands(face_of):
     from facsim.head.appearance import character_colors
 
     assert proxies.hair_greying(dyed, character_colors(dyed))[2] == 0.0
+
+
+def test_hair_lying_on_the_skin_casts_no_shadow_down_the_cheeks(face_of):
+    face = face_of("george")  # short04: its side cards lie on the temples, down to the cheeks
+    hair = next(b for b in face.proxies if b.proxy.kind == "hair")
+    skin = face.neutral[: face.head.skin_vertex_count]
+    cards = hair.binding.positions(face.neutral)
+    cast = proxies.hair_shadow(skin, cards, triangles=hair.proxy.corner_vertex[hair.proxy.triangles], strength=0.0)
+    eyes = np.concatenate([np.asarray(v) for v in face.head.eye_vertices.values()])
+    cheeks = skin[:, 1] < face.neutral[eyes, 1].mean() - 0.2
+    assert (cast[cheeks] < 0.9).mean() < 0.01
