@@ -130,9 +130,16 @@ class Face:
 
         if self.scalp is None:
             return None
-        density = np.zeros(self.head.skin_vertex_count, np.float32)
-        density[self.scalp.binding.ref[:, 0]] = self.scalp.shade
-        return card_cover(bound.neutral, self.neutral[: self.head.skin_vertex_count], density)
+        skin = self.head.skin_vertex_count
+        return card_cover(bound.neutral, self.neutral[:skin], self._scalp_density[:skin])
+
+    @cached_property
+    def _scalp_density(self) -> np.ndarray:
+        """(geometry vertices,) the scalp's hair density (0 where none grows)."""
+        density = np.zeros(len(self.neutral), np.float32)
+        if self.scalp is not None:
+            density[self.scalp.binding.ref[:, 0]] = self.scalp.shade
+        return density
 
     def proxy_draws(self, positions: np.ndarray) -> list:
         """This frame's :class:`facsim.render.proxies.ProxyDraw` s for geometry ``positions``."""
@@ -201,9 +208,7 @@ class Face:
         occlusion[skin] *= 1.0 - CONTACT_DEPTH * contact_shadow(self.head.base_vertices[self.head.base_index[skin]])
         interior, visibility = mouth_depth_visibility(self.head, self.neutral)
         occlusion[interior] = visibility
-        cover = np.zeros(len(self.neutral), np.float32)  # the scalp's hair density per vertex
-        if self.scalp is not None:
-            cover[self.scalp.binding.ref[:, 0]] = self.scalp.shade
+        cover = self._scalp_density
         for bound in self.proxies:
             if bound.proxy.kind == "hair":
                 hair = bound.binding.positions(self.neutral)

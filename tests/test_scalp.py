@@ -18,7 +18,7 @@ def _grid(n=12, size=0.6, width=None):
 
 
 def test_density_is_full_under_the_cards_and_thins_past_their_edge():
-    skin, tris = _grid(25)
+    skin, _ = _grid(25)
     normals = np.tile([0.0, 0.0, 1.0], (len(skin), 1))
     # a card 5 mm over the left half of the patch (quads of 2 cm, as MakeHuman's)
     card, card_tris = _grid(31, 0.6, width=0.3)

@@ -480,17 +480,17 @@ def bind_scalp(hair: BoundProxy, head, neutral_geometry: np.ndarray) -> BoundPro
                         eye_z=float(geo[eyes, 2].mean()))
     if layer is None:
         return None
-    vertices, triangles, density, uv, normals = layer
+    vertices, normals = layer.vertices, layer.normals
     k = len(vertices)
     weights = np.zeros((k, 3), np.float32)
     weights[:, 0] = 1.0
     ref = np.repeat(vertices[:, None], 3, axis=1).astype(np.int64)
     proxy = Proxy(name=hair.proxy.name + SCALP_SUFFIX, kind="scalp",
                   ref=np.asarray(head.base_index)[ref], weights=weights, offsets=LIFT * normals,
-                  triangles=triangles, corner_vertex=np.arange(k, dtype=np.int32), uv=uv,
+                  triangles=layer.triangles, corner_vertex=np.arange(k, dtype=np.int32), uv=layer.uv,
                   png=strand_texture_png(), author="facsim", license="CC0")
     binding = FrameBinding(ref=ref, weights=weights, offsets=(LIFT * normals).astype(np.float32))
-    return BoundProxy(proxy, binding, "hair", 1.0, binding.positions(geo), shade=density)
+    return BoundProxy(proxy, binding, "hair", 1.0, binding.positions(geo), shade=layer.density)
 
 
 def card_samples(points: np.ndarray, triangles: np.ndarray, *, k: int = 4) -> np.ndarray:

@@ -22,6 +22,7 @@ skin does (head motion, and the forehead under AU 1 and 2 carries the hairline's
 from __future__ import annotations
 
 import io
+from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
@@ -216,24 +217,37 @@ def strand_texture_png() -> bytes:
     return buf.getvalue()
 
 
-def scalp_layer(head, neutral_geometry: np.ndarray, cards: np.ndarray, card_triangles: np.ndarray,
-                card_uv: np.ndarray, *, eye_y: float, eye_z: float):
-    """The scalp hair layer under a hairstyle, or None where the hair covers no skin.
+@dataclass(frozen=True, eq=False)
+class ScalpLayer:
+    """The scalp hair under a hairstyle (:func:`scalp_layer`).
 
-    ``eye_y``, ``eye_z``: the eyes' centres' height and depth (the hairline is placed from them).
-
-    Returns
-    -------
+    Attributes
+    ----------
     vertices : (K,) int
         Skin geometry vertices the layer covers (its vertex ``i`` lies over ``vertices[i]``).
-    triangles : (M, 3) int
-        Its triangles over those K vertices (the skin's own, outward wound as the skin).
+    triangles : (M, 3) int32
+        Its triangles over those K vertices (the skin's own, wound outward).
     density : (K,) float32
-        Hair density (0 … 1) per vertex.
+        Hair density (0 bare … 1 full cover) per vertex.
     uv : (K, 2) float32
-        Strand coordinates in texture tiles (:data:`TILE`).
+        Strand coordinates in texture tiles (:data:`TILE`): u across the strands, v along.
     normals : (K, 3) float32
         The skin's outward normals there at neutral (the layer is lifted along them).
+    """
+
+    vertices: np.ndarray
+    triangles: np.ndarray
+    density: np.ndarray
+    uv: np.ndarray
+    normals: np.ndarray
+
+
+def scalp_layer(head, neutral_geometry: np.ndarray, cards: np.ndarray, card_triangles: np.ndarray,
+                card_uv: np.ndarray, *, eye_y: float, eye_z: float) -> ScalpLayer | None:
+    """The scalp hair layer under a hairstyle's cards (``cards`` (P, 3) on the neutral face,
+    ``card_triangles`` over them, ``card_uv`` (P, 2)), or None where they cover no skin.
+
+    ``eye_y``, ``eye_z``: the eyes' centres' height and depth (the hairline is placed from them).
     """
     n_skin = head.skin_vertex_count
     geo = np.asarray(neutral_geometry, np.float64)
@@ -253,8 +267,8 @@ def scalp_layer(head, neutral_geometry: np.ndarray, cards: np.ndarray, card_tria
     triangles = local[keep]
     flow = flow_directions(skin[vertices], normals[vertices], cards, card_triangles, card_uv, triangles)
     uv = strand_coordinates(skin[vertices], normals[vertices], flow, triangles) / np.asarray(TILE, np.float32)
-    return vertices, triangles.astype(np.int32), density[vertices], uv.astype(np.float32), \
-        normals[vertices].astype(np.float32)
+    return ScalpLayer(vertices=vertices, triangles=triangles.astype(np.int32), density=density[vertices],
+                      uv=uv.astype(np.float32), normals=normals[vertices].astype(np.float32))
 
 
 def card_cover(cards: np.ndarray, skin: np.ndarray, density: np.ndarray, *, reach: float = 0.06) -> np.ndarray:
