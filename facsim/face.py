@@ -104,10 +104,20 @@ class Face:
     @cached_property
     def scalp(self):
         """The fine hair on the skin under the hair's cards (a ``"scalp"`` BoundProxy), or None."""
-        from facsim.head.proxies import bind_scalp
+        import hashlib
+
+        from facsim.head.assets import cache_dir
+        from facsim.head.proxies import bind_scalp, hair_table
+        from facsim.head.scalp import VERSION
 
         hair = [b for b in self.proxies if b.proxy.kind == "hair"]
-        return bind_scalp(hair[0], self.head, self.neutral) if hair else None
+        if not hair:
+            return None
+        # Cached on disk like the occlusion bake: by the head's shape, the style and its table.
+        shape = self.character.with_(name="", description="", colors={}, hair="", brows="", lashes="")
+        key = hashlib.sha256(repr((VERSION, shape, hair[0].proxy.name, hair_table().get("scalp")))
+                             .encode()).hexdigest()[:16]
+        return bind_scalp(hair[0], self.head, self.neutral, cache=cache_dir() / "scalp" / f"{key}.npy")
 
     @property
     def _drawn_proxies(self) -> list:

@@ -106,6 +106,8 @@ class Proxy:
         The RGBA texture as stored in the package.
     author, license : str
         From the asset's own metadata.
+    image : (H, W, 4) uint8, optional
+        The texture itself, for proxies facsim makes (the scalp layer) rather than reads.
     """
 
     name: str
@@ -119,6 +121,7 @@ class Proxy:
     png: bytes
     author: str
     license: str
+    image: np.ndarray | None = None
 
     @property
     def vertex_count(self) -> int:
@@ -127,6 +130,8 @@ class Proxy:
     @cached_property
     def texture(self) -> np.ndarray:
         """(H, W, 4) uint8 RGBA, row 0 at the top (image order)."""
+        if self.image is not None:
+            return self.image
         from PIL import Image
 
         return np.asarray(Image.open(io.BytesIO(self.png)).convert("RGBA")).copy()
@@ -468,18 +473,27 @@ def bind_character_proxies(character, head, base_positions, neutral_geometry, *,
     return out
 
 
-def bind_scalp(hair: BoundProxy, head, neutral_geometry: np.ndarray) -> BoundProxy | None:
+def bind_scalp(hair: BoundProxy, head, neutral_geometry: np.ndarray, *, cache: Path | None = None) -> BoundProxy | None:
     """The fine hair growing on the skin under ``hair``'s cards (:mod:`facsim.head.scalp`),
-    bound to those skin vertices, or None where the style covers no skin."""
-    from facsim.head.scalp import LIFT, scalp_layer, strand_texture_png
+    bound to those skin vertices, or None where the style covers no skin. ``cache``: a
+    ``.npy`` file keeping the layer (building it takes a few tenths of a second)."""
+    from facsim.head.assets import cached_array
+    from facsim.head.scalp import LIFT, ScalpLayer, scalp_layer, strand_texture
 
     geo = np.asarray(neutral_geometry, np.float32)
-    eyes = np.concatenate([np.asarray(v) for v in head.eye_vertices.values()])
-    corners = hair.binding.positions(geo)[hair.proxy.corner_vertex]  # cards split at their UV seams
-    layer = scalp_layer(head, geo, corners, hair.proxy.triangles, hair.proxy.uv, eye_y=float(geo[eyes, 1].mean()),
-                        eye_z=float(geo[eyes, 2].mean()))
-    if layer is None:
+
+    def build() -> np.ndarray:
+        eyes = np.concatenate([np.asarray(v) for v in head.eye_vertices.values()])
+        corners = hair.binding.positions(geo)[hair.proxy.corner_vertex]  # cards split at their UV seams
+        layer = scalp_layer(head, geo, corners, hair.proxy.triangles, hair.proxy.uv,
+                            eye_y=float(geo[eyes, 1].mean()), eye_z=float(geo[eyes, 2].mean()))
+        return np.zeros((1, 7)) if layer is None else layer.to_array()
+
+    array = build() if cache is None else cached_array(
+        cache, build, valid=lambda a: a.ndim == 2 and a.shape[1] == 7 and int(a[0, 0]) < head.skin_vertex_count)
+    if int(array[0, 0]) == 0:
         return None
+    layer = ScalpLayer.from_array(array)
     vertices, normals = layer.vertices, layer.normals
     k = len(vertices)
     weights = np.zeros((k, 3), np.float32)
@@ -488,7 +502,7 @@ def bind_scalp(hair: BoundProxy, head, neutral_geometry: np.ndarray) -> BoundPro
     proxy = Proxy(name=hair.proxy.name + SCALP_SUFFIX, kind="scalp",
                   ref=np.asarray(head.base_index)[ref], weights=weights, offsets=LIFT * normals,
                   triangles=layer.triangles, corner_vertex=np.arange(k, dtype=np.int32), uv=layer.uv,
-                  png=strand_texture_png(), author="facsim", license="CC0")
+                  png=b"", author="facsim", license="CC0", image=strand_texture())
     binding = FrameBinding(ref=ref, weights=weights, offsets=(LIFT * normals).astype(np.float32))
     return BoundProxy(proxy, binding, "hair", 1.0, binding.positions(geo), shade=layer.density)
 

@@ -21,7 +21,6 @@ skin does (head motion, and the forehead under AU 1 and 2 carries the hairline's
 """
 from __future__ import annotations
 
-import io
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -37,6 +36,8 @@ CARD_RADIUS = 0.035
 HAIRLINE_WIDTH = 0.06
 #: Height (dm) of the layer over the skin: enough not to fight it in the depth buffer.
 LIFT = 0.004
+#: Bump when the layer a character gets changes (its disk cache is keyed by it).
+VERSION = 1
 #: One texture tile's size (dm) across and along the strands.
 TILE = (0.1, 0.2)
 
@@ -85,7 +86,16 @@ def scalp_density(skin: np.ndarray, normals: np.ndarray, cards: np.ndarray, tria
     from facsim.head.proxies import card_samples
 
     skin = np.asarray(skin, np.float64)
-    tree = cKDTree(card_samples(cards, triangles, k=8))  # a few millimetres apart on cards of a few cm
+    cards = np.asarray(cards, np.float64)
+    triangles = np.asarray(triangles)
+    # Only cards that come within reach of the skin matter (long hair hangs far from it).
+    corners = cards[triangles]
+    size = np.linalg.norm(corners - corners.mean(axis=1, keepdims=True), axis=2).max(axis=1)
+    gap = cKDTree(skin).query(corners.mean(axis=1))[0]
+    near = triangles[gap < REACH + CARD_RADIUS + size]
+    if not len(near):
+        return np.zeros(len(skin), np.float32)
+    tree = cKDTree(card_samples(cards, near, k=8))  # a few millimetres apart on cards of a few cm
     hits = np.zeros(len(skin))
     for d in np.linspace(0.005, REACH, 8):
         near = tree.query(skin + d * normals, k=1, distance_upper_bound=CARD_RADIUS)[0]
@@ -208,15 +218,6 @@ def strand_texture(size: int = 256, seed: int = 13) -> np.ndarray:
     return out
 
 
-def strand_texture_png() -> bytes:
-    """:func:`strand_texture` as PNG bytes (how proxies carry their textures)."""
-    from PIL import Image
-
-    buf = io.BytesIO()
-    Image.fromarray(strand_texture(), "RGBA").save(buf, format="PNG")
-    return buf.getvalue()
-
-
 @dataclass(frozen=True, eq=False)
 class ScalpLayer:
     """The scalp hair under a hairstyle (:func:`scalp_layer`).
@@ -240,6 +241,24 @@ class ScalpLayer:
     density: np.ndarray
     uv: np.ndarray
     normals: np.ndarray
+
+    def to_array(self) -> np.ndarray:
+        """One (1 + K + M, 7) float64 array (for the disk cache; :meth:`from_array` reads it):
+        a header row (K, M), a row per vertex (vertex, density, u, v, normal), a row per triangle."""
+        k, m = len(self.vertices), len(self.triangles)
+        out = np.zeros((1 + k + m, 7))
+        out[0, :2] = k, m
+        out[1 : 1 + k] = np.column_stack([self.vertices, self.density, self.uv, self.normals])
+        out[1 + k :, :3] = self.triangles
+        return out
+
+    @classmethod
+    def from_array(cls, array: np.ndarray) -> ScalpLayer:
+        k, m = (int(x) for x in array[0, :2])
+        rows, tris = array[1 : 1 + k], array[1 + k : 1 + k + m, :3]
+        return cls(vertices=rows[:, 0].astype(np.int64), triangles=tris.astype(np.int32),
+                   density=rows[:, 1].astype(np.float32), uv=rows[:, 2:4].astype(np.float32),
+                   normals=rows[:, 4:7].astype(np.float32))
 
 
 def scalp_layer(head, neutral_geometry: np.ndarray, cards: np.ndarray, card_triangles: np.ndarray,
