@@ -88,7 +88,9 @@ void main() {
     // Tufts finer than a pixel (texels of the tile per pixel across the strands) show only
     // as their mean cover.
     keep = mix(keep, clamp(dens, 0.0, 1.0), smoothstep(16.0, 40.0, fwidth(suv.x) * 256.0));
-    float alpha = tex.a * keep * 0.92;
+    // Where the cover thins, the hairs that are left are finer and fewer: the tuft's own
+    // strands (tex.a) show more of the skin between them, so the hairline ends in wisps.
+    float alpha = mix(tex.a * tex.a * tex.a, tex.a, smoothstep(0.2, 0.9, dens)) * keep * 0.92;
     if (alpha < 0.01) discard;
     vec3 n = normalize(v_normal);
     vec3 t = normalize(v_tangent);
