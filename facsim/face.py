@@ -164,9 +164,12 @@ class Face:
     @cached_property
     def _hair_greying(self) -> tuple:
         """Greying scalp hair's strand colours (:func:`facsim.head.proxies.hair_greying`)."""
+        from facsim.head.appearance import GREY_HAIR, character_colors
+        from facsim.head.colour import hex_to_rgb
         from facsim.head.proxies import hair_greying
 
-        return hair_greying(self.character, self.colors)
+        young = character_colors(self.character.with_(age=min(self.character.age, 40.0)))["hair"]
+        return hair_greying(self.colors["hair"], young, hex_to_rgb(GREY_HAIR))
 
     @cached_property
     def colors(self) -> dict:

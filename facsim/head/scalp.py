@@ -42,18 +42,16 @@ VERSION = 1
 TILE = (0.1, 0.2)
 
 
-def hairline_height(normals: np.ndarray, skin_z: np.ndarray, eye_y: float, eye_z: float) -> np.ndarray:
+def hairline_height(normals: np.ndarray, skin_z: np.ndarray, eye_y: float, eye_z: float, hairline: dict) -> np.ndarray:
     """(N,) height (dm) below which skin facing along ``normals`` (at depths ``skin_z``)
     grows no scalp hair.
 
-    ``hairline_above_eyes_mm`` in ``facsim/data/hair.yaml`` gives it over the forehead (skin
+    ``hairline`` (``scalp: hairline_above_eyes_mm`` in ``facsim/data/hair.yaml``) gives it over the forehead (skin
     facing forward, +z), the temples (sideways, ±x, near the eyes), the sideburns (sideways,
     near the ears) and the nape (backward); between them it blends by the way the skin faces. Cards hanging over skin below it (a fringe over the
     forehead, long hair beside the cheeks) do not grow from it.
     """
-    from facsim.head.proxies import hair_table
-
-    table = hair_table()["scalp"]["hairline_above_eyes_mm"]
+    table = hairline
     n = np.asarray(normals, np.float64)
     w = np.stack([np.clip(n[:, 2], 0, None), np.abs(n[:, 0]), np.clip(-n[:, 2], 0, None)], axis=1) ** 2 + 1e-6
     # Skin facing sideways is temple near the eyes and sideburn near the ear.
@@ -82,8 +80,6 @@ def scalp_density(skin: np.ndarray, normals: np.ndarray, cards: np.ndarray, tria
         Skin below this height is never scalp (:func:`hairline_height`).
     """
     from scipy.spatial import cKDTree
-
-    from facsim.head.proxies import card_samples
 
     skin = np.asarray(skin, np.float64)
     cards = np.asarray(cards, np.float64)
@@ -262,7 +258,7 @@ class ScalpLayer:
 
 
 def scalp_layer(head, neutral_geometry: np.ndarray, cards: np.ndarray, card_triangles: np.ndarray,
-                card_uv: np.ndarray, *, eye_y: float, eye_z: float) -> ScalpLayer | None:
+                card_uv: np.ndarray, *, eye_y: float, eye_z: float, hairline: dict) -> ScalpLayer | None:
     """The scalp hair layer under a hairstyle's cards (``cards`` (P, 3) on the neutral face,
     ``card_triangles`` over them, ``card_uv`` (P, 2)), or None where they cover no skin.
 
@@ -276,7 +272,7 @@ def scalp_layer(head, neutral_geometry: np.ndarray, cards: np.ndarray, card_tria
     normals = vertex_normals(skin, tris).astype(np.float64)
     if np.einsum("ij,ij->i", normals, skin - skin.mean(axis=0)).mean() < 0:  # wound inward: turn it
         tris, normals = tris[:, ::-1], -normals
-    density = scalp_density(skin, normals, cards, card_triangles, floor_y=hairline_height(normals, skin[:, 2], eye_y, eye_z))
+    density = scalp_density(skin, normals, cards, card_triangles, floor_y=hairline_height(normals, skin[:, 2], eye_y, eye_z, hairline))
     keep = tris[(density[tris] > 0.0).any(axis=1)]
     if not len(keep):
         return None
@@ -311,3 +307,14 @@ def card_cover(cards: np.ndarray, skin: np.ndarray, density: np.ndarray, *, reac
     d = np.asarray(density, np.float64)[nearest]
     thinning = (1.0 - d) * smoothstep(0.0, 0.15, d) * smoothstep(reach, 0.5 * reach, distance)
     return (1.0 - thinning).astype(np.float32)
+
+
+def card_samples(points: np.ndarray, triangles: np.ndarray, *, k: int = 4) -> np.ndarray:
+    """Points spread over the cards (a barycentric grid of ``k`` steps per triangle), so
+    distances to the hair are distances to its cards, not to its sparse vertices (cards
+    are a few centimetres across)."""
+    tri = np.asarray(points, np.float64)[np.asarray(triangles)]
+    a, b = np.meshgrid(np.arange(k + 1), np.arange(k + 1), indexing="ij")
+    keep = a + b <= k
+    bary = np.stack([a[keep], b[keep], k - a[keep] - b[keep]], axis=1) / k
+    return np.einsum("sk,tkd->tsd", bary, tri).reshape(-1, 3)
