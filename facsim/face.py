@@ -102,21 +102,74 @@ class Face:
         return bind_character_proxies(self.character, self.head, self.base_positions, self.neutral)
 
     @cached_property
+    def scalp(self):
+        """The fine hair on the skin under the hair's cards (a ``"scalp"`` BoundProxy), or None."""
+        import hashlib
+
+        from facsim.head.assets import cache_dir
+        from facsim.head.proxies import bind_scalp, hair_table
+        from facsim.head.scalp import VERSION
+
+        hair = [b for b in self.proxies if b.proxy.kind == "hair"]
+        if not hair:
+            return None
+        # Cached on disk like the occlusion bake: by the head's shape, the style and its table.
+        shape = self.character.with_(name="", description="", colors={}, hair="", brows="", lashes="")
+        key = hashlib.sha256(repr((VERSION, shape, hair[0].proxy.name, hair_table().get("scalp")))
+                             .encode()).hexdigest()[:16]
+        return bind_scalp(hair[0], self.head, self.neutral, cache=cache_dir() / "scalp" / f"{key}.npy")
+
+    @property
+    def _drawn_proxies(self) -> list:
+        """What the renderer draws: the scalp layer first (under every card), then the proxies."""
+        return ([self.scalp] if self.scalp is not None else []) + list(self.proxies)
+
+    @cached_property
     def proxy_meshes(self) -> list:
         """What the renderer uploads of each proxy (:class:`facsim.render.proxies.ProxyMesh`), in draw order."""
         from facsim.render.proxies import ProxyMesh
 
         return [ProxyMesh(b.proxy.name, b.proxy.kind, b.proxy.triangles, b.proxy.corner_vertex, b.proxy.uv,
-                          b.proxy.texture, b.depth, b.neutral if b.proxy.kind == "hair" else None)
-                for b in self.proxies]
+                          b.proxy.texture, b.depth, b.neutral if b.proxy.kind == "hair" else None,
+                          self._card_cover(b) if b.proxy.kind == "hair" else None, b.coil > 0.0)
+                for b in self._drawn_proxies]
+
+    def _card_cover(self, bound) -> np.ndarray | None:
+        """The scalp's hair density under ``bound``'s cards (:func:`facsim.head.scalp.card_cover`)."""
+        from facsim.head.scalp import card_cover
+
+        if self.scalp is None:
+            return None
+        skin = self.head.skin_vertex_count
+        return card_cover(bound.neutral, self.neutral[:skin], self._scalp_density[:skin])
+
+    @cached_property
+    def _scalp_density(self) -> np.ndarray:
+        """(geometry vertices,) the scalp's hair density (0 where none grows)."""
+        density = np.zeros(len(self.neutral), np.float32)
+        if self.scalp is not None:
+            density[self.scalp.binding.ref[:, 0]] = self.scalp.shade
+        return density
 
     def proxy_draws(self, positions: np.ndarray) -> list:
         """This frame's :class:`facsim.render.proxies.ProxyDraw` s for geometry ``positions``."""
         from facsim.render.proxies import ProxyDraw
 
-        return [ProxyDraw(mesh, self._proxy_positions(bound, positions), tuple(self.colors[bound.color_key]),
-                          bound.sheen, bound.density, bound.coil)
-                for bound, mesh in zip(self.proxies, self.proxy_meshes)]
+        pigment, white, grey = self._hair_greying
+        return [ProxyDraw(mesh, self._proxy_positions(bound, positions), tuple(self.colors[bound.color_key]), bound.sheen,
+                          bound.density, bound.coil,
+                          *((pigment, white, grey) if bound.color_key == "hair" else (None, None, 0.0)))
+                for bound, mesh in zip(self._drawn_proxies, self.proxy_meshes)]
+
+    @cached_property
+    def _hair_greying(self) -> tuple:
+        """Greying scalp hair's strand colours (:func:`facsim.head.proxies.hair_greying`)."""
+        from facsim.head.appearance import GREY_HAIR, character_colors
+        from facsim.head.colour import hex_to_rgb
+        from facsim.head.proxies import hair_greying
+
+        young = character_colors(self.character.with_(age=min(self.character.age, 40.0)))["hair"]
+        return hair_greying(self.colors["hair"], young, hex_to_rgb(GREY_HAIR))
 
     def _proxy_positions(self, bound, positions: np.ndarray) -> np.ndarray:
         """A proxy's vertices on geometry ``positions``; lashes turn with their lids."""
@@ -211,10 +264,11 @@ class Face:
         occlusion[skin] *= 1.0 - CONTACT_DEPTH * contact_shadow(self.head.base_vertices[self.head.base_index[skin]])
         interior, visibility = mouth_depth_visibility(self.head, self.neutral)
         occlusion[interior] = visibility
+        cover = self._scalp_density
         for bound in self.proxies:
             if bound.proxy.kind == "hair":
                 hair = bound.binding.positions(self.neutral)
-                occlusion[skin] *= hair_shadow(self.neutral[skin], hair,
+                occlusion[skin] *= hair_shadow(self.neutral[skin], hair, cover=cover[skin],
                                                triangles=bound.proxy.corner_vertex[bound.proxy.triangles])
         return occlusion
 

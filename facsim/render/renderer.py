@@ -703,6 +703,8 @@ class Renderer:
         ctx.disable(ctx.CULL_FACE)
         for draw in self._proxy_draws:
             layer = self._proxy_layers[draw.mesh]
+            if not layer.has_opaque_pass:
+                continue
             if hair_moving is None or draw.mesh.kind != "hair":
                 layer.draw("OPAQUE")
             elif hair_moving[layer].any():
@@ -723,7 +725,11 @@ class Renderer:
         # the test before the shader fetches their texture only to discard them.
         ctx.depth_func = "<"
         for layer in layers:
+            if layer.culled:
+                ctx.enable(ctx.CULL_FACE)
+                ctx.cull_face = "back"
             layer.draw("BLEND")
+            ctx.disable(ctx.CULL_FACE)
         ctx.depth_func = "<="  # what the head's groups after the proxies use
         fbo.depth_mask = True
         ctx.disable(ctx.BLEND)

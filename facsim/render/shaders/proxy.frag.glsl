@@ -1,6 +1,7 @@
 // Proxy fragment shader: hair, eyebrow and eyelash cards cut out by their texture's alpha.
 // Variants (#defines from facsim/render/proxies.py): PASS_OPAQUE (alpha-tested, writes depth) or
-// PASS_BLEND (the soft fringe, blended back to front); KIND_HAIR, KIND_EYEBROWS, KIND_EYELASHES.
+// PASS_BLEND (the soft fringe, blended back to front); KIND_HAIR, KIND_EYEBROWS, KIND_EYELASHES,
+// KIND_SCALP; COILY for coily hair (its curls cost llvmpipe time even where a uniform skips them).
 
 #include "common.glsl"
 
@@ -10,6 +11,8 @@ in vec3 v_tangent;
 in float v_depth;
 in float v_edge;
 in vec2 v_uv;
+in float v_cover;
+in vec3 v_rest;
 
 uniform sampler2D u_texture;  // R: strand brightness (0.5 = mean), GB: strand direction in UV, A: coverage
 uniform vec3 u_color;         // linear RGB
@@ -17,8 +20,36 @@ uniform float u_along_v;      // 1: the texture's strands run along v everywhere
 uniform float u_sheen;        // strand highlight strength (1 straight hair, less for coily)
 uniform float u_density;      // brows and lashes: how much of the skin their hairs cover
 uniform float u_coil;         // hair: 0 straight ... 1 coily
+uniform vec3 u_pigment;       // greying hair: its pigmented strands' colour (linear RGB) ...
+uniform vec3 u_white;         // ... its white strands' ...
+uniform float u_grey;         // ... and the fraction of white strands (u_color is their mean)
 
 out vec4 f_color;
+
+// Greying hair: the fraction of white strands wanders from clump to clump (clump: clump
+// coordinates), so grey hair shows darker and lighter locks, salt and pepper at the scale
+// of clumps, rather than one flat grey; where clumps are finer than a pixel, the mean colour.
+vec3 hair_colour(vec2 clump) {
+    if (u_grey <= 0.0) return u_color;
+    float local = clamp(u_grey + 0.6 * (value_noise(clump, 0) - 0.5), 0.0, 1.0);
+    vec3 c = mix(u_pigment, u_white, local);
+    return mix(c, u_color, clamp(0.5 * max(fwidth(clump.x), fwidth(clump.y)) - 0.25, 0.0, 1.0));
+}
+
+// Value noise in 3D, [0, 1], faded to its mean where its cells are finer than a pixel.
+float value_noise3(vec3 p) {
+    vec3 i = floor(p);
+    vec3 f = p - i;
+    vec3 u = f * f * (3.0 - 2.0 * f);
+    ivec3 c = ivec3(i);
+    int z0 = 7919 * c.z, z1 = 7919 * (c.z + 1);
+    float a = mix(mix(hash2(ivec2(c.x, c.y + z0)), hash2(ivec2(c.x + 1, c.y + z0)), u.x),
+                  mix(hash2(ivec2(c.x, c.y + 1 + z0)), hash2(ivec2(c.x + 1, c.y + 1 + z0)), u.x), u.y);
+    float b = mix(mix(hash2(ivec2(c.x, c.y + z1)), hash2(ivec2(c.x + 1, c.y + z1)), u.x),
+                  mix(hash2(ivec2(c.x, c.y + 1 + z1)), hash2(ivec2(c.x + 1, c.y + 1 + z1)), u.x), u.y);
+    float n = mix(a, b, u.z);
+    return mix(0.5, n, clamp(2.0 - 1.4 * length(fwidth(p)), 0.0, 1.0));
+}
 
 // Kajiya-Kay: light scattered by a thin cylinder along t.
 float strand_diffuse(vec3 t, vec3 l) {
@@ -27,6 +58,61 @@ float strand_diffuse(vec3 t, vec3 l) {
 }
 
 
+#ifdef KIND_SCALP
+// The fine hair growing on the skin under a hairstyle's cards (facsim/head/scalp.py): drawn
+// blended over the skin before the cards, so the scalp between and beyond them is covered by
+// hair of the cards' colour, thinning over a centimetre at the hairline into single hairs with
+// the skin between them, instead of ending in a seam of bare, shadowed skin.
+// v_uv: strand coordinates in texture tiles (u across, v along the hair's flow); v_depth: the
+// hair's density there (0 bare ... 1 full cover). tex: R brightness, G each strand's rank, A cover.
+void main() {
+#ifdef PASS_OPAQUE
+    discard;
+#endif
+    // Coily hair grows in small round curls, not long strands: the tile's tufts squashed round.
+#ifdef COILY
+    vec2 suv = v_uv * vec2(2.0, 6.0);
+#else
+    vec2 suv = v_uv;
+#endif
+    vec4 tex = texture(u_texture, suv);
+    // Tufts (tex.g: their rank) are kept where their rank is under the density: a thinning
+    // hairline breaks into separate tufts and single hairs. Their edges soften where a tuft
+    // nears a pixel across (the rank's screen-space change), never alias.
+    float w = 0.04 + 1.5 * fwidth(tex.g);
+    // The hairline wanders by a few millimetres (clumps grow forward, gaps recede), so its
+    // tufts do not line up along the mesh's edge like teeth.
+    float wander = value_noise(v_uv * vec2(2.5, 0.8) + 11.0, 0) - 0.5;
+    float dens = v_depth * 1.08 - 0.04 + 1.3 * wander * v_depth * (1.0 - v_depth);
+    float keep = smoothstep(tex.g - w, tex.g + w, dens);
+    // Tufts finer than a pixel (texels of the tile per pixel across the strands) show only
+    // as their mean cover.
+    keep = mix(keep, clamp(dens, 0.0, 1.0), smoothstep(16.0, 40.0, fwidth(suv.x) * 256.0));
+    // Where the cover thins, the hairs that are left are finer and fewer: the tuft's own
+    // strands (tex.a) show more of the skin between them, so the hairline ends in wisps.
+    float alpha = mix(tex.a * tex.a * tex.a, tex.a, smoothstep(0.2, 0.9, dens)) * keep * 0.92;
+    if (alpha < 0.01) discard;
+    vec3 n = normalize(v_normal);
+    vec3 t = normalize(v_tangent);
+    float kl = clamp(dot(n, u_key_dir) * 0.5 + 0.5, 0.0, 1.0);
+    float dk = mix(strand_diffuse(t, u_key_dir), 1.0, 0.3) * kl * kl * 1.25;
+    float df = clamp(dot(n, u_fill_dir) * 0.5 + 0.5, 0.0, 1.0);
+    vec3 lit = dk * u_key_col + df * u_fill_col + hemisphere(n) * 0.8;
+    // The roots under full cover lie in the cards' shadow; the hairline's fine hairs in the open.
+    float light_hair = sqrt(clamp(dot(u_color, vec3(0.2126, 0.7152, 0.0722)), 0.0, 1.0));
+    float shade = mix(0.9, mix(0.35, 0.7, light_hair), smoothstep(0.3, 1.0, v_depth));
+    float curl = 1.0;
+#ifdef COILY
+    {  // and each curl shows its own light and shade
+        vec2 kp = suv * 600.0;
+        curl = 0.55 + 0.9 * mix(0.5, value_noise(kp, 0), clamp(1.8 - 1.4 * fwidth(kp.x), 0.0, 1.0));
+        alpha *= curl * 0.9;
+    }
+#endif
+    vec3 albedo = hair_colour(suv * vec2(8.0, 2.0)) * (0.55 + 0.9 * tex.r) * shade * curl;
+    f_color = vec4(finish(albedo * lit).rgb, alpha);
+}
+#else
 void main() {
     vec4 tex = texture(u_texture, v_uv);
     float alpha = tex.a;
@@ -75,7 +161,7 @@ void main() {
 #ifdef PASS_OPAQUE
     if (alpha < ALPHA_CUTOFF) discard;
 #else
-    if (alpha < 0.02 || (alpha >= ALPHA_CUTOFF && v_edge < 0.1 && dot(n, v) >= 0.28)) discard;
+    if (alpha < 0.02 || (alpha >= ALPHA_CUTOFF && v_edge < 0.1 && v_cover > 0.999 && dot(n, v) >= 0.28)) discard;
 #endif
     // Strand coordinates: across the strands (u) many, along them (v) few. Each noise fades
     // to its mean where it would be finer than a pixel, so small images do not shimmer.
@@ -100,6 +186,23 @@ void main() {
     float fray = outline * (1.0 - strand_mask) * 0.9;
     fray = 1.0 - (1.0 - fray) * (1.0 - smoothstep(0.45, 0.75, v_edge + 0.7 * (0.5 - rag)));
     alpha *= 1.0 - fray * (1.0 - u_coil);
+#ifdef COILY
+    {
+        // Coily hair's outline breaks up in curls (placed on the neutral face, see below):
+        // the volume's edge is a halo of curls with the background between them, not a rim.
+        float halo = value_noise3(v_rest * 70.0 + 2.0);
+        alpha *= 1.0 - u_coil * outline * (1.0 - smoothstep(0.35, 0.65, halo)) * 0.95;
+    }
+#endif
+    // Over a thinning hairline (v_cover < 1, see facsim/head/scalp.py) the cards break up into
+    // strands and clumps, fewer the thinner the cover, so they fade into the scalp's fine hairs.
+    // Coily hair thins in round curls, not in strands along the card.
+#ifdef COILY
+    float thin_at = value_noise(v_uv * 90.0 + 3.0, 0);
+#else
+    float thin_at = rag;
+#endif
+    alpha *= smoothstep(thin_at - 0.2, thin_at + 0.2, 1.3 * v_cover - 0.15);
 #endif
 #ifdef PASS_OPAQUE
     if (alpha < ALPHA_CUTOFF) discard;
@@ -127,17 +230,28 @@ void main() {
     // Strand-scale brightness: the texture's own strands (tex.r: its painted light removed,
     // see shade_texture) and three scales of procedural strands, so neighbouring strands and
     // clumps differ the way real hair does, the same on every card.
-    float strand = (0.45 + 1.1 * tex.r) * (0.7 + 0.6 * fine) * (0.78 + 0.44 * mid) * (0.86 + 0.28 * clump);
+    // (The texture's strands and the widest scale stop at each card's edge: on long01's crown,
+    // at full strength they drew the rows of cards, so they keep less weight.)
+    float strand = (0.62 + 0.76 * tex.r) * (0.7 + 0.6 * fine) * (0.76 + 0.48 * mid) * (0.92 + 0.16 * clump);
 #ifdef PASS_OPAQUE
-    if (u_coil > 0.0) {
-        // Coily hair: at any distance its curls blend into a fine, even, matte texture; the
-        // texture's tufts keep a little of their contrast, fine isotropic curls add the rest.
-        vec2 kp = v_uv * 300.0;
-        float kink = mix(0.5, value_noise(kp, 0), clamp(1.8 - 1.4 * fwidth(kp.x), 0.0, 1.0));
-        strand = mix(strand, (0.6 + 0.8 * tex.r) * (0.62 + 0.76 * kink), u_coil);
+#ifdef COILY
+    {
+        // Coily hair: at any distance its curls blend into a fine, even, matte texture. The
+        // texture's tufts keep a little of their contrast (it is laid out mirrored from card
+        // to card, and at full contrast drew that tiling on the cap: ngozi's grey afro read as
+        // a cap); curls a millimetre and a few millimetres across, placed on the neutral face
+        // (v_rest) rather than in the cards' UVs, add the rest.
+        float kink = value_noise3(v_rest * 110.0);
+        float curls = value_noise3(v_rest * 35.0 + 5.0);
+        strand = mix(strand, (0.82 + 0.36 * tex.r) * (0.6 + 0.8 * kink) * (0.62 + 0.76 * curls), u_coil);
     }
 #endif
-    albedo = u_color * strand;
+#endif
+#ifdef COILY
+    albedo = hair_colour(v_uv * 40.0) * strand;
+#else
+    albedo = hair_colour(v_uv * vec2(45.0, 1.2) + 7.0) * strand;
+#endif
     // Depth in the volume: layers near the scalp lie under the outer ones and get little
     // light (roots and the under-layers darker), the gaps between clumps are darker still.
     // Light hair (blond, grey) scatters light on through the strands, so its inner layers
@@ -198,3 +312,4 @@ void main() {
 #endif
     f_color = vec4(finish(radiance).rgb, alpha);
 }
+#endif

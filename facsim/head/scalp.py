@@ -1,0 +1,320 @@
+"""The scalp's own hair: a fine layer on the skin under a hairstyle's cards.
+
+MakeHuman's hair is a few dozen textured cards floating a few millimetres over the scalp.
+Where they end (the hairline) or part, the skin between and beyond them showed bare and,
+shadowed by the cards, reddish: a seam around a painted helmet (issue 13: "a visible hairline
+seam on the old man"). Real hair grows out of the skin: from the hairline inward it thickens
+over a centimetre or so from single fine hairs to full cover, and the scalp only shows
+through where the hair is sparse.
+
+This module builds that layer as plain data for the renderer (one more proxy, kind
+``"scalp"``): the skin triangles under the hair, lifted a fraction of a millimetre, with
+
+- a **density** per vertex (0 bare … 1 full cover): 1 where cards lie over the skin within
+  a short reach, falling off smoothly past the cards' edge (:func:`scalp_density`);
+- **strand coordinates** as UVs, ``u`` across the strands and ``v`` along them, which follow
+  the direction the cards' own strands run (:func:`strand_coordinates`), so a tiling texture
+  of fine hairs (:func:`strand_texture`) lies along the hair's flow.
+
+The layer is bound to the skin vertices it covers, so it follows every frame exactly as the
+skin does (head motion, and the forehead under AU 1 and 2 carries the hairline's fine hairs).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from facsim.head.surface import smoothstep, vertex_normals
+
+#: How far (dm) over the skin a card may lie and still count as growing from it.
+REACH = 0.12
+#: Distance (dm) from a ray to a card sample that counts as passing through the card.
+CARD_RADIUS = 0.035
+#: Width (dm) of the hairline's gradient from bare skin to full cover.
+HAIRLINE_WIDTH = 0.06
+#: Height (dm) of the layer over the skin: enough not to fight it in the depth buffer.
+LIFT = 0.004
+#: Bump when the layer a character gets changes (its disk cache is keyed by it).
+VERSION = 1
+#: One texture tile's size (dm) across and along the strands.
+TILE = (0.1, 0.2)
+
+
+def hairline_height(normals: np.ndarray, skin_z: np.ndarray, eye_y: float, eye_z: float, hairline: dict) -> np.ndarray:
+    """(N,) height (dm) below which skin facing along ``normals`` (at depths ``skin_z``)
+    grows no scalp hair.
+
+    ``hairline`` (``scalp: hairline_above_eyes_mm`` in ``facsim/data/hair.yaml``) gives it over the forehead (skin
+    facing forward, +z), the temples (sideways, ±x, near the eyes), the sideburns (sideways,
+    near the ears) and the nape (backward); between them it blends by the way the skin faces. Cards hanging over skin below it (a fringe over the
+    forehead, long hair beside the cheeks) do not grow from it.
+    """
+    table = hairline
+    n = np.asarray(normals, np.float64)
+    w = np.stack([np.clip(n[:, 2], 0, None), np.abs(n[:, 0]), np.clip(-n[:, 2], 0, None)], axis=1) ** 2 + 1e-6
+    # Skin facing sideways is temple near the eyes and sideburn near the ear.
+    side = np.interp(np.asarray(skin_z, np.float64), (eye_z - 0.8, eye_z - 0.45), (table["sideburn"], table["temple"]))
+    mm = (w[:, 0] * table["front"] + w[:, 1] * side + w[:, 2] * table["back"]) / w.sum(axis=1)
+    return eye_y + 0.01 * mm
+
+
+def scalp_density(skin: np.ndarray, normals: np.ndarray, cards: np.ndarray, triangles: np.ndarray,
+                  *, floor_y=None) -> np.ndarray:
+    """(N,) hair density on the skin (0 bare … 1 full cover) under a hairstyle's cards.
+
+    A skin vertex is under the hair when its outward normal passes through a card within
+    :data:`REACH`. The cover is then averaged over :data:`HAIRLINE_WIDTH` along the skin,
+    so it thickens over that width from the cards' edge inward instead of stopping at it.
+
+    Parameters
+    ----------
+    skin : (N, 3) float
+        Skin vertices on the neutral face (dm).
+    normals : (N, 3) float
+        Their unit outward normals.
+    cards : (P, 3) float
+        Hair vertices; ``triangles`` (T, 3) index them.
+    floor_y : float or (N,) float, optional
+        Skin below this height is never scalp (:func:`hairline_height`).
+    """
+    from scipy.spatial import cKDTree
+
+    skin = np.asarray(skin, np.float64)
+    cards = np.asarray(cards, np.float64)
+    triangles = np.asarray(triangles)
+    # Only cards that come within reach of the skin matter (long hair hangs far from it).
+    corners = cards[triangles]
+    size = np.linalg.norm(corners - corners.mean(axis=1, keepdims=True), axis=2).max(axis=1)
+    gap = cKDTree(skin).query(corners.mean(axis=1))[0]
+    near = triangles[gap < REACH + CARD_RADIUS + size]
+    if not len(near):
+        return np.zeros(len(skin), np.float32)
+    tree = cKDTree(card_samples(cards, near, k=8))  # a few millimetres apart on cards of a few cm
+    hits = np.zeros(len(skin))
+    for d in np.linspace(0.005, REACH, 8):
+        near = tree.query(skin + d * normals, k=1, distance_upper_bound=CARD_RADIUS)[0]
+        hits = np.maximum(hits, np.isfinite(near))
+    if floor_y is not None:
+        hits *= skin[:, 1] > floor_y
+    # Averaged over the skin within the hairline's width (Gaussian weights): 0.5 on the
+    # cards' edge, full a half-width inside it.
+    pairs = cKDTree(skin).query_pairs(HAIRLINE_WIDTH, output_type="ndarray")
+    i = np.concatenate([pairs[:, 0], pairs[:, 1], np.arange(len(skin))])
+    j = np.concatenate([pairs[:, 1], pairs[:, 0], np.arange(len(skin))])
+    w = np.exp(-np.sum((skin[i] - skin[j]) ** 2, axis=1) / (2.0 * (0.4 * HAIRLINE_WIDTH) ** 2))
+    mean = np.bincount(i, weights=w * hits[j], minlength=len(skin)) / np.bincount(i, weights=w, minlength=len(skin))
+    return smoothstep(0.2, 0.65, mean).astype(np.float32)
+
+
+def flow_directions(skin: np.ndarray, normals: np.ndarray, cards: np.ndarray, card_triangles: np.ndarray,
+                    card_uv: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    """(N, 3) unit direction the hair runs over each skin vertex, in the skin's tangent plane.
+
+    Taken from the nearest cards' strands (dP/dv: MakeHuman's hair textures run along v)
+    as an axis, not an arrow (the cards' v runs either way), averaged with the neighbours
+    (``triangles`` over the N vertices) and then given one sense by walking the mesh, each
+    vertex agreeing with the one it was reached from: strand coordinates need directions
+    that agree locally, whichever way the hair is combed.
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import breadth_first_order, connected_components
+    from scipy.spatial import cKDTree
+
+    p = np.asarray(cards, np.float64)[card_triangles]
+    uv = np.asarray(card_uv, np.float64)[card_triangles]
+    e1, e2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+    d1, d2 = uv[:, 1] - uv[:, 0], uv[:, 2] - uv[:, 0]
+    det = d1[:, 0] * d2[:, 1] - d2[:, 0] * d1[:, 1]
+    det = np.where(np.abs(det) < 1e-12, 1e-12, det)
+    tv = (-d2[:, :1] * e1 + d1[:, :1] * e2) / det[:, None]
+    tv /= np.linalg.norm(tv, axis=1, keepdims=True) + 1e-12
+    _, nearest = cKDTree(p.mean(axis=1)).query(skin, k=6)
+    tensor = np.einsum("nki,nkj->nij", tv[nearest], tv[nearest])       # axes, sign-free
+    n = len(skin)
+    edges = np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]])
+    adjacency = coo_matrix((np.ones(2 * len(edges)), (np.r_[edges[:, 0], edges[:, 1]], np.r_[edges[:, 1], edges[:, 0]])),
+                           shape=(n, n)).tocsr()
+    adjacency.data[:] = 1.0
+    for _ in range(2):  # a little smoothing along the skin
+        tensor = tensor + (adjacency @ tensor.reshape(n, 9)).reshape(n, 3, 3) * 0.5
+    proj = np.eye(3)[None] - np.einsum("ni,nj->nij", normals, normals)
+    tensor = proj @ tensor @ proj
+    t = np.linalg.eigh(tensor)[1][:, :, -1]                             # the principal axis
+    # One sense: walk each connected piece of the layer, agreeing with the predecessor.
+    _, piece = connected_components(adjacency, directed=False)
+    for k in np.unique(piece):
+        seed = int(np.flatnonzero(piece == k)[0])
+        order, parent = breadth_first_order(adjacency, seed, directed=False, return_predecessors=True)
+        for v in order[1:]:
+            if np.dot(t[v], t[parent[v]]) < 0:
+                t[v] = -t[v]
+    return (t / (np.linalg.norm(t, axis=1, keepdims=True) + 1e-12)).astype(np.float32)
+
+
+def strand_coordinates(points: np.ndarray, normals: np.ndarray, flow: np.ndarray,
+                       triangles: np.ndarray) -> np.ndarray:
+    """(N, 2) coordinates (dm) across and along the strands whose gradients best follow
+    ``flow`` (least squares over the mesh's edges, as a stripe pattern is fitted to a
+    direction field), so a texture tiled in them lies along the hair."""
+    from scipy.sparse import coo_matrix, vstack
+    from scipy.sparse.linalg import lsqr
+
+    n = len(points)
+    t = np.asarray(flow, np.float64)
+    b = np.cross(np.asarray(normals, np.float64), t)
+    edges = np.unique(np.sort(np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]]),
+                              axis=1), axis=0)
+    i, j = edges[:, 0], edges[:, 1]
+    e = np.asarray(points, np.float64)[j] - np.asarray(points, np.float64)[i]
+    rows = np.arange(len(edges))
+    d = coo_matrix((np.r_[-np.ones(len(edges)), np.ones(len(edges))], (np.r_[rows, rows], np.r_[i, j])),
+                   shape=(len(edges), n))
+    tie = coo_matrix((np.full(n, 1e-3), (np.arange(n), np.arange(n))), shape=(n, n))  # fixes the offsets
+    a = vstack([d, tie]).tocsr()
+    out = np.empty((n, 2), np.float32)
+    for k, axis in enumerate((b, t)):
+        target = np.einsum("ij,ij->i", e, 0.5 * (axis[i] + axis[j]))
+        out[:, k] = lsqr(a, np.r_[target, np.zeros(n)], atol=1e-8, btol=1e-8, iter_lim=4000)[0]
+    return out
+
+
+@lru_cache(maxsize=1)
+def strand_texture(size: int = 256, seed: int = 13) -> np.ndarray:
+    """(size, size, 4) uint8 RGBA tile of fine hair running along v (image rows), periodic
+    in both directions.
+
+    R: brightness (0.5 = mean). G: rank (0 … 1, uniform) of small tufts a fraction of a
+    millimetre wide and several long; the shader keeps the tufts whose rank is under the
+    local density, so a thinning hairline breaks into separate tufts and single hairs rather
+    than fading like a film. B: unused. A: the hairs' cover inside a tuft.
+    """
+    rng = np.random.default_rng(seed)
+    fu = np.fft.fftfreq(size)[None, :]
+    fv = np.fft.fftfreq(size)[:, None]
+
+    def field(width_u: float, width_v: float) -> np.ndarray:
+        """Periodic Gaussian-filtered noise: ``width_*`` the correlation length in texels."""
+        noise = np.fft.fft2(rng.standard_normal((size, size)))
+        f = np.real(np.fft.ifft2(noise * np.exp(-2.0 * np.pi ** 2 * ((fu * width_u) ** 2 + (fv * width_v) ** 2))))
+        return (f - f.mean()) / (f.std() + 1e-12)
+
+    tufts = field(16.0, 50.0)  # about 0.6 mm across, 4 mm along (TILE)
+    rank = np.empty(size * size)
+    rank[np.argsort(tufts, axis=None)] = np.linspace(0.0, 1.0, size * size)  # uniform ranks
+    strands = field(1.5, 20.0)
+    alpha = 0.6 + 0.4 * smoothstep(-0.8, 0.6, strands)
+    bright = 0.5 + 0.2 * np.tanh(field(6.0, 60.0)) + 0.08 * np.tanh(field(1.5, 20.0))  # streaks along the flow
+    out = np.empty((size, size, 4), np.uint8)
+    out[..., 0] = np.clip(bright * 255 + 0.5, 0, 255)
+    out[..., 1] = np.clip(rank.reshape(size, size) * 255 + 0.5, 0, 255)
+    out[..., 2] = 128
+    out[..., 3] = np.clip(alpha * 255 + 0.5, 0, 255)
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class ScalpLayer:
+    """The scalp hair under a hairstyle (:func:`scalp_layer`).
+
+    Attributes
+    ----------
+    vertices : (K,) int
+        Skin geometry vertices the layer covers (its vertex ``i`` lies over ``vertices[i]``).
+    triangles : (M, 3) int32
+        Its triangles over those K vertices (the skin's own, wound outward).
+    density : (K,) float32
+        Hair density (0 bare … 1 full cover) per vertex.
+    uv : (K, 2) float32
+        Strand coordinates in texture tiles (:data:`TILE`): u across the strands, v along.
+    normals : (K, 3) float32
+        The skin's outward normals there at neutral (the layer is lifted along them).
+    """
+
+    vertices: np.ndarray
+    triangles: np.ndarray
+    density: np.ndarray
+    uv: np.ndarray
+    normals: np.ndarray
+
+    def to_array(self) -> np.ndarray:
+        """One (1 + K + M, 7) float64 array (for the disk cache; :meth:`from_array` reads it):
+        a header row (K, M), a row per vertex (vertex, density, u, v, normal), a row per triangle."""
+        k, m = len(self.vertices), len(self.triangles)
+        out = np.zeros((1 + k + m, 7))
+        out[0, :2] = k, m
+        out[1 : 1 + k] = np.column_stack([self.vertices, self.density, self.uv, self.normals])
+        out[1 + k :, :3] = self.triangles
+        return out
+
+    @classmethod
+    def from_array(cls, array: np.ndarray) -> ScalpLayer:
+        k, m = (int(x) for x in array[0, :2])
+        rows, tris = array[1 : 1 + k], array[1 + k : 1 + k + m, :3]
+        return cls(vertices=rows[:, 0].astype(np.int64), triangles=tris.astype(np.int32),
+                   density=rows[:, 1].astype(np.float32), uv=rows[:, 2:4].astype(np.float32),
+                   normals=rows[:, 4:7].astype(np.float32))
+
+
+def scalp_layer(head, neutral_geometry: np.ndarray, cards: np.ndarray, card_triangles: np.ndarray,
+                card_uv: np.ndarray, *, eye_y: float, eye_z: float, hairline: dict) -> ScalpLayer | None:
+    """The scalp hair layer under a hairstyle's cards (``cards`` (P, 3) on the neutral face,
+    ``card_triangles`` over them, ``card_uv`` (P, 2)), or None where they cover no skin.
+
+    ``eye_y``, ``eye_z``: the eyes' centres' height and depth (the hairline is placed from them).
+    """
+    n_skin = head.skin_vertex_count
+    geo = np.asarray(neutral_geometry, np.float64)
+    tris = np.asarray(head.topology.geo_faces)
+    tris = tris[np.all(tris < n_skin, axis=1)]
+    skin = geo[:n_skin]
+    normals = vertex_normals(skin, tris).astype(np.float64)
+    if np.einsum("ij,ij->i", normals, skin - skin.mean(axis=0)).mean() < 0:  # wound inward: turn it
+        tris, normals = tris[:, ::-1], -normals
+    density = scalp_density(skin, normals, cards, card_triangles, floor_y=hairline_height(normals, skin[:, 2], eye_y, eye_z, hairline))
+    keep = tris[(density[tris] > 0.0).any(axis=1)]
+    if not len(keep):
+        return None
+    vertices = np.unique(keep)
+    local = np.full(n_skin, -1, np.int64)
+    local[vertices] = np.arange(len(vertices))
+    triangles = local[keep]
+    flow = flow_directions(skin[vertices], normals[vertices], cards, card_triangles, card_uv, triangles)
+    uv = strand_coordinates(skin[vertices], normals[vertices], flow, triangles) / np.asarray(TILE, np.float32)
+    return ScalpLayer(vertices=vertices, triangles=triangles.astype(np.int32), density=density[vertices],
+                      uv=uv.astype(np.float32), normals=normals[vertices].astype(np.float32))
+
+
+def card_cover(cards: np.ndarray, skin: np.ndarray, density: np.ndarray, *, reach: float = 0.06) -> np.ndarray:
+    """(V,) the scalp's hair density under each card vertex, for the cards to thin with it.
+
+    Cards within ``reach`` of the skin over a thinning hairline (0 < density < 1) take its
+    density, so they break up into strands there and fade into the scalp layer's fine hairs;
+    cards away from the skin, over full cover or over bare skin the scalp layer leaves alone
+    (a fringe over the forehead) keep 1.
+
+    Parameters
+    ----------
+    cards : (V, 3) float
+        Hair vertices on the neutral face.
+    skin, density : (N, 3), (N,) float
+        Skin vertices and the scalp's hair density there (0 where none grows).
+    """
+    from scipy.spatial import cKDTree
+
+    distance, nearest = cKDTree(np.asarray(skin, np.float64)).query(np.asarray(cards, np.float64))
+    d = np.asarray(density, np.float64)[nearest]
+    thinning = (1.0 - d) * smoothstep(0.0, 0.15, d) * smoothstep(reach, 0.5 * reach, distance)
+    return (1.0 - thinning).astype(np.float32)
+
+
+def card_samples(points: np.ndarray, triangles: np.ndarray, *, k: int = 4) -> np.ndarray:
+    """Points spread over the cards (a barycentric grid of ``k`` steps per triangle), so
+    distances to the hair are distances to its cards, not to its sparse vertices (cards
+    are a few centimetres across)."""
+    tri = np.asarray(points, np.float64)[np.asarray(triangles)]
+    a, b = np.meshgrid(np.arange(k + 1), np.arange(k + 1), indexing="ij")
+    keep = a + b <= k
+    bary = np.stack([a[keep], b[keep], k - a[keep] - b[keep]], axis=1) / k
+    return np.einsum("sk,tkd->tsd", bary, tri).reshape(-1, 3)

@@ -1,0 +1,128 @@
+"""The scalp's fine hair under the cards: where it grows, how it thins, how it follows the face."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from facsim.head import proxies, scalp
+
+
+def _grid(n=12, size=0.6, width=None):
+    """A flat skin patch in the z = 0 plane facing +z, (n*n, 3) points and its triangles."""
+    x, y = np.meshgrid(np.linspace(0, size if width is None else width, n), np.linspace(0, size, n))
+    points = np.column_stack([x.ravel(), y.ravel(), np.zeros(n * n)])
+    i = np.arange(n - 1)[:, None] * n + np.arange(n - 1)[None, :]
+    quads = np.stack([i, i + 1, i + n + 1, i + n], axis=-1).reshape(-1, 4)
+    triangles = np.concatenate([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]])
+    return points, triangles
+
+
+def test_density_is_full_under_the_cards_and_thins_past_their_edge():
+    skin, _ = _grid(25)
+    normals = np.tile([0.0, 0.0, 1.0], (len(skin), 1))
+    # a card 5 mm over the left half of the patch (quads of 2 cm, as MakeHuman's)
+    card, card_tris = _grid(31, 0.6, width=0.3)
+    card = card + [0.0, 0.0, 0.05]
+    density = scalp.scalp_density(skin, normals, card, card_tris)
+    x = skin[:, 0]
+    assert density[x < 0.2].min() > 0.95            # under the card: full cover
+    assert density[x > 0.42].max() < 0.05           # well past its edge: bare skin
+    edge = (x > 0.27) & (x < 0.36)
+    assert 0.05 < density[edge].mean() < 0.95       # a gradient at the hairline, not a step
+    # skin below the hairline's height grows none, whatever hangs over it
+    floored = scalp.scalp_density(skin, normals, card, card_tris, floor_y=0.3)
+    assert floored[skin[:, 1] < 0.25].max() == 0.0
+
+
+def test_strand_coordinates_follow_the_flow():
+    skin, tris = _grid(10, 0.3)
+    normals = np.tile([0.0, 0.0, 1.0], (len(skin), 1))
+    flow = np.tile([0.0, -1.0, 0.0], (len(skin), 1))     # hair running down
+    uv = scalp.strand_coordinates(skin, normals, flow, tris)
+    # v (along) grows down the patch, u (across) sideways
+    along = np.polyfit(skin[:, 1], uv[:, 1], 1)[0]
+    across = np.polyfit(skin[:, 0], uv[:, 0], 1)[0]
+    assert along == pytest.approx(-1.0, abs=0.05) and abs(across) == pytest.approx(1.0, abs=0.05)
+
+
+def test_strand_texture_tiles_and_ranks_are_uniform():
+    tex = scalp.strand_texture()
+    assert tex.shape == (256, 256, 4) and tex.dtype == np.uint8
+    rank = tex[..., 1].astype(float) / 255
+    assert abs(rank.mean() - 0.5) < 0.02 and np.percentile(rank, 90) > 0.85
+    # periodic: the last row and column continue into the first about as smoothly as inside
+    a = tex[..., 3].astype(float)
+    assert np.abs(a[0] - a[-1]).mean() < 2.0 * np.abs(a[1] - a[0]).mean() + 1.0
+
+
+def test_card_cover_thins_cards_only_over_a_thinning_hairline():
+    skin = np.array([[0.0, 0.0, 0.0], [0.1, 0.0, 0.0], [0.2, 0.0, 0.0]])
+    density = np.array([1.0, 0.5, 0.0])
+    cards = skin + [0.0, 0.0, 0.01]
+    cover = scalp.card_cover(cards, skin, density)
+    assert cover[0] == pytest.approx(1.0) and cover[2] == pytest.approx(1.0)  # full cover; a fringe over bare skin
+    assert cover[1] < 0.7
+    far = scalp.card_cover(skin + [0.0, 0.0, 0.2], skin, density)            # long hair away from the skin
+    assert np.allclose(far, 1.0)
+
+
+def test_presets_grow_scalp_hair_on_the_scalp_only(face_of):
+    face = face_of("george")
+    layer = face.scalp
+    assert layer is not None and layer.proxy.kind == "scalp" and layer.style == face.character.hair
+    geo = face.neutral
+    eyes = np.concatenate([np.asarray(v) for v in face.head.eye_vertices.values()])
+    eye_y = geo[eyes, 1].mean()
+    vertices = layer.binding.ref[:, 0]
+    grown = vertices[layer.shade > 0.5]
+    facing = layer.binding.offsets[layer.shade > 0.5] / scalp.LIFT         # the skin's normals there
+    front = facing[:, 2] > 0.7
+    assert front.any() and geo[grown[front], 1].min() > eye_y + 0.3     # none on the brow or the face
+    assert geo[grown, 1].min() > eye_y - 0.6                            # the nape, not the neck
+    top = np.argmax(geo[: face.head.skin_vertex_count, 1])
+    assert top in set(grown)                         # the crown is covered
+    # the layer lies just over the skin and follows it (head turn 51)
+    lift = np.linalg.norm(layer.binding.positions(geo) - geo[vertices], axis=1)
+    assert np.allclose(lift, scalp.LIFT, atol=1e-4)
+    turned = face.deform("51E").positions
+    assert np.allclose(layer.binding.positions(turned) - turned[vertices],
+                       layer.binding.positions(geo) - geo[vertices], atol=1e-6)
+    # the layer is drawn first, under every card, in the hair's colour
+    assert face.proxy_meshes[0].kind == "scalp"
+    draws = face.proxy_draws(geo)
+    assert draws[0].color == draws[1].color
+
+
+def test_contact_shadow_only_where_hair_grows(face_of):
+    face = face_of("george")
+    hair = next(b for b in face.proxies if b.proxy.kind == "hair")
+    skin = face.neutral[: face.head.skin_vertex_count]
+    cards = hair.binding.positions(face.neutral)
+    tris = hair.proxy.corner_vertex[hair.proxy.triangles]
+    bare = proxies.hair_shadow(skin, cards, triangles=tris, cast=0.0, cover=np.zeros(len(skin)))
+    full = proxies.hair_shadow(skin, cards, triangles=tris, cast=0.0, cover=np.ones(len(skin)))
+    assert bare.min() == pytest.approx(1.0) and full.min() < 0.6
+
+
+def test_greying_hair_is_drawn_as_pigmented_and_white_strands(face_of):
+    from facsim.head.colour import srgb_to_linear
+
+    old = face_of("george")
+    pigment, white, fraction = old._hair_greying
+    assert 0.5 < fraction <= 1.0
+    mean = (1 - fraction) * srgb_to_linear(pigment) + fraction * srgb_to_linear(white)
+    assert np.allclose(mean, srgb_to_linear(old.colors["hair"]), atol=0.02)
+    assert face_of("ava")._hair_greying[2] == 0.0
+    # a colour set outright (the same young and old) is kept as it is
+    assert proxies.hair_greying((0.1, 0.1, 0.1), (0.1, 0.1, 0.1), (0.7, 0.7, 0.7))[2] == 0.0
+
+
+def test_hair_lying_on_the_skin_casts_no_shadow_down_the_cheeks(face_of):
+    face = face_of("george")  # short04: its side cards lie on the temples, down to the cheeks
+    hair = next(b for b in face.proxies if b.proxy.kind == "hair")
+    skin = face.neutral[: face.head.skin_vertex_count]
+    cards = hair.binding.positions(face.neutral)
+    cast = proxies.hair_shadow(skin, cards, triangles=hair.proxy.corner_vertex[hair.proxy.triangles], strength=0.0)
+    eyes = np.concatenate([np.asarray(v) for v in face.head.eye_vertices.values()])
+    cheeks = skin[:, 1] < face.neutral[eyes, 1].mean() - 0.2
+    assert (cast[cheeks] < 0.9).mean() < 0.01
