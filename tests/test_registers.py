@@ -7,7 +7,8 @@ import pytest
 from facsim.facs.catalogue import catalogue
 from facsim.facs.activations import Activations, activations
 from facsim.facs.notation import parse
-from facsim.engines.registers import combine_registers, register_table, register_weights, simulated_codes
+from facsim.engines.registers import (combine_registers, register_table, register_weights, response,
+                                     response_inverse, simulated_codes)
 from facsim.engines.rigid import rigid_table
 
 X, Y, Z = 0, 1, 2
@@ -118,7 +119,21 @@ def test_eq1_sums_shared_registers_and_clamps_to_the_smallest_max():
     weights = register_weights(Activations({(42, "left"): 0.2, (4, "left"): 0.2}))
     shared = [w for c, w in weights.items() if c.target == "faceunits/browDownLeft"]
     assert len(weights) == 2  # browDown shared, eyebrows-down summed as well
-    assert shared == [pytest.approx(0.32)]  # 0.2·1.0 + 0.2·0.6, under min(1.0, 0.6)
+    # each AU at the engine's response to 0.2: r·1.0 + r·0.6, under min(1.0, 0.6)
+    assert shared == [pytest.approx(1.6 * response(0.2))] and 1.6 * response(0.2) < 0.6
+
+
+def test_response_is_concave_from_rest_to_e():
+    """Issue 13: an AU at intensity x moves its targets by more than x of the way (skin stiffens),
+    rising steadily from rest (0) to E (1); the inverse reads the intensity back."""
+    levels = np.linspace(0.0, 1.0, 21)
+    weights = np.array([response(x) for x in levels])
+    assert weights[0] == 0.0 and weights[-1] == pytest.approx(1.0)
+    assert np.all(np.diff(weights) > 0) and np.all(np.diff(weights, 2) < 0)   # rising, concave
+    assert 0.55 < response(0.5) < 0.7                                         # HapFACS's 50 % is over half-way
+    assert [response_inverse(w) for w in weights] == pytest.approx(levels)
+    half = register_weights(Activations({(12, "left"): 0.5}))
+    assert {c.target: w for c, w in half.items()}["faceunits/mouthSmileLeft"] == pytest.approx(response(0.5))
 
 
 def test_eq1_never_undoes_the_strongest_au():
