@@ -349,3 +349,37 @@ def test_anger_glares_under_knitted_brows(engine, marks, level):
         return delta[marks["inner_brow_left"], 0] - delta[marks["inner_brow_right"], 0]
 
     assert knit(anger) < knit(disgust) < 0.0
+
+
+@pytest.mark.parametrize("level", [1.0, 0.5])
+def test_surprise_is_not_fear(engine, marks, level):
+    """Session 12 (surprise named fear 5 times in 12): surprise's brows rise in an even arch, outer
+    ends highest, barely drawn together; fear's are drawn together and straightened, inner ends as
+    high as the outer. Surprise's relaxed jaw hangs open in a tall oval narrower than at rest;
+    fear's lips are stretched wider than at rest."""
+    surprise, fear = (_emotion_moved(engine, name, level) for name in ("surprise", "fear"))
+
+    def knit(delta):
+        return delta[marks["inner_brow_left"], 0] - delta[marks["inner_brow_right"], 0]
+
+    def tilt(delta):   # inner end of the brow over its outer end, from rest
+        return delta[marks["inner_brow_left"], 1] - delta[marks["outer_brow_left"], 1]
+
+    def widening(delta):
+        return delta[marks["lip_corner_left"], 0] - delta[marks["lip_corner_right"], 0]
+
+    assert knit(fear) < knit(surprise) - 0.02 * level
+    assert tilt(surprise) < -0.01 * level and tilt(fear) > -0.005
+    assert widening(surprise) < 0.0 < 0.05 * level < widening(fear)
+    opening = surprise[marks["upper_lip"], 1] - surprise[marks["lower_lip"], 1]
+    assert opening > 0.12 * level
+
+
+def test_half_an_emotion_shows_more_than_half_its_movement(engine, marks):
+    """Session 12 (50 % smiles read as neutral, 50 % sadness as neutral): at half intensity each
+    AU goes 0.62 of the way (the concave response), so a half smile lifts its corners over 6 mm
+    and half sadness still tilts the brows up at their inner ends by over 5 mm."""
+    full, half = (_emotion_moved(engine, "happiness", level)[marks["lip_corner_left"], 1] for level in (1.0, 0.5))
+    assert half > 0.06 and half > 0.6 * full
+    sad = _emotion_moved(engine, "sadness", 0.5)
+    assert sad[marks["inner_brow_left"], 1] - sad[marks["outer_brow_left"], 1] > 0.05
