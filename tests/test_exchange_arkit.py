@@ -9,7 +9,7 @@ import pytest
 from facsim.exchange import ExchangeError, load_any_timeline, read_arkit_csv, write_arkit_csv
 from facsim.exchange.arkit import arkit_weights, csv_columns, inverse_map, shape_names
 from facsim.facs.activations import Activations
-from facsim.engines.registers import register_table
+from facsim.engines.registers import register_table, response
 from facsim.timeline.model import Envelope, Hold, Segment, Timeline, Track
 from facsim.timeline.sampling import activation_curves, frame_times
 
@@ -58,17 +58,19 @@ def test_weights_are_the_registers_faceunits_targets():
                 name = reg["target"][len("faceunits/"):].replace("{Side}", "Left")
                 assert weights[name] >= min(reg["max"], 1.0) - 1e-9, (code, name)
     weights = arkit_weights(Activations({(12, "left"): 0.5}))
-    assert weights["mouthSmileLeft"] == pytest.approx(0.5) and weights["mouthSmileRight"] == 0.0
+    half = response(0.5)   # the engine's concave response: half intensity moves more than half-way
+    assert weights["mouthSmileLeft"] == pytest.approx(half) and weights["mouthSmileRight"] == 0.0
     squint = [r["max"] for r in register_table()["action_units"][12]["registers"]
               if r["target"] == "faceunits/cheekSquint{Side}"]
-    assert weights["cheekSquintLeft"] == pytest.approx(0.5 * squint[0])  # 12's cheek raise at half
+    assert weights["cheekSquintLeft"] == pytest.approx(half * squint[0])  # 12's cheek raise at half
     both = arkit_weights(Activations({(6, "left"): 1.0, (7, "left"): 1.0}))
     maxima = [reg["max"] for code in (6, 7) for reg in register_table()["action_units"][code]["registers"]
               if reg["target"] == "faceunits/eyeSquint{Side}"]
     # Eq. 1 clamps the sum to the smaller max, but never below the stronger AU alone (7's 1.0).
     assert len(maxima) == 2 and both["eyeSquintLeft"] == pytest.approx(max(maxima))
-    weak = arkit_weights(Activations({(6, "left"): 0.4, (7, "left"): 0.3}))
-    assert weak["eyeSquintLeft"] == pytest.approx(min(0.4 * maxima[0] + 0.3 * maxima[1], min(maxima)))
+    weak = arkit_weights(Activations({(6, "left"): 0.4, (7, "left"): 0.2}))   # neither alone reaches 0.35
+    assert weak["eyeSquintLeft"] == pytest.approx(min(response(0.4) * maxima[0] + response(0.2) * maxima[1],
+                                                      min(maxima)))
 
 
 def test_inverse_map_is_unambiguous():

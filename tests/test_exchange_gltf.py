@@ -16,6 +16,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from facsim.exchange.gltf import METRES, glb_bytes, morph_target_keys, target_name
+from facsim.engines.registers import response
 from facsim.facs.activations import Activations
 from facsim.timeline.model import Envelope, Hold, Timeline, Track
 from facsim.timeline.sampling import frame_count, frame_times, sample
@@ -168,8 +169,10 @@ def test_animation_has_weights_head_and_eye_channels_sampled_per_frame(animated)
     weights = accessor(doc, blob, by_target["face", "weights"]["output"]).reshape(n, len(names))
     frame = 5                                                       # t = 0.5 s
     act = sample(TIMELINE, frame / 10)
-    assert weights[frame, names.index("AU12_L")] == pytest.approx(act[12, "left"])
-    assert weights[frame, names.index("AU26")] == pytest.approx(act.level(26))
+    # each target is its AU at E, weighted as the register engine moves it (its concave response)
+    assert weights[frame, names.index("AU12_L")] == pytest.approx(response(act[12, "left"]))
+    assert weights[frame, names.index("AU26")] == pytest.approx(response(act.level(26)))
+    assert 0.0 < act.level(26) < response(act.level(26)) < 1.0
     quats = accessor(doc, blob, by_target["head", "rotation"]["output"])
     assert np.allclose(np.linalg.norm(quats, axis=1), 1.0, atol=1e-6)
     rotvec = Rotation.from_quat(quats[frame]).as_rotvec(degrees=True)

@@ -7,7 +7,8 @@ import pytest
 from facsim.facs.catalogue import catalogue
 from facsim.facs.activations import Activations, activations
 from facsim.facs.notation import parse
-from facsim.engines.registers import combine_registers, register_table, register_weights, simulated_codes
+from facsim.engines.registers import (combine_registers, register_table, register_weights, response,
+                                     response_inverse, simulated_codes)
 from facsim.engines.rigid import rigid_table
 
 X, Y, Z = 0, 1, 2
@@ -118,7 +119,21 @@ def test_eq1_sums_shared_registers_and_clamps_to_the_smallest_max():
     weights = register_weights(Activations({(42, "left"): 0.2, (4, "left"): 0.2}))
     shared = [w for c, w in weights.items() if c.target == "faceunits/browDownLeft"]
     assert len(weights) == 2  # browDown shared, eyebrows-down summed as well
-    assert shared == [pytest.approx(0.32)]  # 0.2·1.0 + 0.2·0.6, under min(1.0, 0.6)
+    # each AU at the engine's response to 0.2: r·1.0 + r·0.6, under min(1.0, 0.6)
+    assert shared == [pytest.approx(1.6 * response(0.2))] and 1.6 * response(0.2) < 0.6
+
+
+def test_response_is_concave_from_rest_to_e():
+    """Issue 13: an AU at intensity x moves its targets by more than x of the way (skin stiffens),
+    rising steadily from rest (0) to E (1); the inverse reads the intensity back."""
+    levels = np.linspace(0.0, 1.0, 21)
+    weights = np.array([response(x) for x in levels])
+    assert weights[0] == 0.0 and weights[-1] == pytest.approx(1.0)
+    assert np.all(np.diff(weights) > 0) and np.all(np.diff(weights, 2) < 0)   # rising, concave
+    assert 0.55 < response(0.5) < 0.7                                         # HapFACS's 50 % is over half-way
+    assert [response_inverse(w) for w in weights] == pytest.approx(levels)
+    half = register_weights(Activations({(12, "left"): 0.5}))
+    assert {c.target: w for c, w in half.items()}["faceunits/mouthSmileLeft"] == pytest.approx(response(0.5))
 
 
 def test_eq1_never_undoes_the_strongest_au():
@@ -334,3 +349,37 @@ def test_anger_glares_under_knitted_brows(engine, marks, level):
         return delta[marks["inner_brow_left"], 0] - delta[marks["inner_brow_right"], 0]
 
     assert knit(anger) < knit(disgust) < 0.0
+
+
+@pytest.mark.parametrize("level", [1.0, 0.5])
+def test_surprise_is_not_fear(engine, marks, level):
+    """Session 12 (surprise named fear 5 times in 12): surprise's brows rise in an even arch, outer
+    ends highest, barely drawn together; fear's are drawn together and straightened, inner ends as
+    high as the outer. Surprise's relaxed jaw hangs open in a tall oval narrower than at rest;
+    fear's lips are stretched wider than at rest."""
+    surprise, fear = (_emotion_moved(engine, name, level) for name in ("surprise", "fear"))
+
+    def knit(delta):
+        return delta[marks["inner_brow_left"], 0] - delta[marks["inner_brow_right"], 0]
+
+    def tilt(delta):   # inner end of the brow over its outer end, from rest
+        return delta[marks["inner_brow_left"], 1] - delta[marks["outer_brow_left"], 1]
+
+    def widening(delta):
+        return delta[marks["lip_corner_left"], 0] - delta[marks["lip_corner_right"], 0]
+
+    assert knit(fear) < knit(surprise) - 0.02 * level
+    assert tilt(surprise) < -0.01 * level and tilt(fear) > -0.005
+    assert widening(surprise) < 0.0 < 0.05 * level < widening(fear)
+    opening = surprise[marks["upper_lip"], 1] - surprise[marks["lower_lip"], 1]
+    assert opening > 0.12 * level
+
+
+def test_half_an_emotion_shows_more_than_half_its_movement(engine, marks):
+    """Session 12 (50 % smiles read as neutral, 50 % sadness as neutral): at half intensity each
+    AU goes 0.62 of the way (the concave response), so a half smile lifts its corners over 6 mm
+    and half sadness still tilts the brows up at their inner ends by over 5 mm."""
+    full, half = (_emotion_moved(engine, "happiness", level)[marks["lip_corner_left"], 1] for level in (1.0, 0.5))
+    assert half > 0.06 and half > 0.6 * full
+    sad = _emotion_moved(engine, "sadness", 0.5)
+    assert sad[marks["inner_brow_left"], 1] - sad[marks["outer_brow_left"], 1] > 0.05

@@ -2,7 +2,8 @@
 
 Each AU drives a set of ⟨target, maximum weight⟩ pairs read from
 ``facsim/data/registers.yaml``; targets shared by several active AUs combine by
-HapFACS Eq. 1 (:func:`combine_registers`). Head codes 51–58 move the head
+HapFACS Eq. 1 (:func:`combine_registers`), each AU at :func:`response` of its
+intensity (concave: skin stiffens as it stretches). Head codes 51–58 move the head
 rigidly with a smooth blend into the neck, eye codes 61–66 rotate the
 eyeballs about their centres (and the lids follow vertical gaze via registers).
 
@@ -15,6 +16,7 @@ Examples
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import cached_property, lru_cache
 from typing import Iterable
@@ -45,6 +47,32 @@ def register_table() -> dict:
 def simulated_codes() -> set[int]:
     """AU codes this engine renders."""
     return set(register_table()["action_units"]) | rigid_codes()
+
+
+def response(level: float) -> float:
+    """The share of its registers' maxima an AU reaches at intensity ``level`` (0..1).
+
+    ``ln(1 + k·level) / ln(1 + k)`` with ``k`` the table's ``response: stiffening``:
+    0 at 0, 1 at 1, concave, as skin that stiffens as it stretches moves under a
+    growing pull (the reasoning and the fit are in ``registers.yaml``).
+
+    >>> response(0.0), response(1.0)
+    (0.0, 1.0)
+    >>> round(response(0.5), 2)
+    0.62
+    """
+    k = float(register_table()["response"]["stiffening"])
+    return math.log1p(k * level) / math.log1p(k)
+
+
+def response_inverse(weight: float) -> float:
+    """The intensity whose :func:`response` is ``weight`` (0..1): reads levels back from weights.
+
+    >>> round(response_inverse(response(0.3)), 12)
+    0.3
+    """
+    k = float(register_table()["response"]["stiffening"])
+    return math.expm1(weight * math.log1p(k)) / k
 
 
 def combine_registers(contributions: Iterable[tuple[float, float]]) -> float:
@@ -97,7 +125,9 @@ def _expand(pattern: str, side: str) -> tuple[str, bool]:
 def register_weights(act: Activations) -> dict[Column, float]:
     """Column weights for ``act`` by Eq. 1 — the pure heart of the engine.
 
-    A two-sided target used by an AU on one side only is split at the midline:
+    Each AU takes :func:`response` of its intensity times each register's maximum
+    (the combination rules, read from intensities, may scale the maximum). A
+    two-sided target used by an AU on one side only is split at the midline:
     it gets a left and a right column, each weighted by its own side's AUs.
     """
     table = register_table()["action_units"]
@@ -106,9 +136,10 @@ def register_weights(act: Activations) -> dict[Column, float]:
         if table.get(code, {}).get("direction") and side == "right" and act[code, "left"] == level:
             continue  # a direction code given without a side (e.g. 30) moves to the left only
         scale = combination_scales(act, code, side)
+        weight = response(level)
         for reg in table.get(code, {}).get("registers", []):
             vmax = float(reg["max"]) * scale.get(reg["target"], 1.0)
-            contributions.setdefault(Column(reg["target"], side), []).append((level, vmax))
+            contributions.setdefault(Column(reg["target"], side), []).append((weight, vmax))
     return {col: combine_registers(pairs) for col, pairs in contributions.items()}
 
 

@@ -3,7 +3,8 @@
 AUs → ARKit
     The register engine's own ``faceunits/<ARKit name>`` registers
     (``facsim/data/registers.yaml``) are the mapping: a frame's activations
-    go through :func:`facsim.registers.register_weights` (HapFACS Eq. 1) and
+    go through :func:`facsim.registers.register_weights` (HapFACS Eq. 1, with
+    the engine's concave intensity response) and
     each Face Units register is an ARKit shape. A shape without a side
     (``jawOpen``) takes the mean of its two halves. Sideways gaze
     (``eyeLookIn/Out``), which no register drives, comes from the eyes' yaw,
@@ -15,7 +16,8 @@ ARKit → AUs
     Per frame, the AU levels whose ARKit weights best match the frame's:
     ``scipy.optimize.lsq_linear`` over the same map (one column per AU, or per
     AU and side where the AU can act on one side and its shapes have sides),
-    bounded to 0..1 (non-negative least squares with a ceiling), plus a small
+    bounded to 0..1 (non-negative least squares with a ceiling; the shares
+    become intensities through the inverse of the engine's response), plus a small
     ridge (:data:`RIDGE`) so that where several AU mixes give the same shapes
     (AU25 is AU26 at 0.13 plus AU16 at 0.32) the answer is unique: the
     smallest levels; levels under :data:`LEVEL_FLOOR` are dropped. AUs whose
@@ -211,6 +213,14 @@ def au_levels(weights: np.ndarray) -> np.ndarray:
     for i, row in enumerate(weights):
         if row.any():
             out[i] = lsq_linear(ridged, np.concatenate([row, padding]), bounds=(0.0, 1.0), method="bvls").x
+    # The solve gives each AU's share of its shapes; register-driven AUs reach that share at
+    # a lower intensity (the engine's concave response), sideways gaze (61/62) linearly.
+    from facsim.engines.registers import register_table, response_inverse
+
+    morphs = register_table()["action_units"]
+    for j, (code, _) in enumerate(unknowns):
+        if code in morphs:
+            out[:, j] = [response_inverse(u) for u in np.clip(out[:, j], 0.0, 1.0)]
     out[out < LEVEL_FLOOR] = 0.0
     return np.clip(out, 0.0, 1.0)
 

@@ -238,8 +238,15 @@ def target_name(code: int, side: str) -> str:
 
 
 def target_weights(act, keys) -> np.ndarray:
-    """Morph weights of one frame's activations (one per key of :func:`morph_target_keys`)."""
-    return np.array([act.level(code) if side == "both" else act[code, side] for code, side in keys], np.float32)
+    """Morph weights of one frame's activations (one per key of :func:`morph_target_keys`).
+
+    Each target is its AU at E; at a lower intensity it moves as the register engine's
+    AU does, by the engine's concave :func:`~facsim.engines.registers.response`.
+    """
+    from facsim.engines.registers import response
+
+    return np.array([response(act.level(code) if side == "both" else act[code, side]) for code, side in keys],
+                    np.float32)
 
 
 def _quaternions(rotvecs: np.ndarray) -> np.ndarray:
