@@ -304,7 +304,7 @@ void main() {
     // nasolabial fold and the crow's feet, raised brows the forehead lines, on any face (the
     // lines of a young face show only then).
 #ifdef USE_WRINKLE
-    float line_depth = min(u_age + 1.2 * smoothstep(0.03, 0.35, v_wrinkle), 1.5);
+    float line_depth = min(u_age + 0.5 * smoothstep(0.03, 0.35, v_wrinkle), 1.5);
 #else
     float line_depth = u_age;
 #endif
