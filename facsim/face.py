@@ -178,7 +178,7 @@ class Face:
         from facsim.engines.checks import head_rotation
         from facsim.engines.lids import lashes_turned_with_lids
 
-        roots, eye_of, vectors = self._lash_roots(id(bound))
+        roots, eye_of, vectors = self._lash_roots[id(bound)]
         p = np.asarray(positions)
         eyes = list(self.head.eye_vertices.values())
         centres = np.array([p[v].mean(axis=0) for v in eyes])[eye_of]
@@ -186,25 +186,24 @@ class Face:
         rotation = head_rotation(self.neutral[self._skull], p[self._skull])
         return lashes_turned_with_lids(p[roots], self.neutral[roots], vectors, centres, rest_centres, rotation)
 
-    def _lash_roots(self, key: int):
-        """(roots, eye index, root-to-vertex vectors) of a lash proxy's vertices on the neutral
-        face: each vertex's root is the nearest lid-margin vertex."""
-        if key not in self._lash_cache:
-            from scipy.spatial import cKDTree
-
-            bound = next(b for b in self.proxies if id(b) == key)
-            rest = bound.binding.positions(self.neutral)
-            margins = [np.concatenate([upper, lower]) for _, upper, lower in self._lid_margins.values()]
-            every = np.concatenate(margins)
-            nearest = cKDTree(self.neutral[every]).query(rest)[1]
-            eye_of = np.repeat(np.arange(len(margins)), [len(m) for m in margins])[nearest]
-            roots = every[nearest]
-            self._lash_cache[key] = (roots, eye_of, (rest - self.neutral[roots]).astype(np.float64))
-        return self._lash_cache[key]
-
     @cached_property
-    def _lash_cache(self) -> dict:
-        return {}
+    def _lash_roots(self) -> dict:
+        """id(lash proxy) -> (roots, eye index, root-to-vertex vectors) of its vertices on the
+        neutral face: each vertex's root is the nearest lid-margin vertex."""
+        from scipy.spatial import cKDTree
+
+        margins = [np.concatenate([upper, lower]) for _, upper, lower in self._lid_margins.values()]
+        every = np.concatenate(margins)
+        margin_eye = np.repeat(np.arange(len(margins)), [len(m) for m in margins])
+        tree = cKDTree(self.neutral[every])
+        roots = {}
+        for bound in self.proxies:
+            if bound.proxy.kind == "eyelashes":
+                rest = bound.binding.positions(self.neutral)
+                nearest = tree.query(rest)[1]
+                root = every[nearest]
+                roots[id(bound)] = (root, margin_eye[nearest], (rest - self.neutral[root]).astype(np.float64))
+        return roots
 
     @cached_property
     def _skull(self) -> np.ndarray:

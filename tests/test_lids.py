@@ -92,7 +92,7 @@ def test_lashes_turn_with_the_closing_lid(face_of):
     lashes = next(b for b in face.proxies if b.proxy.kind == "eyelashes")
     rest = face._proxy_positions(lashes, face.neutral)
     assert np.allclose(rest, lashes.binding.positions(face.neutral), atol=1e-5)
-    roots, _, _ = face._lash_roots(id(lashes))
+    roots, _, _ = face._lash_roots[id(lashes)]
     upper = np.isin(roots, np.concatenate([m[1] for m in face._lid_margins.values()]))
     closed = np.asarray(face.deform("45E").positions)
     turned = face._proxy_positions(lashes, closed)
