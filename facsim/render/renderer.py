@@ -459,9 +459,10 @@ class Renderer:
         occlusion : (N_geo,) float in [0, 1], optional
             Ambient visibility per geometry vertex (1 = open), e.g. from
             :func:`bake_occlusion` on the neutral pose; it darkens sockets and creases on
-            skin, eyeballs and lashes, and dims teeth, tongue and mouth interior only down
-            to a floor (55 / 45 / 35 %), so occlusion baked on a closed mouth still lets an
-            open one show. Default: all 1.
+            skin, eyeballs and lashes. The mouth's parts read it per frame from
+            :func:`facsim.head.mouth.mouth_light` (teeth: their height below the upper lip's
+            edge; tongue: the light the parted lips let in) and the mouth interior from
+            :func:`facsim.head.mouth.mouth_depth_visibility`. Default: all 1.
         lighting : Lighting, optional
             Overrides the renderer's rig for this frame.
         proxies : sequence of :class:`~facsim.render.proxies.ProxyDraw`
