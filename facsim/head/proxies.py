@@ -388,6 +388,8 @@ class BoundProxy:
     density: float = 1.0  # brows and lashes: how much of the skin their hairs cover (0 … 1)
     neutral: np.ndarray | None = None  # (V, 3) positions on the neutral face
     shade: np.ndarray | None = None  # (V,) the scalp layer's hair density (see :attr:`depth`)
+    strand_points: int = 0  # wisps: points per strand (facsim.head.wisps)
+    strand_width: float = 0.0  # wisps: a strand's width (dm) at its root
 
     @cached_property
     def depth(self) -> np.ndarray:
@@ -395,7 +397,8 @@ class BoundProxy:
         layers … 1 in the open (:func:`hair_exposure`, self-shadowing). Lashes: 0 at the
         lid … 1 at the tips (tapering). Brows:
         0 at each brow's head … 1 at its tail (:func:`along_brow`), where the hairs thin.
-        Scalp: the hair's density on the skin (:mod:`facsim.head.scalp`)."""
+        Scalp: the hair's density on the skin (:mod:`facsim.head.scalp`). Wisps: 0 at each
+        strand's root … 1 at its tip."""
         if self.shade is not None:
             return np.asarray(self.shade, np.float32)
         if self.proxy.kind == "eyebrows" and self.neutral is not None:
@@ -425,13 +428,15 @@ class BoundProxy:
 
     @property
     def style(self) -> str:
-        """The proxy's name; a scalp layer's is its hairstyle's (it is that hair's roots)."""
-        return self.proxy.name.removesuffix(SCALP_SUFFIX)
+        """The proxy's name; a scalp layer's or loose strands' is their hairstyle's."""
+        return self.proxy.name.removesuffix(SCALP_SUFFIX).removesuffix(WISPS_SUFFIX)
 
 
 COLOR_KEY = {"hair": "hair", "eyebrows": "brows", "eyelashes": "lashes"}
 #: A scalp layer's name is its hairstyle's with this suffix (:func:`bind_scalp`).
 SCALP_SUFFIX = "-scalp"
+#: Loose strands' name is their hairstyle's with this suffix (:func:`bind_wisps`).
+WISPS_SUFFIX = "-wisps"
 
 
 def hair_greying(mean: tuple, young: tuple, white: tuple) -> tuple[tuple, tuple, float]:
@@ -503,6 +508,29 @@ def bind_scalp(hair: BoundProxy, head, neutral_geometry: np.ndarray, *, cache: P
                   png=b"", author="facsim", license="CC0", image=strand_texture())
     binding = FrameBinding(ref=ref, weights=weights, offsets=(LIFT * normals).astype(np.float32))
     return BoundProxy(proxy, binding, "hair", 1.0, binding.positions(geo), shade=layer.density)
+
+
+def bind_wisps(hair: BoundProxy, head, neutral_geometry: np.ndarray) -> BoundProxy | None:
+    """Loose strands over ``hair``'s cards (:mod:`facsim.head.wisps`, ``wisps:`` in
+    ``facsim/data/hair.yaml``), each point bound as the hair vertex nearest to it, or None
+    where the style grows none."""
+    from facsim.head.wisps import grow_wisps, strand_profile, wisp_style
+
+    style = wisp_style(hair_table().get("wisps", {}), hair.style)
+    if style is None or hair.neutral is None:
+        return None
+    wisps = grow_wisps(hair.neutral, hair.proxy.triangles, hair.proxy.corner_vertex, hair.proxy.uv, hair.depth,
+                       style, texture=hair.proxy.texture, seed=hair.style)
+    ref = hair.binding.ref[wisps.anchor]
+    weights = hair.binding.weights[wisps.anchor]
+    anchor = np.einsum("vk,vkd->vd", weights, np.asarray(neutral_geometry, np.float32)[ref])
+    binding = FrameBinding(ref=ref, weights=weights, offsets=(wisps.points - anchor).astype(np.float32))
+    triangles, corner_vertex, uv = wisps.ribbon()
+    proxy = Proxy(name=hair.proxy.name + WISPS_SUFFIX, kind="wisps", ref=np.asarray(head.base_index)[ref],
+                  weights=weights, offsets=binding.offsets, triangles=triangles, corner_vertex=corner_vertex, uv=uv,
+                  png=b"", author="facsim", license="CC0", image=strand_profile())
+    return BoundProxy(proxy, binding, "hair", style.alpha, binding.positions(neutral_geometry), shade=wisps.along,
+                      strand_points=wisps.per_strand, strand_width=0.01 * style.width_mm)
 
 
 def hair_exposure(points: np.ndarray, triangles: np.ndarray, *, reach: float = 0.3,

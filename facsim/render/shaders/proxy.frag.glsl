@@ -1,7 +1,7 @@
 // Proxy fragment shader: hair, eyebrow and eyelash cards cut out by their texture's alpha.
 // Variants (#defines from facsim/render/proxies.py): PASS_OPAQUE (alpha-tested, writes depth) or
 // PASS_BLEND (the soft fringe, blended back to front); KIND_HAIR, KIND_EYEBROWS, KIND_EYELASHES,
-// KIND_SCALP; COILY for coily hair (its curls cost llvmpipe time even where a uniform skips them).
+// KIND_SCALP, KIND_WISPS; COILY for coily hair (its curls cost llvmpipe time even where a uniform skips them).
 
 #include "common.glsl"
 
@@ -111,6 +111,34 @@ void main() {
 #endif
     vec3 albedo = hair_colour(suv * vec2(8.0, 2.0)) * (0.55 + 0.9 * tex.r) * shade * curl;
     f_color = vec4(finish(albedo * lit).rgb, alpha);
+}
+#elif defined(KIND_WISPS)
+// Loose strands over the hair (facsim/head/wisps.py): thin ribbons turned toward the camera
+// (proxy.vert.glsl), drawn blended after the cards in the hair's colour. v_depth: 0 at the
+// root ... 1 at the tip; v_cover: the share of the drawn width the strand covers; tex.a: the
+// cover across the ribbon (soft at its sides).
+void main() {
+#ifdef PASS_OPAQUE
+    discard;
+#endif
+    vec4 tex = texture(u_texture, v_uv);
+    // Faint where it leaves the mass, then thinning to nothing at the tip.
+    float alpha = tex.a * v_cover * u_density * smoothstep(0.0, 0.15, v_depth) * (1.0 - smoothstep(0.55, 1.0, v_depth));
+    if (alpha < 0.01) discard;
+    vec3 n = normalize(v_normal);
+    vec3 t = normalize(v_tangent);
+    vec3 v = normalize(u_cam_pos - v_pos);
+    float kl = clamp(dot(n, u_key_dir) * 0.5 + 0.5, 0.0, 1.0);
+    float dk = strand_diffuse(t, u_key_dir) * kl * 1.1;
+    float df = clamp(dot(n, u_fill_dir) * 0.5 + 0.5, 0.0, 1.0);
+    // Stray hairs against the background catch the rim light through their edges.
+    float dr = clamp(dot(n, u_rim_dir) * 0.5 + 0.5, 0.0, 1.0);
+    vec3 lit = dk * u_key_col + df * u_fill_col + 0.5 * dr * u_rim_col + hemisphere(n) * 0.7;
+    vec3 h = normalize(u_key_dir + v);
+    float th = dot(t, h);
+    vec3 spec = u_key_col * 0.12 * u_sheen * exp2(30.0 * log2(max(1.0 - th * th, 1e-6)));
+    vec3 albedo = hair_colour(v_uv * vec2(1.0, 3.0) + v_rest.xy * 40.0);
+    f_color = vec4(finish(albedo * lit * 0.75 + spec).rgb, alpha);
 }
 #else
 void main() {
