@@ -107,7 +107,7 @@ class Face:
         import hashlib
 
         from facsim.head.assets import cache_dir
-        from facsim.head.proxies import bind_scalp, hair_table
+        from facsim.head.proxies import bind_scalp, hair_table, hair_volume
         from facsim.head.scalp import VERSION
 
         hair = [b for b in self.proxies if b.proxy.kind == "hair"]
@@ -115,7 +115,8 @@ class Face:
             return None
         # Cached on disk like the occlusion bake: by the head's shape, the style and its table.
         shape = self.character.with_(name="", description="", colors={}, hair="", brows="", lashes="")
-        key = hashlib.sha256(repr((VERSION, shape, hair[0].proxy.name, hair_table().get("scalp")))
+        key = hashlib.sha256(repr((VERSION, shape, hair[0].proxy.name, hair_table().get("scalp"),
+                                   hair_volume(hair[0].proxy.name)))
                              .encode()).hexdigest()[:16]
         return bind_scalp(hair[0], self.head, self.neutral, cache=cache_dir() / "scalp" / f"{key}.npy")
 

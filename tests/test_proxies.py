@@ -214,3 +214,16 @@ def test_coily_hair_is_drawn_as_coily(face_of):
     draws = {m.kind: d for d, m in zip(face.proxy_draws(face.neutral), face.proxy_meshes)}
     assert draws["hair"].coil == 1.0 and draws["hair"].sheen < 1.0
     assert face_of("ava").proxy_draws(face_of("ava").neutral)[0].coil == 0.0
+
+
+def test_afro_stands_off_the_skull_but_meets_the_skin_at_the_hairline(face_of):
+    face = face_of("amara")  # afro01, volume_mm in hair.yaml
+    hair = next(b for b in face.proxies if b.proxy.kind == "hair")
+    mm = proxies.hair_volume("afro01")
+    assert mm > 0 and proxies.hair_volume("long01") == 0.0
+    offset = proxies.hair_volume_offset("afro01", hair.neutral, face.head, face.neutral)
+    lift = np.linalg.norm(offset, axis=1)
+    y = hair.neutral[:, 1]
+    assert np.allclose(lift[y > np.percentile(y, 90)], 0.01 * mm, rtol=1e-3)
+    assert np.median(lift[y < np.percentile(y, 5)]) < 0.1 * 0.01 * mm
+    assert not proxies.hair_volume_offset("long01", hair.neutral, face.head, face.neutral).any()

@@ -366,6 +366,8 @@ def bind_to_frame(proxy: Proxy, head, base_positions: np.ndarray, neutral_geomet
         ref, weights, fitted = place_brows(fitted, skin_now, tris, look)
         anchor = np.einsum("vk,vkd->vd", weights, skin_now[ref])
         return FrameBinding(ref=ref, weights=weights, offsets=(fitted - anchor).astype(np.float32))
+    if proxy.kind == "hair":
+        fitted = fitted + hair_volume_offset(proxy.name, fitted, head, neutral_geometry)
     ref = geo_of_base[proxy.ref]
     missing = ref < 0
     if missing.any():
@@ -373,6 +375,49 @@ def bind_to_frame(proxy: Proxy, head, base_positions: np.ndarray, neutral_geomet
         ref[missing] = tree.query(np.asarray(base_positions)[proxy.ref[missing]])[1]
     anchor = np.einsum("vk,vkd->vd", proxy.weights, np.asarray(neutral_geometry, np.float32)[ref])
     return FrameBinding(ref=ref, weights=proxy.weights, offsets=(fitted - anchor).astype(np.float32))
+
+
+#: Height (dm) above the hairline over which a hairstyle's extra volume fades in.
+VOLUME_FADE = 0.3
+
+
+def hair_volume(style: str) -> float:
+    """Millimetres ``style``'s cards stand further off the skull (``volume_mm:`` in
+    ``facsim/data/hair.yaml``, default 0)."""
+    return float(hair_table().get("volume_mm", {}).get(style, 0.0))
+
+
+def hair_volume_offset(style: str, fitted: np.ndarray, head, neutral_geometry: np.ndarray) -> np.ndarray:
+    """(V, 3) offsets (dm) lifting a hairstyle's vertices ``fitted`` (V, 3) by its
+    :func:`hair_volume` along the outward normal of the skin nearest each (zeros without one).
+
+    The lift fades in over :data:`VOLUME_FADE` above the hairline (``scalp:`` in
+    ``hair.yaml``, :func:`facsim.head.scalp.hairline_height`), so the cards still meet the
+    skin at the forehead, temples and nape and only the mass over the skull stands off it."""
+    from scipy.spatial import cKDTree
+
+    mm = hair_volume(style)
+    fitted = np.asarray(fitted, np.float64)
+    if mm == 0.0:
+        return np.zeros_like(fitted, dtype=np.float32)
+    from facsim.head.surface import smoothstep, vertex_normals
+
+    n_skin = head.skin_vertex_count
+    geo = np.asarray(neutral_geometry, np.float64)
+    tris = np.asarray(head.topology.geo_faces)
+    tris = tris[np.all(tris < n_skin, axis=1)]
+    skin = geo[:n_skin]
+    normals = vertex_normals(skin, tris).astype(np.float64)
+    if np.einsum("ij,ij->i", normals, skin - skin.mean(axis=0)).mean() < 0:  # wound inward
+        normals = -normals
+    from facsim.head.scalp import hairline_height
+
+    nearest = cKDTree(skin).query(fitted)[1]
+    eyes = np.concatenate([np.asarray(v) for v in head.eye_vertices.values()])
+    line = hairline_height(normals[nearest], skin[nearest, 2], float(geo[eyes, 1].mean()), float(geo[eyes, 2].mean()),
+                           hair_table()["scalp"]["hairline_above_eyes_mm"])
+    fade = smoothstep(line, line + VOLUME_FADE, fitted[:, 1])
+    return (0.01 * mm * fade[:, None] * normals[nearest]).astype(np.float32)
 
 
 @dataclass(frozen=True, eq=False)
