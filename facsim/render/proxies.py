@@ -260,6 +260,29 @@ def volume_normals(points: np.ndarray, card_normals: np.ndarray, *, card_weight:
     return (n / (np.linalg.norm(n, axis=1, keepdims=True) + 1e-12)).astype(np.float32)
 
 
+def along_volume(tangents: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """Unit strand directions (N, 3) laid into the hair volume's surface (``normals`` (N, 3):
+    :func:`volume_normals` with no card weight): each card keeps its strands' direction
+    along the surface, but not its tilt out of it.
+
+    Cards overlap like shingles, each tilted out of the volume's surface by its own
+    amount: a strand highlight computed with the tilted directions lands at the same place
+    on every card of a row, so long01's crown showed rows of bright bands, one per row of
+    cards. Laid into the surface, the directions of neighbouring rows agree and the
+    highlight runs across the hair as one band. Strands that run mostly out of the surface
+    (under-layers curling in toward the face) keep their own direction: laid into the
+    surface, what is left of them points anywhere.
+    """
+    from facsim.head.surface import smoothstep
+
+    t = np.asarray(tangents, np.float32)
+    laid = t - np.einsum("ij,ij->i", t, normals)[:, None] * normals
+    length = np.linalg.norm(laid, axis=1, keepdims=True)
+    w = smoothstep(0.5, 0.8, length).astype(np.float32)
+    out = w * laid / (length + 1e-12) + (1.0 - w) * t
+    return (out / (np.linalg.norm(out, axis=1, keepdims=True) + 1e-12)).astype(np.float32)
+
+
 def strand_tangents(positions: np.ndarray, mesh: ProxyMesh, operator=None, directions=None) -> np.ndarray:
     """Unit strand direction per corner, averaged over the corner's triangles.
 
@@ -488,7 +511,8 @@ class ProxyLayer:
                 rest = np.asarray(self.mesh.rest, np.float32)[self.mesh.corner_vertex]
                 self._smooth = neighbour_mean_operator(rest, STRAND_SMOOTHING)
             tangents = np.asarray(self._smooth @ tangents, np.float32)
-            tangents /= np.linalg.norm(tangents, axis=1, keepdims=True) + 1e-12
+        if self.mesh.kind == "hair":
+            tangents = along_volume(tangents, volume_normals(p, normals, card_weight=0.0))
         buf[:, 6:9] = tangents
         buf[:, 9] = self._depth
         self._vbo.write(buf)

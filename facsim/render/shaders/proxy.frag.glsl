@@ -248,9 +248,14 @@ void main() {
     vec3 albedo = u_color * (0.6 + 0.8 * tex.r);
 
 #ifdef KIND_HAIR
+    // Shading's strands and clumps: along the strands their phase also follows the card's
+    // place on the head (v_rest). Cards of one row share their texture's v range, and noise
+    // in v alone lit and darkened every card of a row alike: long01's crown drew its rows of
+    // cards as horizontal bands. (The cards' fraying above keeps the noise in v alone.)
+    vec2 phase = vec2(0.0, dot(v_rest, vec3(3.1, 2.3, 2.7)));
     vec3 t = normalize(v_tangent);
 #ifdef PASS_OPAQUE
-    vec2 sp = v_uv * vec2(420.0, 5.0);
+    vec2 sp = v_uv * vec2(420.0, 5.0) + 2.0 * phase;
     float fine = mix(0.5, value_noise(sp, 0), along_v * clamp(1.8 - 1.6 * fwidth(sp.x), 0.0, 1.0));
 #else
     float fine = 0.5;   // the thin fringe: too sparse for the finest breakup to show
@@ -260,6 +265,10 @@ void main() {
     // clumps differ the way real hair does, the same on every card.
     // (The texture's strands and the widest scale stop at each card's edge: on long01's crown,
     // at full strength they drew the rows of cards, so they keep less weight.)
+    mp += phase;
+    mid = mix(0.5, value_noise(mp, 0), along_v * clamp(2.0 - 1.4 * fwidth(mp.x), 0.0, 1.0));
+    cp += 0.5 * phase;
+    clump = mix(0.5, value_noise(cp, 0), along_v * clamp(2.0 - 1.5 * fwidth(cp.x), 0.0, 1.0));
     float strand = (0.62 + 0.76 * tex.r) * (0.7 + 0.6 * fine) * (0.76 + 0.48 * mid) * (0.92 + 0.16 * clump);
 #ifdef PASS_OPAQUE
 #ifdef COILY
@@ -278,7 +287,7 @@ void main() {
 #ifdef COILY
     albedo = hair_colour(v_uv * 40.0) * strand;
 #else
-    albedo = hair_colour(v_uv * vec2(45.0, 1.2) + 7.0) * strand;
+    albedo = hair_colour(v_uv * vec2(45.0, 1.2) + 7.0 + 0.5 * phase) * strand;
 #endif
     // Depth in the volume: layers near the scalp lie under the outer ones and get little
     // light (roots and the under-layers darker), the gaps between clumps are darker still.
@@ -321,8 +330,15 @@ void main() {
     // Light hair's own diffuse is bright already: a full-strength white lobe on it reads as
     // white streaks, so it takes less.
     gate *= mix(1.0, 0.55, light_hair);
+    // A few sparse glints: single strands (a fraction of a millimetre across, a few long)
+    // that catch the key light sharply where the primary lobe lies, as real hair glitters
+    // here and there instead of shining evenly; faded out where they would be finer than a pixel.
+    vec2 gp = v_uv * vec2(400.0, 9.0) + 13.0 + 3.0 * phase;
+    float glint = smoothstep(0.86, 0.96, value_noise(gp, 0)) * along_v
+                * clamp(1.6 - 1.2 * fwidth(gp.x), 0.0, 1.0);
     vec3 spec = u_key_col * gate * (0.16 * strands * tint * exp2(40.0 * log2(s1))
-                                    + 0.55 * sparkle * u_color * exp2(10.0 * log2(s2)));
+                                    + 0.55 * sparkle * u_color * exp2(10.0 * log2(s2))
+                                    + 0.25 * glint * tint * exp2(40.0 * log2(s1)));
 #else
     vec3 spec = vec3(0.0);
 #endif
