@@ -175,7 +175,13 @@ def test_gltf_export_carries_hair_brows_and_lashes(face_of):
     length = struct.unpack_from("<I", blob, 12)[0]
     doc = json.loads(blob[20 : 20 + length])
     meshes = {m["name"]: m for m in doc["meshes"]}
-    assert {"hair", "brows", "eyelashes"} <= set(meshes)
+    assert {"hair", "scalp", "brows", "eyelashes"} <= set(meshes) and "wisps" not in meshes
+    scalp = meshes["scalp"]["primitives"][0]
+    assert doc["materials"][scalp["material"]]["alphaMode"] == "BLEND"
+    texture = doc["textures"][doc["materials"][scalp["material"]]["pbrMetallicRoughness"]["baseColorTexture"]["index"]]
+    assert doc["samplers"][texture["sampler"]]["wrapS"] == 10497  # the strand tile repeats
+    density = doc["accessors"][scalp["attributes"]["COLOR_0"]]
+    assert density["count"] == doc["accessors"][scalp["attributes"]["POSITION"]]["count"]
     brows = meshes["brows"]
     assert brows["extras"]["proxy"] == face.character.brows == "eyebrow010"
     assert any(n.startswith("AU01") for n in brows["extras"]["targetNames"])
@@ -183,7 +189,7 @@ def test_gltf_export_carries_hair_brows_and_lashes(face_of):
     assert material["alphaMode"] == "MASK" and material["doubleSided"]
     scene = doc["scenes"][0]["nodes"]
     assert all(any(doc["nodes"][i].get("mesh") == doc["meshes"].index(m) for i in scene) for m in meshes.values()
-               if m["name"] in ("hair", "brows", "eyelashes"))
+               if m["name"] in ("hair", "scalp", "brows", "eyelashes"))
 
 
 def test_cli_hair_option(tmp_path, capsys):
