@@ -60,7 +60,7 @@ class WispStyle:
     fuzz: int = 0
     flyaways: int = 0
     fuzz_length_mm: tuple[float, float] = (5.0, 12.0)
-    flyaway_length_mm: tuple[float, float] = (25.0, 50.0)
+    flyaway_length_mm: tuple[float, float] = (15.0, 35.0)
     lift: float = 0.9
     width_mm: float = 0.12
     alpha: float = 0.6
