@@ -107,7 +107,7 @@ class Face:
         import hashlib
 
         from facsim.head.assets import cache_dir
-        from facsim.head.proxies import bind_scalp, hair_table
+        from facsim.head.proxies import bind_scalp, hair_table, hair_volume
         from facsim.head.scalp import VERSION
 
         hair = [b for b in self.proxies if b.proxy.kind == "hair"]
@@ -115,14 +115,29 @@ class Face:
             return None
         # Cached on disk like the occlusion bake: by the head's shape, the style and its table.
         shape = self.character.with_(name="", description="", colors={}, hair="", brows="", lashes="")
-        key = hashlib.sha256(repr((VERSION, shape, hair[0].proxy.name, hair_table().get("scalp")))
+        key = hashlib.sha256(repr((VERSION, shape, hair[0].proxy.name, hair_table().get("scalp"),
+                                   hair_volume(hair[0].proxy.name)))
                              .encode()).hexdigest()[:16]
         return bind_scalp(hair[0], self.head, self.neutral, cache=cache_dir() / "scalp" / f"{key}.npy")
 
+    @cached_property
+    def wisps(self):
+        """Loose strands over the hair's cards (a ``"wisps"`` BoundProxy, facsim.head.wisps), or None."""
+        from facsim.head.proxies import bind_wisps
+
+        hair = [b for b in self.proxies if b.proxy.kind == "hair"]
+        return bind_wisps(hair[0], self.head, self.neutral) if hair else None
+
     @property
     def _drawn_proxies(self) -> list:
-        """What the renderer draws: the scalp layer first (under every card), then the proxies."""
-        return ([self.scalp] if self.scalp is not None else []) + list(self.proxies)
+        """What the renderer draws: the scalp layer first (under every card), then the hair,
+        its loose strands, brows and lashes."""
+        out = [self.scalp] if self.scalp is not None else []
+        for bound in self.proxies:
+            out.append(bound)
+            if bound.proxy.kind == "hair" and self.wisps is not None:
+                out.append(self.wisps)
+        return out
 
     @cached_property
     def proxy_meshes(self) -> list:
@@ -130,8 +145,9 @@ class Face:
         from facsim.render.proxies import ProxyMesh
 
         return [ProxyMesh(b.proxy.name, b.proxy.kind, b.proxy.triangles, b.proxy.corner_vertex, b.proxy.uv,
-                          b.proxy.texture, b.depth, b.neutral if b.proxy.kind == "hair" else None,
-                          self._card_cover(b) if b.proxy.kind == "hair" else None, b.coil > 0.0)
+                          b.proxy.texture, b.depth, b.neutral if b.proxy.kind in ("hair", "wisps") else None,
+                          self._card_cover(b) if b.proxy.kind == "hair" else None, b.coil > 0.0,
+                          b.strand_points, b.strand_width)
                 for b in self._drawn_proxies]
 
     def _card_cover(self, bound) -> np.ndarray | None:

@@ -218,8 +218,9 @@ def test_eyes_are_separate_nodes_at_the_eye_centres(face, animated):
     mesh = doc["meshes"][nodes["eye_L"]["mesh"]]
     points = accessor(doc, blob, mesh["primitives"][0]["attributes"]["POSITION"])
     assert np.linalg.norm(points, axis=1) == pytest.approx(radius * METRES, rel=1e-5)
-    # skin, eye, then one per proxy (hair, brows, lashes)
-    assert len(doc["images"]) == 2 + len(face.proxies) and all(img["mimeType"] == "image/png" for img in doc["images"])
+    # skin, eye, then the scalp layer under the hair and one per proxy (hair, brows, lashes)
+    assert face.scalp is not None
+    assert len(doc["images"]) == 3 + len(face.proxies) and all(img["mimeType"] == "image/png" for img in doc["images"])
 
 
 def _head_geometry_vertices(face):

@@ -175,7 +175,13 @@ def test_gltf_export_carries_hair_brows_and_lashes(face_of):
     length = struct.unpack_from("<I", blob, 12)[0]
     doc = json.loads(blob[20 : 20 + length])
     meshes = {m["name"]: m for m in doc["meshes"]}
-    assert {"hair", "brows", "eyelashes"} <= set(meshes)
+    assert {"hair", "scalp", "brows", "eyelashes"} <= set(meshes) and "wisps" not in meshes
+    scalp = meshes["scalp"]["primitives"][0]
+    assert doc["materials"][scalp["material"]]["alphaMode"] == "BLEND"
+    texture = doc["textures"][doc["materials"][scalp["material"]]["pbrMetallicRoughness"]["baseColorTexture"]["index"]]
+    assert doc["samplers"][texture["sampler"]]["wrapS"] == 10497  # the strand tile repeats
+    density = doc["accessors"][scalp["attributes"]["COLOR_0"]]
+    assert density["count"] == doc["accessors"][scalp["attributes"]["POSITION"]]["count"]
     brows = meshes["brows"]
     assert brows["extras"]["proxy"] == face.character.brows == "eyebrow010"
     assert any(n.startswith("AU01") for n in brows["extras"]["targetNames"])
@@ -183,7 +189,7 @@ def test_gltf_export_carries_hair_brows_and_lashes(face_of):
     assert material["alphaMode"] == "MASK" and material["doubleSided"]
     scene = doc["scenes"][0]["nodes"]
     assert all(any(doc["nodes"][i].get("mesh") == doc["meshes"].index(m) for i in scene) for m in meshes.values()
-               if m["name"] in ("hair", "brows", "eyelashes"))
+               if m["name"] in ("hair", "scalp", "brows", "eyelashes"))
 
 
 def test_cli_hair_option(tmp_path, capsys):
@@ -214,3 +220,16 @@ def test_coily_hair_is_drawn_as_coily(face_of):
     draws = {m.kind: d for d, m in zip(face.proxy_draws(face.neutral), face.proxy_meshes)}
     assert draws["hair"].coil == 1.0 and draws["hair"].sheen < 1.0
     assert face_of("ava").proxy_draws(face_of("ava").neutral)[0].coil == 0.0
+
+
+def test_afro_stands_off_the_skull_but_meets_the_skin_at_the_hairline(face_of):
+    face = face_of("amara")  # afro01, volume_mm in hair.yaml
+    hair = next(b for b in face.proxies if b.proxy.kind == "hair")
+    mm = proxies.hair_volume("afro01")
+    assert mm > 0 and proxies.hair_volume("long01") == 0.0
+    offset = proxies.hair_volume_offset("afro01", hair.neutral, face.head, face.neutral)
+    lift = np.linalg.norm(offset, axis=1)
+    y = hair.neutral[:, 1]
+    assert np.allclose(lift[y > np.percentile(y, 90)], 0.01 * mm, rtol=1e-3)
+    assert np.median(lift[y < np.percentile(y, 5)]) < 0.1 * 0.01 * mm
+    assert not proxies.hair_volume_offset("long01", hair.neutral, face.head, face.neutral).any()

@@ -151,6 +151,23 @@ def test_hair_texture_keeps_its_strands_but_not_its_painted_light():
     assert kept[84:108, 20:108].std(axis=1).mean() > 15      # ... the strands across u stay
 
 
+def test_strand_directions_lie_in_the_volume_so_shingled_rows_of_cards_agree():
+    from facsim.render.proxies import along_volume
+
+    # two rows of shingled cards over a surface facing +z, their strands (down, -y) tilted
+    # out of it by different amounts: laid into the surface they run the same way
+    tilted = np.array([[0.0, -1.0, 0.4], [0.0, -1.0, -0.25], [0.3, -1.0, 0.1]], np.float32)
+    normals = np.tile(np.array([0.0, 0.0, 1.0], np.float32), (3, 1))
+    laid = along_volume(tilted / np.linalg.norm(tilted, axis=1, keepdims=True), normals)
+    assert np.allclose(laid[0], laid[1], atol=1e-6) and np.allclose(laid[0], [0.0, -1.0, 0.0], atol=1e-6)
+    assert np.allclose(np.linalg.norm(laid, axis=1), 1.0, atol=1e-5)
+    assert np.allclose(np.einsum("ij,ij->i", laid, normals), 0.0, atol=1e-6)
+    assert laid[2, 0] > 0.2  # the direction along the surface is kept
+    # a strand running almost straight out of the surface keeps its own direction
+    out = np.array([[0.0, -0.2, 1.0]], np.float32) / np.hypot(0.2, 1.0)
+    assert np.allclose(along_volume(out, normals[:1]), out, atol=1e-6)
+
+
 def test_card_outline_frays_only_cards_with_an_inside():
     from facsim.render.proxies import card_outline
 

@@ -12,7 +12,12 @@ What the file holds
     * Meshes ``hair``, ``brows``, ``eyelashes``: the character's MakeHuman
       proxies (``facsim.head.proxies``), each with its own alpha-masked texture
       tinted with the character's colour, skinned like the face and with the
-      same AU morph targets (brows follow AU 1, 2 and 4).
+      same AU morph targets (brows follow AU 1, 2 and 4). Mesh ``scalp``: the
+      fine hair on the skin under the hair (``facsim.head.scalp``), a blended
+      layer whose tiled strand texture (repeating sampler) is faded by the hair's
+      density per vertex (``COLOR_0`` alpha). The loose strands the renderer draws
+      over the hair (``facsim.head.wisps``) are camera-facing ribbons and are not
+      exported.
     * Morph targets, one per AU the register engine simulates with morphs,
       per side for AUs that can act on one side: ``AU12_L``, ``AU12_R``,
       ``AU26``. A target is the register engine at that AU (and side) at
@@ -370,7 +375,9 @@ def _proxy_meshes(b: GlbBuilder, face, keys, pivot, materials: dict) -> list[dic
     from facsim.engines.rigid import neck_weight
     from facsim.render.proxies import shade_texture
 
-    if not face.proxies:
+    scalp = getattr(face, "scalp", None)
+    exported = ([scalp] if scalp is not None else []) + list(face.proxies)
+    if not exported:
         return []
     engine = face.engine if face.engine_name == "registers" else RegisterEngine(
         face.head, face.data, face.character, face.base_positions)
@@ -378,23 +385,33 @@ def _proxy_meshes(b: GlbBuilder, face, keys, pivot, materials: dict) -> list[dic
                         np.float32) for code, side in keys]
     follow_head = neck_weight(face.head, np.asarray(face.neutral, np.float64), face.base_positions)
     out = []
-    for bound in face.proxies:
+    for bound in exported:
         proxy, binding = bound.proxy, bound.binding
         rest = binding.positions(face.neutral).astype(np.float64)
         corner = proxy.corner_vertex
-        # Texture: the strand brightness times the character's colour, alpha kept.
-        shade = shade_texture(proxy.texture)[::-1].astype(np.float32) / 255.0  # back to image row order
         tint = _linear(face.colors[bound.color_key])
+        is_scalp = proxy.kind == "scalp"
+        # Texture: the strand brightness times the character's colour, alpha kept. The scalp
+        # layer's tile is made for the renderer already (R brightness, A cover; tiled).
+        if is_scalp:
+            shade = np.asarray(proxy.texture, np.float32) / 255.0
+            rgb = tint * (0.55 + 0.9 * shade[..., :1]) * 0.7   # the roots lie in the cards' shade
+        else:
+            shade = shade_texture(proxy.texture)[::-1].astype(np.float32) / 255.0  # back to image row order
+            rgb = tint * (0.6 + 0.8 * shade[..., :1])
         rgba = np.empty(shade.shape, np.uint8)
-        rgba[..., :3] = _srgb8(tint * (0.6 + 0.8 * shade[..., :1]))
+        rgba[..., :3] = _srgb8(rgb)
         rgba[..., 3] = (shade[..., 3] * 255 + 0.5).astype(np.uint8)
         image = len(materials["images"])
         materials["images"].append({"name": proxy.name, "mimeType": "image/png", "bufferView": b.image(_png(rgba))})
-        materials["textures"].append({"source": image, "sampler": 0, "name": proxy.name})
-        materials["materials"].append({
-            "name": proxy.name, "alphaMode": "MASK", "alphaCutoff": 0.5, "doubleSided": True,
-            "pbrMetallicRoughness": {"metallicFactor": 0.0, "roughnessFactor": 0.6 if proxy.kind == "hair" else 0.9,
-                                     "baseColorTexture": {"index": len(materials["textures"]) - 1}}})
+        if is_scalp and len(materials["samplers"]) < 2:
+            materials["samplers"].append({"magFilter": 9729, "minFilter": 9987, "wrapS": 10497, "wrapT": 10497})
+        materials["textures"].append({"source": image, "sampler": 1 if is_scalp else 0, "name": proxy.name})
+        pbr = {"metallicFactor": 0.0, "roughnessFactor": 0.6 if proxy.kind in ("hair", "scalp") else 0.9,
+               "baseColorTexture": {"index": len(materials["textures"]) - 1}}
+        materials["materials"].append(
+            {"name": proxy.name, "alphaMode": "BLEND", "pbrMetallicRoughness": pbr} if is_scalp else
+            {"name": proxy.name, "alphaMode": "MASK", "alphaCutoff": 0.5, "doubleSided": True, "pbrMetallicRoughness": pbr})
         weights = np.zeros((len(corner), 4), np.float32)
         # Each proxy vertex follows the head as the skin it is bound to does.
         follow = np.einsum("vk,vk->v", binding.weights, follow_head[binding.ref])
@@ -408,7 +425,10 @@ def _proxy_meshes(b: GlbBuilder, face, keys, pivot, materials: dict) -> list[dic
                 "POSITION": b.accessor(rest[corner] * METRES, "VEC3", target=ARRAY_BUFFER, bounds=True),
                 "TEXCOORD_0": b.accessor(uv, "VEC2", target=ARRAY_BUFFER),
                 "JOINTS_0": b.accessor(joints, "VEC4", UBYTE, target=ARRAY_BUFFER),
-                "WEIGHTS_0": b.accessor(weights, "VEC4", target=ARRAY_BUFFER)},
+                "WEIGHTS_0": b.accessor(weights, "VEC4", target=ARRAY_BUFFER),
+                **({"COLOR_0": b.accessor(np.column_stack([np.ones((len(corner), 3), np.float32),
+                                                           np.clip(bound.depth, 0.0, 1.0)[corner]]),
+                                          "VEC4", target=ARRAY_BUFFER)} if is_scalp else {})},
             "indices": b.accessor(proxy.triangles.reshape(-1).astype(np.uint32), "SCALAR",
                                   USHORT if len(corner) < 65536 else UINT, target=ELEMENT_ARRAY_BUFFER, bounds=True),
             "material": len(materials["materials"]) - 1, "mode": 4}

@@ -366,6 +366,8 @@ def bind_to_frame(proxy: Proxy, head, base_positions: np.ndarray, neutral_geomet
         ref, weights, fitted = place_brows(fitted, skin_now, tris, look)
         anchor = np.einsum("vk,vkd->vd", weights, skin_now[ref])
         return FrameBinding(ref=ref, weights=weights, offsets=(fitted - anchor).astype(np.float32))
+    if proxy.kind == "hair":
+        fitted = fitted + hair_volume_offset(proxy.name, fitted, head, neutral_geometry)
     ref = geo_of_base[proxy.ref]
     missing = ref < 0
     if missing.any():
@@ -373,6 +375,49 @@ def bind_to_frame(proxy: Proxy, head, base_positions: np.ndarray, neutral_geomet
         ref[missing] = tree.query(np.asarray(base_positions)[proxy.ref[missing]])[1]
     anchor = np.einsum("vk,vkd->vd", proxy.weights, np.asarray(neutral_geometry, np.float32)[ref])
     return FrameBinding(ref=ref, weights=proxy.weights, offsets=(fitted - anchor).astype(np.float32))
+
+
+#: Height (dm) above the hairline over which a hairstyle's extra volume fades in.
+VOLUME_FADE = 0.3
+
+
+def hair_volume(style: str) -> float:
+    """Millimetres ``style``'s cards stand further off the skull (``volume_mm:`` in
+    ``facsim/data/hair.yaml``, default 0)."""
+    return float(hair_table().get("volume_mm", {}).get(style, 0.0))
+
+
+def hair_volume_offset(style: str, fitted: np.ndarray, head, neutral_geometry: np.ndarray) -> np.ndarray:
+    """(V, 3) offsets (dm) lifting a hairstyle's vertices ``fitted`` (V, 3) by its
+    :func:`hair_volume` along the outward normal of the skin nearest each (zeros without one).
+
+    The lift fades in over :data:`VOLUME_FADE` above the hairline (``scalp:`` in
+    ``hair.yaml``, :func:`facsim.head.scalp.hairline_height`), so the cards still meet the
+    skin at the forehead, temples and nape and only the mass over the skull stands off it."""
+    from scipy.spatial import cKDTree
+
+    mm = hair_volume(style)
+    fitted = np.asarray(fitted, np.float64)
+    if mm == 0.0:
+        return np.zeros_like(fitted, dtype=np.float32)
+    from facsim.head.surface import smoothstep, vertex_normals
+
+    n_skin = head.skin_vertex_count
+    geo = np.asarray(neutral_geometry, np.float64)
+    tris = np.asarray(head.topology.geo_faces)
+    tris = tris[np.all(tris < n_skin, axis=1)]
+    skin = geo[:n_skin]
+    normals = vertex_normals(skin, tris).astype(np.float64)
+    if np.einsum("ij,ij->i", normals, skin - skin.mean(axis=0)).mean() < 0:  # wound inward
+        normals = -normals
+    from facsim.head.scalp import hairline_height
+
+    nearest = cKDTree(skin).query(fitted)[1]
+    eyes = np.concatenate([np.asarray(v) for v in head.eye_vertices.values()])
+    line = hairline_height(normals[nearest], skin[nearest, 2], float(geo[eyes, 1].mean()), float(geo[eyes, 2].mean()),
+                           hair_table()["scalp"]["hairline_above_eyes_mm"])
+    fade = smoothstep(line, line + VOLUME_FADE, fitted[:, 1])
+    return (0.01 * mm * fade[:, None] * normals[nearest]).astype(np.float32)
 
 
 @dataclass(frozen=True, eq=False)
@@ -388,6 +433,8 @@ class BoundProxy:
     density: float = 1.0  # brows and lashes: how much of the skin their hairs cover (0 … 1)
     neutral: np.ndarray | None = None  # (V, 3) positions on the neutral face
     shade: np.ndarray | None = None  # (V,) the scalp layer's hair density (see :attr:`depth`)
+    strand_points: int = 0  # wisps: points per strand (facsim.head.wisps)
+    strand_width: float = 0.0  # wisps: a strand's width (dm) at its root
 
     @cached_property
     def depth(self) -> np.ndarray:
@@ -395,7 +442,8 @@ class BoundProxy:
         layers … 1 in the open (:func:`hair_exposure`, self-shadowing). Lashes: 0 at the
         lid … 1 at the tips (tapering). Brows:
         0 at each brow's head … 1 at its tail (:func:`along_brow`), where the hairs thin.
-        Scalp: the hair's density on the skin (:mod:`facsim.head.scalp`)."""
+        Scalp: the hair's density on the skin (:mod:`facsim.head.scalp`). Wisps: 0 at each
+        strand's root … 1 at its tip."""
         if self.shade is not None:
             return np.asarray(self.shade, np.float32)
         if self.proxy.kind == "eyebrows" and self.neutral is not None:
@@ -425,13 +473,15 @@ class BoundProxy:
 
     @property
     def style(self) -> str:
-        """The proxy's name; a scalp layer's is its hairstyle's (it is that hair's roots)."""
-        return self.proxy.name.removesuffix(SCALP_SUFFIX)
+        """The proxy's name; a scalp layer's or loose strands' is their hairstyle's."""
+        return self.proxy.name.removesuffix(SCALP_SUFFIX).removesuffix(WISPS_SUFFIX)
 
 
 COLOR_KEY = {"hair": "hair", "eyebrows": "brows", "eyelashes": "lashes"}
 #: A scalp layer's name is its hairstyle's with this suffix (:func:`bind_scalp`).
 SCALP_SUFFIX = "-scalp"
+#: Loose strands' name is their hairstyle's with this suffix (:func:`bind_wisps`).
+WISPS_SUFFIX = "-wisps"
 
 
 def hair_greying(mean: tuple, young: tuple, white: tuple) -> tuple[tuple, tuple, float]:
@@ -503,6 +553,29 @@ def bind_scalp(hair: BoundProxy, head, neutral_geometry: np.ndarray, *, cache: P
                   png=b"", author="facsim", license="CC0", image=strand_texture())
     binding = FrameBinding(ref=ref, weights=weights, offsets=(LIFT * normals).astype(np.float32))
     return BoundProxy(proxy, binding, "hair", 1.0, binding.positions(geo), shade=layer.density)
+
+
+def bind_wisps(hair: BoundProxy, head, neutral_geometry: np.ndarray) -> BoundProxy | None:
+    """Loose strands over ``hair``'s cards (:mod:`facsim.head.wisps`, ``wisps:`` in
+    ``facsim/data/hair.yaml``), each point bound as the hair vertex nearest to it, or None
+    where the style grows none."""
+    from facsim.head.wisps import grow_wisps, strand_profile, wisp_style
+
+    style = wisp_style(hair_table().get("wisps", {}), hair.style)
+    if style is None or hair.neutral is None:
+        return None
+    wisps = grow_wisps(hair.neutral, hair.proxy.triangles, hair.proxy.corner_vertex, hair.proxy.uv, hair.depth,
+                       style, texture=hair.proxy.texture, seed=hair.style)
+    ref = hair.binding.ref[wisps.anchor]
+    weights = hair.binding.weights[wisps.anchor]
+    anchor = np.einsum("vk,vkd->vd", weights, np.asarray(neutral_geometry, np.float32)[ref])
+    binding = FrameBinding(ref=ref, weights=weights, offsets=(wisps.points - anchor).astype(np.float32))
+    triangles, corner_vertex, uv = wisps.ribbon()
+    proxy = Proxy(name=hair.proxy.name + WISPS_SUFFIX, kind="wisps", ref=np.asarray(head.base_index)[ref],
+                  weights=weights, offsets=binding.offsets, triangles=triangles, corner_vertex=corner_vertex, uv=uv,
+                  png=b"", author="facsim", license="CC0", image=strand_profile())
+    return BoundProxy(proxy, binding, "hair", style.alpha, binding.positions(neutral_geometry), shade=wisps.along,
+                      strand_points=wisps.per_strand, strand_width=0.01 * style.width_mm)
 
 
 def hair_exposure(points: np.ndarray, triangles: np.ndarray, *, reach: float = 0.3,

@@ -37,7 +37,7 @@ HAIRLINE_WIDTH = 0.06
 #: Height (dm) of the layer over the skin: enough not to fight it in the depth buffer.
 LIFT = 0.004
 #: Bump when the layer a character gets changes (its disk cache is keyed by it).
-VERSION = 1
+VERSION = 2  # 2: afro01's cards stand off the skull (volume_mm in hair.yaml)
 #: One texture tile's size (dm) across and along the strands.
 TILE = (0.1, 0.2)
 

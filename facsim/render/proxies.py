@@ -27,7 +27,7 @@ from facsim.render.geometry import normal_operator, vertex_normals
 from facsim.render.gl import _set_uniform, _shader_source
 from facsim.render.inputs import srgb_to_linear
 
-PROXY_KINDS = ("hair", "eyebrows", "eyelashes", "scalp")
+PROXY_KINDS = ("hair", "eyebrows", "eyelashes", "scalp", "wisps")
 #: Alpha at and above which a fragment belongs to the opaque (alpha-tested) pass.
 ALPHA_CUTOFF = 0.5
 
@@ -65,6 +65,12 @@ class ProxyMesh:
     coily : bool
         Hair and scalp: drawn with the coily-hair shader variant (curls instead of strands;
         :attr:`ProxyDraw.coil` sets how strongly).
+    strand_points, strand_width : int, float
+        ``"wisps"``: loose strands (facsim.head.wisps), ``strand_points`` points each, laid
+        out strand by strand, root first, two corners per point (u 0 and 1 across); drawn
+        as ribbons ``strand_width`` dm wide at the root (at least a pixel, fainter where
+        widened) turned toward the camera, tapering to the tip. ``depth``: 0 at the root …
+        1 at the tip.
     """
 
     name: str
@@ -77,6 +83,8 @@ class ProxyMesh:
     rest: np.ndarray | None = None
     cover: np.ndarray | None = None
     coily: bool = False
+    strand_points: int = 0
+    strand_width: float = 0.0
 
     def __post_init__(self):
         if self.kind not in PROXY_KINDS:
@@ -86,6 +94,10 @@ class ProxyMesh:
             raise ValueError(f"proxy texture must be (H, W, 4) uint8, got {tex.dtype} {tex.shape}")
         if len(self.uv) != len(self.corner_vertex):
             raise ValueError("proxy uv and corner_vertex must have one row per corner")
+        if self.kind == "wisps" and (self.strand_points < 2 or self.vertex_count % self.strand_points
+                                     or not self.strand_width > 0):
+            raise ValueError(f"wisps need strand_points >= 2 dividing their {self.vertex_count} points and a "
+                             f"strand_width > 0, got {self.strand_points} and {self.strand_width}")
 
     @property
     def vertex_count(self) -> int:
@@ -248,6 +260,29 @@ def volume_normals(points: np.ndarray, card_normals: np.ndarray, *, card_weight:
     return (n / (np.linalg.norm(n, axis=1, keepdims=True) + 1e-12)).astype(np.float32)
 
 
+def along_volume(tangents: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """Unit strand directions (N, 3) laid into the hair volume's surface (``normals`` (N, 3):
+    :func:`volume_normals` with no card weight): each card keeps its strands' direction
+    along the surface, but not its tilt out of it.
+
+    Cards overlap like shingles, each tilted out of the volume's surface by its own
+    amount: a strand highlight computed with the tilted directions lands at the same place
+    on every card of a row, so long01's crown showed rows of bright bands, one per row of
+    cards. Laid into the surface, the directions of neighbouring rows agree and the
+    highlight runs across the hair as one band. Strands that run mostly out of the surface
+    (under-layers curling in toward the face) keep their own direction: laid into the
+    surface, what is left of them points anywhere.
+    """
+    from facsim.head.surface import smoothstep
+
+    t = np.asarray(tangents, np.float32)
+    laid = t - np.einsum("ij,ij->i", t, normals)[:, None] * normals
+    length = np.linalg.norm(laid, axis=1, keepdims=True)
+    w = smoothstep(0.5, 0.8, length).astype(np.float32)
+    out = w * laid / (length + 1e-12) + (1.0 - w) * t
+    return (out / (np.linalg.norm(out, axis=1, keepdims=True) + 1e-12)).astype(np.float32)
+
+
 def strand_tangents(positions: np.ndarray, mesh: ProxyMesh, operator=None, directions=None) -> np.ndarray:
     """Unit strand direction per corner, averaged over the corner's triangles.
 
@@ -355,6 +390,8 @@ class ProxyLayer:
         # Hair: 1 on a card's outline, 0 inside (the shader frays the cards' edges into strands).
         self._buffer[:, 10] = (card_outline(np.asarray(mesh.corner_vertex)[self._triangles])[mesh.corner_vertex]
                                if mesh.kind == "hair" else 0.0)
+        if mesh.kind == "wisps":  # which side of the strand's ribbon (-1, 1): the shader widens it
+            self._buffer[:, 10] = 2.0 * np.asarray(mesh.uv, np.float32)[:, 0] - 1.0
         self._vbo = track(ctx.buffer(reserve=self._buffer.nbytes, dynamic=True))
         cover = np.ones(mesh.vertex_count, np.float32) if mesh.cover is None else np.asarray(mesh.cover, np.float32)
         # Where each corner was on the neutral face: coily hair's curls are placed in this space
@@ -369,7 +406,7 @@ class ProxyLayer:
         # layers then fail the depth test before they are shaded), back to front for blending.
         self._ibo = {"OPAQUE": track(ctx.buffer(self._triangles.tobytes(), dynamic=True)),
                      "BLEND": track(ctx.buffer(self._triangles.tobytes(), dynamic=True))}
-        if mesh.kind == "scalp":  # made for the renderer already (facsim.head.scalp.strand_texture)
+        if mesh.kind in ("scalp", "wisps"):  # made for the renderer already (facsim.head.scalp, .wisps)
             tex = np.ascontiguousarray(np.asarray(mesh.texture)[::-1])
         else:
             tex = shade_texture(np.asarray(mesh.texture), directions=mesh.kind == "hair",
@@ -391,7 +428,7 @@ class ProxyLayer:
         self.texture.filter = (ctx.LINEAR_MIPMAP_LINEAR, ctx.LINEAR)
         self.texture.repeat_x = self.texture.repeat_y = mesh.kind == "scalp"
         # The scalp layer lies on the skin, under every card: blended only, back faces culled.
-        self.has_opaque_pass = mesh.kind != "scalp"
+        self.has_opaque_pass = mesh.kind not in ("scalp", "wisps")
         self.culled = mesh.kind == "scalp"
         self.programs, self.vaos = {}, {}
         self._last = None  # (camera position, vertex positions) of the last upload
@@ -409,6 +446,7 @@ class ProxyLayer:
                                      fragment_shader=_shader_source("proxy.frag.glsl", defines)))
             _set_uniform(prog, "u_texture", 1)
             _set_uniform(prog, "u_along_v", self._along_v)
+            _set_uniform(prog, "u_strand_width", float(mesh.strand_width))
             self.programs[stage] = prog
             self.vaos[stage] = track(ctx.vertex_array(
                 prog, [(self._vbo, "3f 3f 3f 1f 1f", "in_pos", "in_normal", "in_tangent", "in_depth", "in_edge"),
@@ -451,12 +489,20 @@ class ProxyLayer:
         buf = self._buffer
         buf[:, 0:3] = p
         # Normals on welded vertices would mix the two sides of a card; corners are fine here.
-        normals = vertex_normals(p, self._triangles, self._normal_op)
-        if self.mesh.kind == "hair":
-            normals = volume_normals(p, normals)
-        buf[:, 3:6] = self._welded(normals)
-        # Tangents stay per corner: strands really do flow apart on the two sides of a parting.
-        tangents = strand_tangents(positions, self.mesh, self._normal_op, self._directions)
+        if self.mesh.kind == "wisps":
+            # Loose strands: the volume's normal (no surface of their own) and the direction
+            # along each strand.
+            buf[:, 3:6] = volume_normals(p, np.zeros_like(p), card_weight=0.0)
+            along = np.gradient(positions.reshape(-1, self.mesh.strand_points, 3), axis=1).reshape(-1, 3)
+            along /= np.linalg.norm(along, axis=1, keepdims=True) + 1e-12
+            tangents = along[self.mesh.corner_vertex]
+        else:
+            normals = vertex_normals(p, self._triangles, self._normal_op)
+            if self.mesh.kind == "hair":
+                normals = volume_normals(p, normals)
+            buf[:, 3:6] = self._welded(normals)
+            # Tangents stay per corner: strands really do flow apart on the two sides of a parting.
+            tangents = strand_tangents(positions, self.mesh, self._normal_op, self._directions)
         if self.mesh.kind == "hair" and self.mesh.rest is not None:
             # Neighbouring cards' strands run the same way: averaged over the cards within a
             # centimetre or two, the highlight runs on across the cards instead of lighting
@@ -465,7 +511,8 @@ class ProxyLayer:
                 rest = np.asarray(self.mesh.rest, np.float32)[self.mesh.corner_vertex]
                 self._smooth = neighbour_mean_operator(rest, STRAND_SMOOTHING)
             tangents = np.asarray(self._smooth @ tangents, np.float32)
-            tangents /= np.linalg.norm(tangents, axis=1, keepdims=True) + 1e-12
+        if self.mesh.kind == "hair":
+            tangents = along_volume(tangents, volume_normals(p, normals, card_weight=0.0))
         buf[:, 6:9] = tangents
         buf[:, 9] = self._depth
         self._vbo.write(buf)
@@ -492,12 +539,14 @@ class ProxyLayer:
         mean = np.asarray(self._weld @ per_corner)[self.mesh.corner_vertex]
         return (mean / (np.linalg.norm(mean, axis=1, keepdims=True) + 1e-12)).astype(np.float32)
 
-    def set_uniforms(self, vp_bytes: bytes, lights: dict) -> None:
-        key = (vp_bytes, tuple(lights.items()))
+    def set_uniforms(self, vp_bytes: bytes, lights: dict, viewport: tuple[int, int] = (512, 512)) -> None:
+        """The camera's view-projection, the lights and the frame buffer's size in pixels."""
+        key = (vp_bytes, tuple(lights.items()), tuple(viewport))
         if key == self._camera_uniforms:  # a video's camera and lights hold still
             return
         self._camera_uniforms = key
         for prog in self.programs.values():
+            _set_uniform(prog, "u_viewport", tuple(float(v) for v in viewport))
             try:
                 prog["u_view_proj"].write(vp_bytes)
             except KeyError:

@@ -151,9 +151,9 @@ class Renderer:
         default fits facsim's head (hm08 UVs normalised to its paint box); for other
         layouts see :func:`brow_uv_frame` and :data:`HM08_BROW_UV_FRAME`.
     hair_fringe : bool
-        Draw the hair's soft fringe (alpha below the cutoff) blended, back to front. ``False``
-        saves ~10-15 % of a 512² frame on llvmpipe but leaves a hard, cut-out hairline. Brows
-        and lashes always get theirs.
+        Draw the hair's soft fringe (alpha below the cutoff) and its loose strands (proxy kind
+        ``"wisps"``) blended, back to front. ``False`` saves ~10-15 % of a 512² frame on
+        llvmpipe but leaves a hard, cut-out hairline. Brows and lashes always get theirs.
     cull_backfaces : bool
         Skip skin and eyeball triangles facing away (about 1.5x faster). Needs those
         surfaces closed (cap the neck); the winding is checked on the first frame and
@@ -586,7 +586,7 @@ class Renderer:
         for draw in proxies:
             layer = self._proxy_layers[draw.mesh]
             layer.update(draw, position)
-            layer.set_uniforms(vp_bytes, lights)
+            layer.set_uniforms(vp_bytes, lights, self._scene_fbo.size)
         self._prepare_hair_layer(vp_bytes, lights)
 
     @contextmanager
@@ -718,7 +718,7 @@ class Renderer:
         ctx = self._ctx
         ctx.disable(ctx.CULL_FACE)
         layers = [self._proxy_layers[d.mesh] for d in self._proxy_draws
-                  if self.hair_fringe or d.mesh.kind != "hair"]
+                  if self.hair_fringe or d.mesh.kind not in ("hair", "wisps")]
         ctx.enable(ctx.BLEND)
         ctx.blend_func = (ctx.SRC_ALPHA, ctx.ONE_MINUS_SRC_ALPHA, ctx.ONE, ctx.ONE_MINUS_SRC_ALPHA)
         fbo.depth_mask = False

@@ -1,7 +1,7 @@
 // Proxy fragment shader: hair, eyebrow and eyelash cards cut out by their texture's alpha.
 // Variants (#defines from facsim/render/proxies.py): PASS_OPAQUE (alpha-tested, writes depth) or
 // PASS_BLEND (the soft fringe, blended back to front); KIND_HAIR, KIND_EYEBROWS, KIND_EYELASHES,
-// KIND_SCALP; COILY for coily hair (its curls cost llvmpipe time even where a uniform skips them).
+// KIND_SCALP, KIND_WISPS; COILY for coily hair (its curls cost llvmpipe time even where a uniform skips them).
 
 #include "common.glsl"
 
@@ -112,6 +112,34 @@ void main() {
     vec3 albedo = hair_colour(suv * vec2(8.0, 2.0)) * (0.55 + 0.9 * tex.r) * shade * curl;
     f_color = vec4(finish(albedo * lit).rgb, alpha);
 }
+#elif defined(KIND_WISPS)
+// Loose strands over the hair (facsim/head/wisps.py): thin ribbons turned toward the camera
+// (proxy.vert.glsl), drawn blended after the cards in the hair's colour. v_depth: 0 at the
+// root ... 1 at the tip; v_cover: the share of the drawn width the strand covers; tex.a: the
+// cover across the ribbon (soft at its sides).
+void main() {
+#ifdef PASS_OPAQUE
+    discard;
+#endif
+    vec4 tex = texture(u_texture, v_uv);
+    // Faint where it leaves the mass, then thinning to nothing at the tip.
+    float alpha = tex.a * v_cover * u_density * smoothstep(0.0, 0.15, v_depth) * (1.0 - smoothstep(0.55, 1.0, v_depth));
+    if (alpha < 0.01) discard;
+    vec3 n = normalize(v_normal);
+    vec3 t = normalize(v_tangent);
+    vec3 v = normalize(u_cam_pos - v_pos);
+    float kl = clamp(dot(n, u_key_dir) * 0.5 + 0.5, 0.0, 1.0);
+    float dk = strand_diffuse(t, u_key_dir) * kl * 1.1;
+    float df = clamp(dot(n, u_fill_dir) * 0.5 + 0.5, 0.0, 1.0);
+    // Stray hairs against the background catch the rim light through their edges.
+    float dr = clamp(dot(n, u_rim_dir) * 0.5 + 0.5, 0.0, 1.0);
+    vec3 lit = dk * u_key_col + df * u_fill_col + 0.5 * dr * u_rim_col + hemisphere(n) * 0.7;
+    vec3 h = normalize(u_key_dir + v);
+    float th = dot(t, h);
+    vec3 spec = u_key_col * 0.12 * u_sheen * exp2(30.0 * log2(max(1.0 - th * th, 1e-6)));
+    vec3 albedo = hair_colour(v_uv * vec2(1.0, 3.0) + v_rest.xy * 40.0);
+    f_color = vec4(finish(albedo * lit * 0.75 + spec).rgb, alpha);
+}
 #else
 void main() {
     vec4 tex = texture(u_texture, v_uv);
@@ -220,9 +248,14 @@ void main() {
     vec3 albedo = u_color * (0.6 + 0.8 * tex.r);
 
 #ifdef KIND_HAIR
+    // Shading's strands and clumps: along the strands their phase also follows the card's
+    // place on the head (v_rest). Cards of one row share their texture's v range, and noise
+    // in v alone lit and darkened every card of a row alike: long01's crown drew its rows of
+    // cards as horizontal bands. (The cards' fraying above keeps the noise in v alone.)
+    vec2 phase = vec2(0.0, dot(v_rest, vec3(3.1, 2.3, 2.7)));
     vec3 t = normalize(v_tangent);
 #ifdef PASS_OPAQUE
-    vec2 sp = v_uv * vec2(420.0, 5.0);
+    vec2 sp = v_uv * vec2(420.0, 5.0) + 2.0 * phase;
     float fine = mix(0.5, value_noise(sp, 0), along_v * clamp(1.8 - 1.6 * fwidth(sp.x), 0.0, 1.0));
 #else
     float fine = 0.5;   // the thin fringe: too sparse for the finest breakup to show
@@ -232,6 +265,10 @@ void main() {
     // clumps differ the way real hair does, the same on every card.
     // (The texture's strands and the widest scale stop at each card's edge: on long01's crown,
     // at full strength they drew the rows of cards, so they keep less weight.)
+    mp += phase;
+    mid = mix(0.5, value_noise(mp, 0), along_v * clamp(2.0 - 1.4 * fwidth(mp.x), 0.0, 1.0));
+    cp += 0.5 * phase;
+    clump = mix(0.5, value_noise(cp, 0), along_v * clamp(2.0 - 1.5 * fwidth(cp.x), 0.0, 1.0));
     float strand = (0.62 + 0.76 * tex.r) * (0.7 + 0.6 * fine) * (0.76 + 0.48 * mid) * (0.92 + 0.16 * clump);
 #ifdef PASS_OPAQUE
 #ifdef COILY
@@ -250,7 +287,7 @@ void main() {
 #ifdef COILY
     albedo = hair_colour(v_uv * 40.0) * strand;
 #else
-    albedo = hair_colour(v_uv * vec2(45.0, 1.2) + 7.0) * strand;
+    albedo = hair_colour(v_uv * vec2(45.0, 1.2) + 7.0 + 0.5 * phase) * strand;
 #endif
     // Depth in the volume: layers near the scalp lie under the outer ones and get little
     // light (roots and the under-layers darker), the gaps between clumps are darker still.
@@ -293,8 +330,15 @@ void main() {
     // Light hair's own diffuse is bright already: a full-strength white lobe on it reads as
     // white streaks, so it takes less.
     gate *= mix(1.0, 0.55, light_hair);
+    // A few sparse glints: single strands (a fraction of a millimetre across, a few long)
+    // that catch the key light sharply where the primary lobe lies, as real hair glitters
+    // here and there instead of shining evenly; faded out where they would be finer than a pixel.
+    vec2 gp = v_uv * vec2(400.0, 9.0) + 13.0 + 3.0 * phase;
+    float glint = smoothstep(0.86, 0.96, value_noise(gp, 0)) * along_v
+                * clamp(1.6 - 1.2 * fwidth(gp.x), 0.0, 1.0);
     vec3 spec = u_key_col * gate * (0.16 * strands * tint * exp2(40.0 * log2(s1))
-                                    + 0.55 * sparkle * u_color * exp2(10.0 * log2(s2)));
+                                    + 0.55 * sparkle * u_color * exp2(10.0 * log2(s2))
+                                    + 0.25 * glint * tint * exp2(40.0 * log2(s1)));
 #else
     vec3 spec = vec3(0.0);
 #endif
