@@ -81,3 +81,18 @@ def test_the_upper_lid_and_lashes_shade_the_sclera_below_them(eye_pixels):
         beside = np.abs(xs - (np.nonzero(iris[:, side])[1].mean() + side.start)) < SIZE / 25
         rows = [lum[y, xs[beside][ys[beside] == y]].mean() for y in range(ys[beside].min(), ys[beside].max() + 1)]
         assert np.mean(rows[:3]) < 0.65 * max(rows), rows
+
+
+@pytest.mark.parametrize("mirrored", [False, True])
+def test_eye_rotation_recovers_the_eyes_turn(mirrored):
+    """The cornea's refraction is computed in the eye's own frame: the renderer recovers each
+    eye's turn from its vertices (a mirrored frame maps by a reflection)."""
+    from scipy.spatial.transform import Rotation
+
+    from facsim.render.geometry import eye_rotation, sphere_directions
+
+    coords = sphere_directions(200)
+    turn = Rotation.from_euler("yx", [30.0, -12.0], degrees=True).as_matrix()
+    frame = np.diag([-1.0, 1.0, 1.0]) if mirrored else np.eye(3)
+    now = 0.16 * coords @ (turn @ frame).T
+    np.testing.assert_allclose(eye_rotation(coords, now), turn @ frame, atol=1e-9)
