@@ -206,7 +206,7 @@ float softbox(vec3 refl, vec3 l, vec2 size) {
     float px = max(fwidth(q.x), fwidth(q.y));
     q *= q;
     float d = sqrt(sqrt(dot(q, q)));   // a superellipse: a rectangle with rounded corners
-    return (1.0 - smoothstep(0.45, 1.2 + px, d)) * (0.8 + 0.2 * (1.0 - min(d, 1.0))) * step(0.0, dot(refl, l));
+    return (1.0 - smoothstep(0.2, 1.2 + px, d)) * (0.8 + 0.2 * (1.0 - min(d, 1.0))) * step(0.0, dot(refl, l));
 }
 const float ROOM_REFLECTION = 0.035;
 // Along the lids (degrees of eyeball arc from the margins, facsim.render.geometry.lid_elevations):
