@@ -631,7 +631,7 @@ void main() {
     float to_gap = min(arc - b0, b1 - arc);
     float convex = 1.0 - 0.08 * pow(side, 3.0);
     float gap = 1.0 - 0.26 * (1.0 - smoothstep(0.0, gap_aa + 0.006, to_gap))
-                    * clamp(1.5 - 120.0 * gap_aa, 0.3, 1.0) * mix(1.0, 0.45, smoothstep(0.1, 0.5, h));
+                    * clamp(1.5 - 120.0 * gap_aa, 0.3, 1.0) * mix(1.0, 0.3, smoothstep(0.04, 0.25, h));
     // Scalloped gum line, arched rootward over each crown (crowns ~10 mm of the band's 16),
     // papillae reaching toward the biting edge between crowns. A smile rarely shows it;
     // where it shows it is pink, lit like the teeth (no dark band under the lip).
@@ -642,28 +642,28 @@ void main() {
     // Ivory enamel, never one flat white: each crown has its own shade and a little of its
     // own hue (canines yellower), mottled in faint vertical streaks; warmer toward the neck
     // where dentin shows through; at the biting edge the enamel holds no dentin and lets the
-    // light through: a translucent blue-grey band (~1.3 mm) under a thin bright rim (the
+    // light through: a translucent blue-grey band (~1.5 mm) under a thin bright rim (the
     // incisal halo, light caught in the edge), as in photographs of teeth.
     float tooth_id = float(kind) + 7.0 * step(0.0, v_uv.x) + 14.0 * lower;
     float vary = hash2(ivec2(int(tooth_id), 29));
-    vec3 enamel = u_albedo * (0.9 + 0.14 * vary) * mix(vec3(1.0), vec3(1.0, 0.97, 0.9), 0.4 + 0.6 * float(kind == 2));
+    vec3 enamel = u_albedo * (0.92 + 0.12 * vary) * mix(vec3(1.0), vec3(1.0, 0.97, 0.9), 0.15 * vary + 0.85 * float(kind == 2));
     float streak = value_noise(vec2(v_uv.x * 140.0, max(h, lingual) * 5.0), 0);
     enamel *= 0.96 + 0.08 * mix(0.5, streak, clamp(1.5 - 20.0 * fwidth(v_uv.x), 0.0, 1.0));
     float edge_h = max(h, lingual) - notch;                 // band units above the edge
-    float incisal = (1.0 - smoothstep(0.02, 0.085, edge_h)) * (kind <= 2 ? 1.0 : 0.5);
-    enamel = mix(enamel, u_albedo * vec3(0.8, 0.87, 0.97), 0.75 * incisal);
+    float incisal = (1.0 - smoothstep(0.025, 0.1, edge_h)) * (kind <= 2 ? 1.0 : 0.5) * mix(1.0, 0.6, lower);
+    enamel = mix(enamel, dot(u_albedo, vec3(0.33)) * vec3(0.86, 0.92, 1.0), 0.65 * incisal);
     float halo_w = max(0.012, fwidth(edge_h));
     enamel *= 1.0 + 0.22 * exp(-edge_h * edge_h / (halo_w * halo_w)) * (0.012 / halo_w) * float(shaped);
     enamel *= mix(vec3(1.0), vec3(1.0, 0.93, 0.8), smoothstep(0.3, gum_edge, h));
     vec3 gums = vec3(0.62, 0.27, 0.28) * (0.92 + 0.16 * value_noise(v_uv * vec2(60.0, 8.0), 0));
     vec3 albedo = mix(enamel * gap * convex, gums, gum);
-    // Each crown bulges (~0.6 mm over its width): its normal turns across it (a surface
+    // Each crown bulges (~1 mm over its width): its normal turns across it (a surface
     // gradient from screen derivatives, as on the skin), so the key lays a soft highlight
     // down each crown and its flanks turn into shade: separate teeth, not a flat strip.
     vec3 dpdx = dFdx(v_pos), dpdy = dFdy(v_pos);
     vec3 r1 = cross(dpdy, n), r2 = cross(n, dpdx);
     float det = dot(dpdx, r1);
-    float bulge_h = 0.006 * (b1 - b0) / 0.08 * (1.0 - (2.0 * w - 1.0) * (2.0 * w - 1.0)) * (1.0 - gum);
+    float bulge_h = 0.01 * (b1 - b0) / 0.08 * (1.0 - (2.0 * w - 1.0) * (2.0 * w - 1.0)) * (1.0 - gum);
     n = normalize(abs(det) * n - sign(det) * (dFdx(bulge_h) * r1 + dFdy(bulge_h) * r2));
     // Light inside the mouth falls off with depth: the front teeth catch it, the back ones sit
     // in the shadow of the cheeks (the dark buccal corridor). The upper lip casts a soft
