@@ -69,6 +69,24 @@ def test_a_catch_light_sits_on_the_iris(eye_pixels):
     assert (lum_iris > np.median(lum_iris) + 60).mean() < 0.05  # ... not a glossy sheet
 
 
+@pytest.mark.parametrize("name", ["amara", "mei"])
+def test_each_eye_shows_one_catch_light(name):
+    """Issue 13: two large reflections (key and fill) read as glossy doll's eyes, and under
+    lower-set lids the key's lay hidden (mei showed none). One small catch-light per eye, on the
+    cornea (iris or pupil)."""
+    from scipy import ndimage
+
+    character = preset(name)
+    image = _render(character)
+    marked = _render(character.with_(colors={**character.colors, "iris": "#ff0000", "pupil": "#ff0000"}))
+    cornea = np.abs(marked - image).sum(-1) > 60
+    bright = cornea & (_luminance(image) > 120)
+    for side in (slice(0, SIZE // 2), slice(SIZE // 2, SIZE)):
+        _, count = ndimage.label(bright[:, side], structure=np.ones((3, 3)))
+        assert count == 1, count
+    assert bright.sum() < 0.05 * cornea.sum()   # small
+
+
 def test_the_upper_lid_and_lashes_shade_the_sclera_below_them(eye_pixels):
     """Beside the iris, the sclera's top rows lie in the lash line's shadow: dark under the lid,
     brightening toward the middle (it was an evenly lit, glassy white to the lid's edge)."""
