@@ -639,14 +639,14 @@ void main() {
     // (Labial side only: the lingual gum lies deep in the arch's shade, and drawn pink it
     // showed as red dots between the lower crowns when 16 bared them.)
     float gum = smoothstep(gum_edge - 0.025, gum_edge + 0.025, h);
-    // Ivory enamel, never one flat white: each crown has its own shade and a little of its
-    // own hue (canines yellower), mottled in faint vertical streaks; warmer toward the neck
+    // Ivory enamel, never one flat white: each crown has its own shade (canines a little
+    // yellower), mottled in faint vertical streaks; warmer toward the neck
     // where dentin shows through; at the biting edge the enamel holds no dentin and lets the
     // light through: a translucent blue-grey band (~1.5 mm) under a thin bright rim (the
     // incisal halo, light caught in the edge), as in photographs of teeth.
     float tooth_id = float(kind) + 7.0 * step(0.0, v_uv.x) + 14.0 * lower;
     float vary = hash2(ivec2(int(tooth_id), 29));
-    vec3 enamel = u_albedo * (0.92 + 0.12 * vary) * mix(vec3(1.0), vec3(1.0, 0.97, 0.9), 0.15 * vary + 0.85 * float(kind == 2));
+    vec3 enamel = u_albedo * (0.92 + 0.12 * vary) * mix(vec3(1.0), vec3(1.0, 0.97, 0.9), float(kind == 2));
     float streak = value_noise(vec2(v_uv.x * 140.0, max(h, lingual) * 5.0), 0);
     enamel *= 0.96 + 0.08 * mix(0.5, streak, clamp(1.5 - 20.0 * fwidth(v_uv.x), 0.0, 1.0));
     float edge_h = max(h, lingual) - notch;                 // band units above the edge
