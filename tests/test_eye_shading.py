@@ -69,6 +69,24 @@ def test_a_catch_light_sits_on_the_iris(eye_pixels):
     assert (lum_iris > np.median(lum_iris) + 60).mean() < 0.05  # ... not a glossy sheet
 
 
+@pytest.mark.parametrize("name", ["amara", "mei"])
+def test_each_eye_shows_one_catch_light(name):
+    """Issue 13: two large reflections (key and fill) read as glossy doll's eyes, and under
+    lower-set lids the key's lay hidden (mei showed none). One small catch-light per eye, on the
+    cornea (iris or pupil)."""
+    from scipy import ndimage
+
+    character = preset(name)
+    image = _render(character)
+    marked = _render(character.with_(colors={**character.colors, "iris": "#ff0000", "pupil": "#ff0000"}))
+    cornea = np.abs(marked - image).sum(-1) > 60
+    bright = cornea & (_luminance(image) > 120)
+    for side in (slice(0, SIZE // 2), slice(SIZE // 2, SIZE)):
+        _, count = ndimage.label(bright[:, side], structure=np.ones((3, 3)))
+        assert count == 1, count
+    assert bright.sum() < 0.05 * cornea.sum()   # small
+
+
 def test_the_upper_lid_and_lashes_shade_the_sclera_below_them(eye_pixels):
     """Beside the iris, the sclera's top rows lie in the lash line's shadow: dark under the lid,
     brightening toward the middle (it was an evenly lit, glassy white to the lid's edge)."""
@@ -81,3 +99,18 @@ def test_the_upper_lid_and_lashes_shade_the_sclera_below_them(eye_pixels):
         beside = np.abs(xs - (np.nonzero(iris[:, side])[1].mean() + side.start)) < SIZE / 25
         rows = [lum[y, xs[beside][ys[beside] == y]].mean() for y in range(ys[beside].min(), ys[beside].max() + 1)]
         assert np.mean(rows[:3]) < 0.65 * max(rows), rows
+
+
+@pytest.mark.parametrize("mirrored", [False, True])
+def test_eye_rotation_recovers_the_eyes_turn(mirrored):
+    """The cornea's refraction is computed in the eye's own frame: the renderer recovers each
+    eye's turn from its vertices (a mirrored frame maps by a reflection)."""
+    from scipy.spatial.transform import Rotation
+
+    from facsim.render.geometry import eye_rotation, sphere_directions
+
+    coords = sphere_directions(200)
+    turn = Rotation.from_euler("yx", [30.0, -12.0], degrees=True).as_matrix()
+    frame = np.diag([-1.0, 1.0, 1.0]) if mirrored else np.eye(3)
+    now = 0.16 * coords @ (turn @ frame).T
+    np.testing.assert_allclose(eye_rotation(coords, now), turn @ frame, atol=1e-9)

@@ -457,8 +457,10 @@ class BoundProxy:
             # along the taper.
             y = self.neutral[:, 1]
             # (Issue 13: at 0.45 they still read as painted doll's lashes; real lower lashes
-            # are short, sparse and hardly show beside the upper ones.)
-            depth = np.where(y < 0.5 * (y.min() + y.max()), 0.65 + 0.35 * depth, depth)
+            # are short, sparse and hardly show beside the upper ones. At 0.65 men's were
+            # gone: the lower lid then read as bare, its margin a painted line. Shorter
+            # (lower_lash_reach) but a little denser at the roots, they show as a fine row.)
+            depth = np.where(y < 0.5 * (y.min() + y.max()), 0.58 + 0.42 * depth, depth)
         return np.clip(depth, 0.0, 1.0).astype(np.float32)
 
     @property

@@ -160,6 +160,18 @@ def sphere_directions(n: int) -> np.ndarray:
     return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)
 
 
+def eye_rotation(eye_coord: np.ndarray, offsets: np.ndarray) -> np.ndarray:
+    """(3, 3) the orthogonal map that takes an eye's own frame to the world this frame.
+
+    ``eye_coord`` (N, 3) are the eyeball's vertices as directions in its own frame (+Z the
+    gaze), ``offsets`` (N, 3) the same vertices now, less the eyeball's centre. The best fit
+    in least squares (Kabsch); a mirrored eye frame gives a reflection, which is what maps
+    its directions to the world.
+    """
+    u, _, vt = np.linalg.svd(offsets.T @ eye_coord)
+    return u @ vt
+
+
 def _orientation(p: np.ndarray, faces: np.ndarray) -> float:
     """> 0 when the triangles' winding normals point away from their centroid (outward)."""
     a, b, c = p[faces[:, 0]], p[faces[:, 1]], p[faces[:, 2]]

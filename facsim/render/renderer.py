@@ -46,7 +46,7 @@ import numpy as np
 
 from facsim.render.camera import Camera, projection_matrix, view_matrix, _size_pair
 from facsim.media.images import write_png
-from facsim.render.geometry import (CREASES_PER_DM, _faces_touching, _orientation, crease_phase, lash_coordinates,
+from facsim.render.geometry import (CREASES_PER_DM, _faces_touching, _orientation, crease_phase, eye_rotation, lash_coordinates,
                               normal_operator, region_components, sphere_centre, sphere_directions,
                               vertex_normals)
 from facsim.render.gl import RenderError, _set_uniform, _shader_source, gl_context
@@ -231,6 +231,7 @@ class Renderer:
         self._hair_moving = None  # this frame: {layer: cards drawn over the kept pixels}, or None
         self._eyes = region_components(topology, "eyeball")
         self._eye_render = np.flatnonzero(topology.region == REGIONS.index("eyeball"))
+        self._eye_frames = _eye_frame_coordinates(topology, self._eyes)
         self._lashes = region_components(topology, "lashes")
         self._lash_vertices = (np.concatenate(self._lashes) if self._lashes
                                else np.zeros(0, dtype=np.int64))
@@ -784,6 +785,10 @@ class Renderer:
         _set_uniform(prog, "u_eye_a", tuple(float(x) for x in centres[0]))
         _set_uniform(prog, "u_eye_b", tuple(float(x) for x in centres[1]))
         _set_uniform(prog, "u_eye_radius", radius)
+        # Each eye's turn (its own frame -> world) for the cornea's refraction and bulge.
+        for uniform, eye, coords, centre in zip(("u_eye_rot_a", "u_eye_rot_b"), self._eyes, self._eye_frames, centres):
+            rotation = eye_rotation(coords, p[eye].astype(np.float64) - centre)
+            _set_uniform(prog, uniform, tuple(float(x) for x in rotation.T.reshape(-1)))  # column-major
 
     def _set_camera(self, camera: Camera, lighting: Lighting) -> None:
         w, h = self.size
@@ -917,6 +922,17 @@ class Renderer:
         state = "closed" if self._closed else "open"
         return (f"Renderer({self.topology.n_render} vertices, {len(self.topology.faces)} faces, "
                 f"size={self.size}, {self.aa_method} x{self.antialias}, {state})")
+
+
+def _eye_frame_coordinates(topology: RenderTopology, eyes: list) -> list:
+    """Per eyeball (geometry vertex indices), each vertex's direction in the eye's own frame."""
+    frames = []
+    for eye in eyes:
+        coords = np.zeros((len(eye), 3))
+        rows = np.flatnonzero(np.isin(topology.render_to_geo, eye))
+        coords[np.searchsorted(eye, topology.render_to_geo[rows])] = topology.eye_coord[rows]
+        frames.append(coords)
+    return frames
 
 
 def _per_vertex(name: str, value, n_rows: int, n_used: int) -> np.ndarray | None:

@@ -162,6 +162,10 @@ uniform vec3 u_pupil;
 uniform vec3 u_eye_a = vec3(1.0, 0.0, 0.0);
 uniform vec3 u_eye_b = vec3(-1.0, 0.0, 0.0);
 uniform float u_eye_radius = 1.0;
+// Each eye's own frame -> world this frame (Renderer._set_eye_centres; a mirrored frame is a
+// reflection): the view seen from inside the eye, for the cornea's refraction and bulge.
+uniform mat3 u_eye_rot_a = mat3(1.0);
+uniform mat3 u_eye_rot_b = mat3(1.0);
 // Radii as fractions of the eyeball radius, measured in the plane across the gaze axis
 // (length of eye_coord.xy on the front half). hm08's eyeballs are 1.59 cm in radius:
 // an iris 11.7 mm across (the adult mean) and a 4 mm pupil.
@@ -169,32 +173,47 @@ const float IRIS_RADIUS = 0.368;
 const float PUPIL_RADIUS = 0.13;
 const float LIMBUS_WIDTH = 0.22;   // fraction of the iris annulus darkened at its rim
 const float CORNEA_RADIUS = 0.49;  // radius of the cornea's curvature, 1.33 iris radii
+// The iris lies in the anterior chamber, behind the cornea: the eyeball's sphere puts it
+// only ~1.1 mm under the corneal apex, the apex is ~3.6 mm in front of it; this is the extra depth
+// (eyeball radii) at the iris's centre, falling to nothing at the limbus. Seen through the
+// cornea (refractive index 1.376), the iris shifts against the eyeball as the view turns.
+const float ANTERIOR_CHAMBER = 0.15;
+const float CORNEA_INDEX = 1.376;
 const int IRIS_FIBRES = 96;        // radial noise cells around the iris
 const float COLLARETTE = 0.33;     // where the collarette lies across the iris annulus (0 pupil, 1 rim)
 const vec2 CARUNCLE = vec2(0.5, 0.58);   // nasal e.x where the caruncle begins and is full
 // The key's reflection in the cornea: the softbox's half-size (radians, across and up) and
-// strength; the room's faint reflection over the whole cornea.
-const vec2 SOFTBOX = vec2(0.22, 0.19);
-const float KEY_REFLECTION = 0.5;
+// strength; the room's faint reflection over the whole cornea. (Issue 13: at 0.22 x 0.19
+// with the fill's at 0.6, two large bright patches read as glossy doll's eyes.)
+const vec2 SOFTBOX = vec2(0.17, 0.14);
+// The key softbox is large: the cornea mirrors its lower part, ~16 degrees above the eye
+// rather than the key's ~30 (its middle's reflection lies under the upper lid of most eyes,
+// which then showed no catch-light at all: liam's did not).
+const float SOFTBOX_DROP = 0.22;
+const float KEY_REFLECTION = 0.6;
 // The fill is a broad bounce card to the side: a larger, dimmer reflection (it shows where
 // a lowered lid hides the key's, as in photographs).
 const vec2 FILL_BOX = vec2(0.2, 0.3);
-const float FILL_REFLECTION = 0.6;
+const float FILL_REFLECTION = 0.15;
 // Coverage of a soft-edged rounded rectangle of half-size `size` (radians) centred on the
 // light direction `l`, seen along the reflected ray `refl` (for catch-lights).
 float softbox(vec3 refl, vec3 l, vec2 size) {
     vec3 bu = normalize(cross(l, vec3(0.0, 1.0, 0.0)));
     vec3 bv = cross(bu, l);
     vec2 q = vec2(dot(refl, bu), dot(refl, bv)) / size;
+    // (Its soft edge widens by a pixel where the box is smaller than that, so small
+    // images keep a catch-light instead of missing it between pixel centres.)
+    float px = max(fwidth(q.x), fwidth(q.y));
     q *= q;
     float d = sqrt(sqrt(dot(q, q)));   // a superellipse: a rectangle with rounded corners
-    return (1.0 - smoothstep(0.65, 1.3, d)) * (0.8 + 0.2 * (1.0 - min(d, 1.0))) * step(0.0, dot(refl, l));
+    return (1.0 - smoothstep(0.2, 1.2 + px, d)) * (0.8 + 0.2 * (1.0 - min(d, 1.0))) * step(0.0, dot(refl, l));
 }
 const float ROOM_REFLECTION = 0.035;
 // Along the lids (degrees of eyeball arc from the margins, facsim.render.geometry.lid_elevations):
 // the lower lid's wet rim and the tear line over it; the upper lid's shadow (depth, reach).
 const float WET_RIM = 1.6;
 const vec3 WET_RIM_COLOR = vec3(0.5, 0.25, 0.23);   // moist lid tissue (linear), whatever the skin
+const float WET_RIM_SHEEN = 0.3;   // its film's reflection of the room
 const float TEAR_WIDTH = 0.7;
 const float TEAR_SHINE = 0.15;
 const vec2 UPPER_SHADOW = vec2(0.6, 2.5);
@@ -427,10 +446,23 @@ void main() {
     float r = length(e.xy);
     float front = step(0.0, e.z);
     float aa = max(fwidth(r), 1e-4);
+    bool on_a = distance(v_pos, u_eye_a) < distance(v_pos, u_eye_b);
+    mat3 eye_rot = on_a ? u_eye_rot_a : u_eye_rot_b;
+    // The cornea bulges over the iris as a sphere of 1.33 iris radii (7.8 mm over an
+    // 11.7-mm iris). The view ray refracts through it and meets the iris deeper in: the
+    // iris (and pupil) is drawn where the refracted ray lands, so it shifts with the view
+    // as a real one does (parallax), while the limbus stays on the eyeball.
+    vec2 bulge = e.xy / CORNEA_RADIUS;
+    vec3 corneal = vec3(bulge, sqrt(max(1.0 - dot(bulge, bulge), 0.0)));
+    vec3 into = refract(-(transpose(eye_rot) * v), corneal, 1.0 / CORNEA_INDEX);
+    float chamber = ANTERIOR_CHAMBER * max(1.0 - r * r / (IRIS_RADIUS * IRIS_RADIUS), 0.0);
+    vec2 seen = e.xy + into.xy * chamber / max(-into.z, 0.25);
+    float ri = length(seen);
+    float aai = max(fwidth(ri), 1e-4);
     float iris_mask = front * (1.0 - smoothstep(IRIS_RADIUS - aa, IRIS_RADIUS + aa, r));
-    float pupil_mask = front * (1.0 - smoothstep(PUPIL_RADIUS - aa, PUPIL_RADIUS + aa, r));
-    float t = clamp((r - PUPIL_RADIUS) / (IRIS_RADIUS - PUPIL_RADIUS), 0.0, 1.0);
-    float angle = atan(e.y, e.x);
+    float pupil_mask = front * (1.0 - smoothstep(PUPIL_RADIUS - aai, PUPIL_RADIUS + aai, ri));
+    float t = clamp((ri - PUPIL_RADIUS) / (IRIS_RADIUS - PUPIL_RADIUS), 0.0, 1.0);
+    float angle = atan(seen.y, seen.x);
     float turns = (angle / (2.0 * PI) + 0.5) * float(IRIS_FIBRES);
     // Stroma: fine radial fibres (long along the radius, narrow around it), coarser bundles,
     // faded to their mean where they would be finer than a pixel (small images stay calm).
@@ -458,11 +490,10 @@ void main() {
     iris *= mix(1.0, 0.28, smoothstep(1.0 - LIMBUS_WIDTH, 1.0, t));   // limbal ring
     // The pupil is not ink: the lens behind it returns a little light (and the cornea in
     // front reflects the room, below).
-    vec3 pupil = max(u_pupil, vec3(0.006, 0.0055, 0.0055)) * mix(1.3, 0.8, smoothstep(0.0, 0.8, r / PUPIL_RADIUS));
+    vec3 pupil = max(u_pupil, vec3(0.006, 0.0055, 0.0055)) * mix(1.3, 0.8, smoothstep(0.0, 0.8, ri / PUPIL_RADIUS));
     iris = mix(iris, pupil, pupil_mask);
     // The socket's frame: hx across the eye toward the nose (the other eye), hy up, in
     // eyeball radii from this eye's centre.
-    bool on_a = distance(v_pos, u_eye_a) < distance(v_pos, u_eye_b);
     vec3 centre = on_a ? u_eye_a : u_eye_b;
     vec3 to_nose = (on_a ? u_eye_b : u_eye_a) - centre;
     to_nose = length(to_nose) > 1e-6 ? normalize(to_nose) : vec3(-sign(v_pos.x), 0.0, 0.0);
@@ -505,7 +536,8 @@ void main() {
     // (Both fade out toward the canthi, where the lower margin turns up steeply and the
     // caruncle takes over.)
     float along_lower = (1.0 - smoothstep(0.45, 0.62, abs(hx))) * (1.0 - smoothstep(-0.1, 0.1, hy));
-    albedo = mix(albedo, WET_RIM_COLOR, rim * along_lower);
+    float wet_rim = rim * along_lower;
+    albedo = mix(albedo, WET_RIM_COLOR, wet_rim);
     float tear_w = max(TEAR_WIDTH, px);
     float tear = exp(-pow((v_lids.y - WET_RIM - 0.5 * TEAR_WIDTH) / tear_w, 2.0)) * TEAR_WIDTH / tear_w * along_lower;
     float lash_shadow = 1.0 - UPPER_SHADOW.x * exp(-max(v_lids.x, 0.0) / UPPER_SHADOW.y);
@@ -514,7 +546,7 @@ void main() {
     occ *= (1.0 - UPPER_LID_SHADE.x * exp(-max(v_lids.x, 0.0) / UPPER_LID_SHADE.y))
          * (1.0 - LOWER_LID_SHADE.x * exp(-max(v_lids.y, 0.0) / LOWER_LID_SHADE.y));
 #else
-    float rim = 0.0, tear = 0.0, lash_shadow = 1.0;
+    float rim = 0.0, wet_rim = 0.0, tear = 0.0, lash_shadow = 1.0;
 #endif
     // The eyeball sits in the lids' shade. The thick upper lid and its lashes shadow a band
     // under its margin and the lower lid a little above its own: that shade follows the lids
@@ -529,26 +561,28 @@ void main() {
     vec3 diffuse = diffuse_light(n, vec3(0.15), occ) * albedo * lid_shade;
     // Wet surface. The cornea bulges over the iris as a sphere of 1.33 iris radii (7.8 mm
     // over an 11.7-mm iris), so its normal tilts faster than the eyeball's: the catch-light
-    // sits on the iris, not beside it. (The eye frame is the world's while head and gaze are
-    // at rest; the tilt is added to the world normal, exact at rest and close for the small
-    // turns of 51-58 and 61-64.) It mirrors what lights the face: the key is a large
-    // softbox, so its catch-light is a soft-edged rounded rectangle, not a pin-point, and
-    // the room's faint glow lies over the whole cornea (the pupil is never ink black).
+    // sits on the iris, not beside it (eye_rot turns the corneal normal with the eye). It
+    // mirrors what lights the face: the key is a softbox, so its catch-light is one small,
+    // soft-edged rounded rectangle, not a pin-point nor a glossy blob; the fill's is faint,
+    // and the room's faint glow lies over the whole cornea (the pupil is never ink black).
     float cornea = front * (1.0 - smoothstep(IRIS_RADIUS - 0.02, IRIS_RADIUS + 0.02, r));
-    vec2 bulge = e.xy / CORNEA_RADIUS;
-    vec3 corneal = vec3(bulge, sqrt(max(1.0 - dot(bulge, bulge), 0.0)));
-    vec3 nc = normalize(n + (corneal - e) * cornea);
+    vec3 nc = normalize(mix(n, eye_rot * corneal, cornea));
     vec3 refl = reflect(-v, nc);
     float ndv = max(dot(nc, v), 0.0);
     float fres = schlick(0.025, ndv) / 0.025;
     vec3 room = mix(u_ground_col, u_sky_col, 0.5 + 0.5 * refl.y) * ROOM_REFLECTION;
-    vec3 boxes = softbox(refl, u_key_dir, SOFTBOX) * u_key_col
+    vec3 boxes = softbox(refl, normalize(u_key_dir - vec3(0.0, SOFTBOX_DROP, 0.0)), SOFTBOX) * u_key_col
                + softbox(refl, u_fill_dir, FILL_BOX) * u_fill_col * FILL_REFLECTION;
     vec3 spec = (boxes * KEY_REFLECTION + room) * fres * mix(0.45, 1.0, cornea);
     // The sclera and the lid's wet rim are wet too but less smooth (a broad sheen), and the
     // tear meniscus catches a thin bright line of the key.
     spec += specular_light(n, v, 40.0) * 0.03 + tear * u_key_col * TEAR_SHINE;
     spec *= mix(0.5, 1.0, lash_shadow) * mix(0.4, 1.0, lid_shade / 0.7);
+    // The lower lid's wet margin faces up and out of the socket: it takes the room's ambient
+    // light that the eyeball under the lids does not, and its film mirrors the room as a
+    // soft sheen, so it reads as a moist band, not a painted pink line.
+    spec += wet_rim * mix(u_ground_col, u_sky_col, 0.5 + 0.5 * refl.y) * WET_RIM_SHEEN;
+    diffuse += wet_rim * WET_RIM_COLOR * hemisphere(n) * 0.5 * (1.0 - lid_shade);
     radiance = diffuse + spec * occ;
 #endif
 
@@ -595,9 +629,9 @@ void main() {
     // finer than a pixel.
     float gap_aa = fwidth(arc);
     float to_gap = min(arc - b0, b1 - arc);
-    float convex = 1.0 - 0.16 * pow(side, 3.0);
+    float convex = 1.0 - 0.08 * pow(side, 3.0);
     float gap = 1.0 - 0.26 * (1.0 - smoothstep(0.0, gap_aa + 0.006, to_gap))
-                    * clamp(1.5 - 120.0 * gap_aa, 0.3, 1.0) * mix(1.0, 0.45, smoothstep(0.1, 0.5, h));
+                    * clamp(1.5 - 120.0 * gap_aa, 0.3, 1.0) * mix(1.0, 0.3, smoothstep(0.04, 0.25, h));
     // Scalloped gum line, arched rootward over each crown (crowns ~10 mm of the band's 16),
     // papillae reaching toward the biting edge between crowns. A smile rarely shows it;
     // where it shows it is pink, lit like the teeth (no dark band under the lip).
@@ -605,15 +639,32 @@ void main() {
     // (Labial side only: the lingual gum lies deep in the arch's shade, and drawn pink it
     // showed as red dots between the lower crowns when 16 bared them.)
     float gum = smoothstep(gum_edge - 0.025, gum_edge + 0.025, h);
-    // Ivory enamel: translucent at the edge (a little grey-blue where the dark mouth shows
-    // through), warmer toward the neck where dentin shows, a little variation tooth to tooth.
+    // Ivory enamel, never one flat white: each crown has its own shade (canines a little
+    // yellower), mottled in faint vertical streaks; warmer toward the neck
+    // where dentin shows through; at the biting edge the enamel holds no dentin and lets the
+    // light through: a translucent blue-grey band (~1.5 mm) under a thin bright rim (the
+    // incisal halo, light caught in the edge), as in photographs of teeth.
     float tooth_id = float(kind) + 7.0 * step(0.0, v_uv.x) + 14.0 * lower;
-    float vary = fract(sin(tooth_id * 12.9898) * 43758.5453);
-    vec3 enamel = u_albedo * (0.96 + 0.06 * vary);
-    enamel *= mix(vec3(0.82, 0.86, 0.92), vec3(1.0), smoothstep(notch, notch + 0.09, max(h, lingual)));
-    enamel *= mix(vec3(1.0), vec3(1.0, 0.94, 0.83), smoothstep(0.3, gum_edge, h));
+    float vary = hash2(ivec2(int(tooth_id), 29));
+    vec3 enamel = u_albedo * (0.92 + 0.12 * vary) * mix(vec3(1.0), vec3(1.0, 0.97, 0.9), float(kind == 2));
+    float streak = value_noise(vec2(v_uv.x * 140.0, max(h, lingual) * 5.0), 0);
+    enamel *= 0.96 + 0.08 * mix(0.5, streak, clamp(1.5 - 20.0 * fwidth(v_uv.x), 0.0, 1.0));
+    float edge_h = max(h, lingual) - notch;                 // band units above the edge
+    float incisal = (1.0 - smoothstep(0.025, 0.1, edge_h)) * (kind <= 2 ? 1.0 : 0.5) * mix(1.0, 0.6, lower);
+    enamel = mix(enamel, dot(u_albedo, vec3(0.33)) * vec3(0.86, 0.92, 1.0), 0.65 * incisal);
+    float halo_w = max(0.012, fwidth(edge_h));
+    enamel *= 1.0 + 0.22 * exp(-edge_h * edge_h / (halo_w * halo_w)) * (0.012 / halo_w) * float(shaped);
+    enamel *= mix(vec3(1.0), vec3(1.0, 0.93, 0.8), smoothstep(0.3, gum_edge, h));
     vec3 gums = vec3(0.62, 0.27, 0.28) * (0.92 + 0.16 * value_noise(v_uv * vec2(60.0, 8.0), 0));
     vec3 albedo = mix(enamel * gap * convex, gums, gum);
+    // Each crown bulges (~1 mm over its width): its normal turns across it (a surface
+    // gradient from screen derivatives, as on the skin), so the key lays a soft highlight
+    // down each crown and its flanks turn into shade: separate teeth, not a flat strip.
+    vec3 dpdx = dFdx(v_pos), dpdy = dFdy(v_pos);
+    vec3 r1 = cross(dpdy, n), r2 = cross(n, dpdx);
+    float det = dot(dpdx, r1);
+    float bulge_h = 0.01 * (b1 - b0) / 0.08 * (1.0 - (2.0 * w - 1.0) * (2.0 * w - 1.0)) * (1.0 - gum);
+    n = normalize(abs(det) * n - sign(det) * (dFdx(bulge_h) * r1 + dFdy(bulge_h) * r2));
     // Light inside the mouth falls off with depth: the front teeth catch it, the back ones sit
     // in the shadow of the cheeks (the dark buccal corridor). The upper lip casts a soft
     // contact shadow just under its edge: v_occlusion is the fragment's height (dm) below
@@ -643,7 +694,7 @@ void main() {
     // The tongue lies in the shadow of the lips and upper teeth: dim at the tip, dark toward
     // the throat and at its sides against the teeth.
     // How much light the parted lips let in arrives in occ (facsim.head.mouth.mouth_light).
-    float mouth_shade = mix(0.45, 0.05, smoothstep(0.0, 0.3, along)) * mix(1.0, 0.5, smoothstep(0.4, 1.0, abs(across)))
+    float mouth_shade = mix(0.36, 0.04, smoothstep(0.0, 0.3, along)) * mix(1.0, 0.5, smoothstep(0.4, 1.0, abs(across)))
                       * mix(0.1, 1.0, occ);
     // Moist: a soft sheen broken by the papillae, and a tighter glint on the film of saliva.
     vec3 spec = specular_light(n, v, 40.0) * 0.12 * papillae + specular_light(n, v, 90.0) * 0.3 * smoothstep(0.8, 1.1, papillae);

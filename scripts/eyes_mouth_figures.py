@@ -1,0 +1,113 @@
+"""Print objective figures for the eyes and teeth as rendered (issue 13), per character.
+
+Each part's pixels are found by rendering the same frame again with that part in a loud
+colour and keeping the pixels that changed (as ``tests/test_eye_shading.py`` does).
+
+Teeth, in a 6+12+25 smile at 512²: mean luminance (0–255) and chroma (max − min of RGB) of
+the teeth's pixels, and how much bluer (B − R) the biting edge is than the crowns (the
+lowest two pixels of each column of the upper row's middle third against the rest).
+
+Eyes, neutral: catch-lights per eye at 320² (connected pixels over iris and pupil brighter
+than 120, without anti-aliasing, as in the tests), their area; in the three-quarter-left
+view at 512² the pupil's centre less the visible cornea's (px along x; positive toward
+the camera side: the refracted iris's parallax); the lower lashes' coverage (summed change,
+in pixels, when the lashes are recoloured, in a band 12 px deep under each eye's sclera).
+
+Usage::
+
+    python3 scripts/eyes_mouth_figures.py [CHARACTER ...]      (default: amara liam mei george)
+"""
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+from scipy import ndimage
+
+from facsim import Face
+from facsim.head.character import preset
+
+LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
+WHITE = (1.0, 1.0, 1.0)
+
+
+def _renders(character, expression, recolours, *, size, view="front", antialias=4):
+    """The frame and the same frame with each of ``recolours`` applied, as float RGB."""
+    images = []
+    with Face(character) as face:
+        deformation = face.deform(expression)
+        images.append(face.render(deformation=deformation, size=size, view=view, antialias=antialias,
+                                  background=WHITE))
+    for colours in recolours:
+        with Face(character.with_(colors={**character.colors, **colours})) as face:
+            images.append(face.render(deformation=deformation, size=size, view=view, antialias=antialias,
+                                      background=WHITE))
+    return [image[..., :3].astype(float) for image in images]
+
+
+def _changed(marked, image):
+    return np.abs(marked - image).sum(-1) > 60
+
+
+def teeth_figures(character, expression="6+12+25", size=512) -> dict:
+    image, marked = _renders(character, expression, [{"teeth": "#00ff00"}], size=size)
+    teeth = (marked[..., 1] > marked[..., 0] + 20) & (marked[..., 1] > marked[..., 2] + 20)
+    pixels = image[teeth]
+    ys, xs = np.nonzero(teeth)
+    middle = np.abs(xs - xs.mean()) < (xs.max() - xs.min()) / 6
+    edge, crown = [], []
+    for x in np.unique(xs[middle]):
+        column = np.sort(ys[xs == x])
+        upper = column[: np.argmax(np.diff(np.r_[column, column[-1] + 2]) > 1) + 1]  # first run from the top
+        edge += [image[y, x] for y in upper[-2:]]
+        crown += [image[y, x] for y in upper[:-2]]
+    edge, crown = np.array(edge), np.array(crown)
+    return {"luminance": round(float((pixels @ LUMINANCE).mean()), 1),
+            "chroma": round(float((pixels.max(1) - pixels.min(1)).mean()), 1),
+            "edge_bluer_by": round(float((edge[:, 2] - edge[:, 0]).mean() - (crown[:, 2] - crown[:, 0]).mean()), 1)}
+
+
+def catch_light_figures(character, size=320) -> dict:
+    image, marked = _renders(character, "", [{"iris": "#ff0000", "pupil": "#ff0000"}], size=size, antialias=1)
+    bright = _changed(marked, image) & (image @ LUMINANCE > 120)
+    half = size // 2
+    counts = [ndimage.label(bright[:, side], structure=np.ones((3, 3)))[1]
+              for side in (slice(0, half), slice(half, size))]
+    return {"catch_lights_per_eye": counts, "catch_light_px": int(bright.sum())}
+
+
+def three_quarter_figures(character, size=512) -> dict:
+    image, iris_marked, pupil_marked, sclera_marked, lash_marked = _renders(
+        character, "", [{"iris": "#ff0000"}, {"pupil": "#0000ff"}, {"sclera": "#00ff00"}, {"lashes": "#00ff00"}],
+        size=size, view="three-quarter-left")
+    iris = _changed(iris_marked, image)
+    sclera = _changed(sclera_marked, image) & ~iris
+    pupil = _changed(pupil_marked, image) & ~iris & ~sclera
+    cornea, count = ndimage.label(iris | pupil)
+    offsets = []
+    for k in range(1, count + 1):
+        piece = cornea == k
+        if (piece & pupil).sum() > 5:
+            offsets.append(round(float(np.nonzero(piece & pupil)[1].mean() - np.nonzero(piece)[1].mean()), 2))
+    lash = np.abs(lash_marked - image).sum(-1) / 255.0
+    below = np.zeros(lash.shape, bool)
+    eyes, n_eyes = ndimage.label(ndimage.binary_dilation(sclera | iris | pupil, iterations=3))
+    for k in range(1, n_eyes + 1):
+        ys, xs = np.nonzero(eyes == k)
+        if len(ys) > 20:
+            below[ys.max() - 1: ys.max() + 12, xs.min(): xs.max() + 1] = True
+    return {"pupil_offset_px": offsets, "lower_lash_cover": round(float(lash[below].sum()), 1)}
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("characters", nargs="*", default=["amara", "liam", "mei", "george"])
+    args = parser.parse_args(argv)
+    for name in args.characters:
+        character = preset(name)
+        figures = {**teeth_figures(character), **catch_light_figures(character), **three_quarter_figures(character)}
+        print(name, "  ".join(f"{k} {v}" for k, v in figures.items()), flush=True)
+
+
+if __name__ == "__main__":
+    main()
