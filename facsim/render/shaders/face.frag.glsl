@@ -58,7 +58,10 @@ vec3 specular_light(vec3 n, vec3 v, float shininess) {
 
 #ifdef REGION_SKIN
 uniform sampler2D u_paint;   // R brow hair density, G lips, B eyelids, A cheek blush
-uniform sampler2D u_detail;  // R redness, G beard area, B oiliness, A age lines
+uniform sampler2D u_detail;  // R redness, G beard area, B oiliness
+const float FOLD_TEXELS = 3.0;   // a groove's half-width in fold-map texels (~0.8 mm each on the face)
+uniform sampler2D u_folds;   // R forehead lines + crow's feet, G under-eye lines, B fold shade,
+                             // A where R and G replace the engine's furrows (facsim.head.skin)
 uniform sampler2D u_tone;    // R periorbital darkening, G translucency, B pores, A sun (facsim.head.skin)
 uniform float u_beard;       // 0..1 stubble shadow
 uniform float u_age;         // 0..1 how much the age lines show
@@ -297,28 +300,41 @@ void main() {
 #endif
     float hair = brow.x;
     albedo = mix(albedo, u_brows * brow.y, hair);
-    // Age lines and folds (detail.a: forehead lines, crow's feet, nasolabial and marionette
-    // folds, tear troughs) are grooves in the skin, not paint: only their floor darkens a
-    // little; their slopes shade them (below), lit on one flank and in soft shade on the other.
-    // They deepen where the skin is pushed together: a smile's compression deepens the
-    // nasolabial fold and the crow's feet, raised brows the forehead lines, on any face (the
-    // lines of a young face show only then).
+    // Folds of skin (u_folds): the forehead lines and crow's feet, the under-eye lines, the
+    // nasolabial and marionette folds, as soft grooves 3-5 mm across, not painted strokes: their
+    // sloping sides shade them (lit on one flank, in soft shade on the other) and their floor
+    // darkens only a little. Age shows them; the forehead lines and crow's feet also deepen
+    // where the skin is pushed together (raised brows for the forehead, the raised cheek of 6
+    // for the crow's feet: the lines of a young face show only then). The nasolabial and
+    // marionette folds are a soft shade on the cheek's side (the smile's deepening fold is in
+    // the geometry), not a line.
+    vec4 folds = texture(u_folds, v_uv);
 #ifdef USE_WRINKLE
-    float line_depth = min(u_age + 0.5 * smoothstep(0.03, 0.35, v_wrinkle), 1.5);
+    float line_depth = min(u_age + 1.1 * smoothstep(0.03, 0.35, v_wrinkle), 1.4);
 #else
     float line_depth = u_age;
 #endif
-    float cavity = 1.0 - 0.25 * line_depth * detail.a;
+    float lines = folds.r * line_depth, under_eye = folds.g * u_age;
+    float cavity = (1.0 - 0.1 * lines - 0.04 * under_eye) * (1.0 - 0.12 * u_age * folds.b);
     // Surface frame for bump mapping from screen derivatives (Mikkelsen's surface gradient):
     // a height h tilts the normal to normalize(|det| n - sign(det) (dh/dx r1 + dh/dy r2)).
     vec3 dpdx = dFdx(v_pos), dpdy = dFdy(v_pos);
     vec3 r1 = cross(dpdy, n), r2 = cross(n, dpdx);
     float det = dot(dpdx, r1);
     vec3 n_smooth = n;
-    float age_h = -0.022 * line_depth * detail.a;   // up to 3 mm deep (dm), ~2 mm across
-    n = normalize(abs(det) * n - sign(det) * (dFdx(age_h) * r1 + dFdy(age_h) * r2));
+    // The grooves' slopes (up to ~3 mm deep, dm) come from the map alone, their depth held
+    // constant across them: the wrinkle amount is interpolated per triangle, and its slope
+    // broke the grooves into facets where 6 squeezes the outer eye corner. They fade out where
+    // they would be narrower than about two pixels (a pre-filter: the slope is constant over
+    // each 2x2 pixel quad, so narrower grooves would break into light and dark blocks).
+    vec2 texel = v_uv * vec2(textureSize(u_folds, 0));
+    float groove_px = FOLD_TEXELS / max(max(length(dFdx(texel)), length(dFdy(texel))), 1e-6);
+    vec2 depth = vec2(-0.024 * line_depth, -0.006 * u_age) * clamp(groove_px - 1.5, 0.0, 1.0);
+    float dh_dx = dot(dFdx(folds.rg), depth), dh_dy = dot(dFdy(folds.rg), depth);
+    n = normalize(abs(det) * n - sign(det) * (dh_dx * r1 + dh_dy * r2));
 #ifdef USE_WRINKLE
-    Fold fold = crease_fold(v_wrinkle, v_crease, v_uv);
+    // The engine's furrows, except where the fold map draws the lines itself (folds.a).
+    Fold fold = crease_fold(v_wrinkle * (1.0 - folds.a), v_crease, v_uv);
     // Compressed skin is a little darker overall (blood pushed together, less light between
     // the rolls), and the crevices' bottoms darker still.
     cavity *= (1.0 - u_wrinkle_darken * clamp(v_wrinkle, 0.0, 1.0)) * (1.0 - 0.5 * fold.crevice);
