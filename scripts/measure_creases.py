@@ -26,7 +26,7 @@ import numpy as np
 #: Patch centres on the base mesh (decimetres, character's left; mirrored for the right).
 PATCHES = {
     "under_eye": (0.30, 7.13, 1.42),
-    "crows_feet": (0.52, 7.27, 1.26),
+    "crows_feet": (0.58, 7.27, 1.21),
     "nasolabial": (0.215, 6.76, 1.46),
     "forehead": (0.15, 7.64, 1.5),
 }

@@ -214,7 +214,7 @@ def test_freckles_and_the_skin_seed_change_the_skin_not_the_background(face_of):
 
 
 #: Base-mesh points (decimetres, the character's left) on the forehead lines and the crow's feet.
-FOLD_PLACES = {"forehead": (0.15, 7.64, 1.5), "crows_feet": (0.53, 7.27, 1.25)}
+FOLD_PLACES = {"forehead": (0.15, 7.64, 1.5), "crows_feet": (0.58, 7.27, 1.21)}
 
 
 @pytest.mark.parametrize("expression, acts, rests", [("1E+2E", "forehead", "crows_feet"),
@@ -222,7 +222,7 @@ FOLD_PLACES = {"forehead": (0.15, 7.64, 1.5), "crows_feet": (0.53, 7.27, 1.25)}
 def test_fold_lines_deepen_where_their_au_acts_and_nowhere_else(face_of, head, expression, acts, rests):
     face = face_of("kwame")   # 28: no age lines of his own, so the lines that show are the AU's
     assert face.appearance.age == 0.0
-    size = 384
+    size = 512
     deformation = face.deform(expression)
     positions = np.asarray(deformation.positions, np.float32)
     camera = face.camera(size=(size, size))
@@ -239,12 +239,12 @@ def test_fold_lines_deepen_where_their_au_acts_and_nowhere_else(face_of, head, e
     darkening = luma(without_lines) - luma(face.appearance.folds)
     skin = head.base_vertices[head.base_index[: head.skin_vertex_count]]
 
-    def around(place, r=5):
+    def around(place, r=6):
         vertex = int(np.argmin(((skin - np.asarray(FOLD_PLACES[place])) ** 2).sum(1)))
         (x, y), = project(camera, positions[[vertex]], size)[0].astype(int)
         return darkening[y - r:y + r + 1, x - r:x + r + 1]
 
-    assert np.percentile(around(acts), 90) > 2.0    # the floors of the AU's lines darken ...
+    assert np.percentile(around(acts), 90) > 1.5    # the floors of the AU's lines darken ...
     assert np.abs(around(rests)).max() < 1.0        # ... and the other lines' skin stays as it was
 
 

@@ -238,7 +238,7 @@ def crows_feet_density(positions: np.ndarray) -> np.ndarray:
         across = (angle - bend) * np.maximum(radius, 0.04)     # distance across the ray (dm)
         length = rng.uniform(0.16, 0.22)
         along = smoothstep(0.05, 0.09, radius) * smoothstep(length, length - 0.08, radius)
-        out = np.maximum(out, rng.uniform(0.6, 0.9) * _groove(across, 0.022) * along)
+        out = np.maximum(out, rng.uniform(0.5, 0.75) * _groove(across, 0.026) * along)
     return np.clip(out * (dx > 0) * smoothstep(0.6, 0.9, z), 0, 1).astype(np.float32)
 
 

@@ -91,6 +91,24 @@ vec2 spots(vec2 p, float prob, float radius, int salt) {
     return vec2(cover * step(h, prob), fract(h * 13.7));
 }
 
+// Skin's specular (Fresnel F0 = SKIN_F0) from one light, in its two lobes (broad, tight):
+// GGX distributions of roughness SKIN_ROUGHNESS (alpha = roughness²) with Hammon's
+// approximation of the height-correlated Smith visibility, times N.L.
+const float SKIN_F0 = 0.028;
+const vec2 SKIN_ROUGHNESS = vec2(0.5, 0.3);
+const float PEACH_FUZZ = 0.05;   // grazing sheen of the vellus hair, of the light reaching it
+vec2 skin_specular(vec3 n, vec3 l, vec3 v, float ndv) {
+    vec3 h = normalize(l + v);
+    float ndl = max(dot(n, l), 0.0);
+    float ndh = max(dot(n, h), 0.0);
+    vec2 alpha = SKIN_ROUGHNESS * SKIN_ROUGHNESS;
+    vec2 a2 = alpha * alpha;
+    vec2 d = ndh * ndh * (a2 - 1.0) + 1.0;
+    vec2 distribution = a2 / (PI * d * d);
+    vec2 visibility = 0.5 / mix(vec2(2.0 * ndl * ndv), vec2(ndl + ndv), alpha);
+    return distribution * visibility * (schlick(SKIN_F0, max(dot(v, h), 0.0)) * ndl);
+}
+
 #ifdef USE_WRINKLE
 // Creases as folds of skin, not painted lines (issue 13: "stamped/carved"): compressed skin
 // buckles into rounded rolls with a narrow crevice between them. One crevice at each whole
@@ -411,24 +429,29 @@ void main() {
     float back_rim = clamp(dot(v, -normalize(u_rim_dir + 0.4 * n)), 0.0, 1.0);
     vec3 glow = back_rim * back_rim * u_rim_col * occ;
     diffuse += tone.g * 0.55 * glow * u_skin * vec3(1.0, 0.42, 0.3);
-    // Specular in two lobes, as skin has: a broad one from the rough horny layer and a tight
-    // one from the oil film. The film is patchy: the T-zone (detail.b) has most, in patches,
-    // the cheeks little (matte), the lips are wet but broken by their furrows; brow hair has
-    // none. Micro-relief (grain) breaks the sheen into a speckle instead of a plastic glaze,
-    // and the rough surface keeps the grazing-angle Fresnel sheen low.
-    float ndv = max(dot(n, v), 0.0);
-    float fres = mix(0.028, schlick(0.028, ndv), 0.55);
+    // Specular in two GGX lobes, as measured on skin: a broad one (roughness 0.5) from the
+    // rough horny layer and a tighter one (0.3) from the oil film, with Fresnel from skin's
+    // reflectance at normal incidence (F0 = 0.028, IOR 1.4). The film is patchy: the T-zone
+    // (detail.b) has most, in patches, and shines more in the tight lobe; the cheeks are
+    // nearly matte; the lips are wet but broken by their furrows; brow hair has none.
+    // Micro-relief (grain) breaks the sheen into a speckle instead of a plastic glaze.
+    float ndv = max(dot(n, v), 1e-4);
     float oil = detail.b * (1.0 - 0.35 * u_age) * mix(0.55, 1.3, patches) * (1.0 - lips);
     // Wet, but the film is broken by the furrows and by the lips' fine mottle: a continuous
     // glossy band along the lip read as rubber.
     float wet = lips * (1.0 - 0.85 * lip_line) * (0.55 + 0.45 * blotch);
-    // (The fill is too weak to show in a broad lobe: key and rim only.)
-    float broad_shine = mix(8.0, 14.0, oil);
-    vec3 broad = (blinn(bumped, u_key_dir, v, broad_shine) * u_key_col
-                  + blinn(bumped, u_rim_dir, v, broad_shine) * u_rim_col) * mix(0.2, 0.75, oil);
-    vec3 tight = blinn(bumped, u_key_dir, v, mix(32.0, 70.0, wet)) * u_key_col
-               * (mix(0.12, 3.2, oil * oil) + 1.2 * wet);
-    vec3 spec = (broad + tight) * fres * (1.0 - hair) * (0.6 + 0.8 * grain) * spec_break;
+    // Lobe weights (broad, tight); the fill is too weak to show: key and rim only.
+    vec2 weight = vec2(mix(0.3, 0.7, oil), mix(0.05, 0.8, oil * oil) + 0.25 * wet);
+    vec3 spec = dot(skin_specular(bumped, u_key_dir, v, ndv), weight) * u_key_col
+              + dot(skin_specular(bumped, u_rim_dir, v, ndv), weight) * u_rim_col;
+    spec *= (1.0 - hair) * (0.6 + 0.8 * grain) * spec_break;
+    // Peach fuzz: the fine vellus hair on the cheeks and forehead scatters a faint, soft sheen
+    // where the skin turns away from the eye (toward the face's outline), never a highlight.
+    float graze = 1.0 - ndv;
+    graze *= graze;
+    vec3 fuzz_light = u_key_col * max(dot(n_smooth, u_key_dir), 0.0) + u_rim_col * max(dot(n_smooth, u_rim_dir), 0.0)
+                    + hemisphere(n_smooth);
+    spec += PEACH_FUZZ * graze * graze * fuzz_light * mix(vec3(1.0), albedo, 0.5) * (1.0 - lips) * (1.0 - hair);
 #ifdef USE_WRINKLE
     // Light reaching a crevice's floor has passed through the skin around it: redder.
     vec3 crevice_tint = mix(vec3(1.0), vec3(1.0, 0.94, 0.92), fold.crevice * scatter);
