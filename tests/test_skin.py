@@ -259,3 +259,15 @@ def test_nasolabial_fold_is_a_broad_shade_on_the_cheeks_side_not_a_line():
     assert floor > 0.9
     assert fold_shade_density(at(0.04))[0] > 0.5 * floor      # 4 mm onto the cheek: still shaded ...
     assert fold_shade_density(at(-0.04))[0] < 0.05 * floor    # ... 4 mm toward the lip: gone
+
+
+def test_oil_film_makes_the_t_zone_shine_more_than_the_cheeks(face_of, marks):
+    face = face_of("ava")
+    dry_detail = face.appearance.detail.copy()
+    dry_detail[..., 2] = 0
+    oily, camera = render(face, face.appearance)
+    dry, _ = render(face, dataclasses.replace(face.appearance, detail=dry_detail))
+    shine = lambda point: (patch(oily, camera, point) - patch(dry, camera, point)).sum()  # noqa: E731
+    nose, cheek = face.neutral[marks["nose_tip"]], face.neutral[marks["cheek_left"]]
+    assert shine(nose) > 1.5             # the film's sheen on the nose ...
+    assert abs(shine(cheek)) < 0.5       # ... and next to none on the cheek, nearly matte
