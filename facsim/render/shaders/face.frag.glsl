@@ -59,6 +59,7 @@ vec3 specular_light(vec3 n, vec3 v, float shininess) {
 #ifdef REGION_SKIN
 uniform sampler2D u_paint;   // R brow hair density, G lips, B eyelids, A cheek blush
 uniform sampler2D u_detail;  // R redness, G beard area, B oiliness
+const float FOLD_TEXELS = 3.0;   // a groove's half-width in fold-map texels (~0.8 mm each on the face)
 uniform sampler2D u_folds;   // R forehead lines + crow's feet, G under-eye lines, B fold shade,
                              // A where R and G replace the engine's furrows (facsim.head.skin)
 uniform sampler2D u_tone;    // R periorbital darkening, G translucency, B pores, A sun (facsim.head.skin)
@@ -341,9 +342,12 @@ void main() {
     vec3 n_smooth = n;
     // The grooves' slopes (up to ~3 mm deep, dm) come from the map alone, their depth held
     // constant across them: the wrinkle amount is interpolated per triangle, and its slope
-    // broke the grooves into facets where 6 squeezes the outer eye corner. (In small images
-    // the map's mipmaps soften the slopes.)
-    vec2 depth = vec2(-0.024 * line_depth, -0.006 * u_age);
+    // broke the grooves into facets where 6 squeezes the outer eye corner. They fade out where
+    // they would be narrower than about two pixels (a pre-filter: the slope is constant over
+    // each 2x2 pixel quad, so narrower grooves would break into light and dark blocks).
+    vec2 texel = v_uv * vec2(textureSize(u_folds, 0));
+    float groove_px = FOLD_TEXELS / max(max(length(dFdx(texel)), length(dFdy(texel))), 1e-6);
+    vec2 depth = vec2(-0.024 * line_depth, -0.006 * u_age) * clamp(groove_px - 1.5, 0.0, 1.0);
     float dh_dx = dot(dFdx(folds.rg), depth), dh_dy = dot(dFdy(folds.rg), depth);
     n = normalize(abs(det) * n - sign(det) * (dh_dx * r1 + dh_dy * r2));
 #ifdef USE_WRINKLE
