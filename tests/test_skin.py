@@ -228,3 +228,63 @@ def test_freckles_and_the_skin_seed_change_the_skin_not_the_background(face_of):
     assert not changed[:, :8].any()
     with pytest.raises(ValueError, match="freckles must be in"):
         dataclasses.replace(face.appearance, freckles=1.5)
+
+
+#: Base-mesh points (decimetres, the character's left) on the forehead lines and the crow's feet.
+FOLD_PLACES = {"forehead": (0.15, 7.64, 1.5), "crows_feet": (0.58, 7.27, 1.21)}
+
+
+@pytest.mark.parametrize("expression, acts, rests", [("1E+2E", "forehead", "crows_feet"),
+                                                     ("6E", "crows_feet", "forehead")])
+def test_fold_lines_deepen_where_their_au_acts_and_nowhere_else(face_of, head, expression, acts, rests):
+    face = face_of("kwame")   # 28: no age lines of his own, so the lines that show are the AU's
+    assert face.appearance.age == 0.0
+    size = 512
+    deformation = face.deform(expression)
+    positions = np.asarray(deformation.positions, np.float32)
+    camera = face.camera(size=(size, size))
+    without_lines = face.appearance.folds.copy()
+    without_lines[..., 0] = 0
+
+    def luma(folds):
+        appearance = dataclasses.replace(face.appearance, folds=folds)
+        image = face.renderer(size=size).render(positions, appearance=appearance, camera=camera,
+                                                wrinkle=deformation.wrinkle, crease_phase=deformation.crease_phase,
+                                                occlusion=face.frame_occlusion(positions))
+        return image[..., :3].astype(float) @ np.array([0.2126, 0.7152, 0.0722])
+
+    darkening = luma(without_lines) - luma(face.appearance.folds)
+    skin = head.base_vertices[head.base_index[: head.skin_vertex_count]]
+
+    def around(place, r=6):
+        vertex = int(np.argmin(((skin - np.asarray(FOLD_PLACES[place])) ** 2).sum(1)))
+        (x, y), = project(camera, positions[[vertex]], size)[0].astype(int)
+        return darkening[y - r:y + r + 1, x - r:x + r + 1]
+
+    assert np.percentile(around(acts), 90) > 1.5    # the floors of the AU's lines darken ...
+    assert np.abs(around(rests)).max() < 1.0        # ... and the other lines' skin stays as it was
+
+
+def test_nasolabial_fold_is_a_broad_shade_on_the_cheeks_side_not_a_line():
+    from facsim.head.skin import FOLD_LINES, fold_shade_density
+
+    (x0, y0), (x1, y1), _, _ = FOLD_LINES[0]
+    mid = np.array([(x0 + x1) / 2, (y0 + y1) / 2])
+    normal = np.array([y0 - y1, x1 - x0]) / np.hypot(x1 - x0, y1 - y0)   # toward the cheek (+x)
+    at = lambda d: np.array([[*(mid + d * normal), 1.45]])                  # noqa: E731
+    floor = fold_shade_density(at(0.0))[0]
+    assert floor > 0.9
+    assert fold_shade_density(at(0.04))[0] > 0.5 * floor      # 4 mm onto the cheek: still shaded ...
+    assert fold_shade_density(at(-0.04))[0] < 0.05 * floor    # ... 4 mm toward the lip: gone
+
+
+def test_oil_film_makes_the_t_zone_shine_more_than_the_cheeks(face_of, marks):
+    face = face_of("ava")
+    dry_detail = face.appearance.detail.copy()
+    dry_detail[..., 2] = 0
+    oily, camera = render(face, face.appearance)
+    dry, _ = render(face, dataclasses.replace(face.appearance, detail=dry_detail))
+    shine = lambda point: (patch(oily, camera, point) - patch(dry, camera, point)).sum()  # noqa: E731
+    nose, cheek = face.neutral[marks["nose_tip"]], face.neutral[marks["cheek_left"]]
+    assert shine(nose) > 1.5             # the film's sheen on the nose ...
+    assert abs(shine(cheek)) < 0.5       # ... and next to none on the cheek, nearly matte

@@ -23,7 +23,7 @@ from typing import Mapping
 
 from facsim.head.character import COLOR_NAMES, EXTRA_COLOR_NAMES, Character
 from facsim.head.colour import hex_to_rgb, linear_to_srgb, srgb_to_linear
-from facsim.head.skin import tone_texture
+from facsim.head.skin import fold_texture, tone_texture
 from facsim.head.surface import smoothstep
 
 #: A plausible default appearance (light-medium skin, brown eyes), display sRGB.
@@ -61,11 +61,11 @@ class Appearance:
     detail : (H, W, 4) uint8, optional
         Skin detail in the same UV space and row order: R = redness (nose, cheeks, ears,
         caruncle), G = beard area, B = oiliness (the T-zone's sheen, wet lid margins),
-        A = age lines and shadows (forehead lines, crow's feet, nasolabial folds, tear troughs).
+        A unused (0; the age lines are in ``folds``).
     beard : float
         0 … 1: how much the beard area shows a shaved stubble shadow.
     age : float
-        0 … 1: how strongly the age lines of ``detail`` show (and the skin's mottling).
+        0 … 1: how strongly the age lines of ``folds`` show (and the skin's mottling).
     tone : (H, W, 4) uint8, optional
         Skin tone maps in the same UV space and row order: R = periorbital darkening,
         G = translucency, B = pore strength, A = sun exposure (see :mod:`facsim.head.skin`).
@@ -76,6 +76,12 @@ class Appearance:
     seed : float
         0 … 1000: where this person's skin patterns (mottling, moles, freckles) fall, so two
         people of the same colouring do not share one skin.
+    folds : (H, W, 4) uint8, optional
+        The skin's folds in the same UV space and row order, shaded as soft grooves:
+        R = forehead lines and crow's feet (deepened where expression compresses the skin),
+        G = under-eye lines, B = nasolabial and marionette fold shade, A = where R and G replace
+        the expression engine's furrows (see :func:`facsim.head.skin.fold_texture`). ``None`` =
+        no age lines or folds.
     """
 
     colors: Mapping[str, tuple[float, float, float]] = field(default_factory=lambda: DEFAULT_COLORS)
@@ -87,6 +93,7 @@ class Appearance:
     freckles: float = 0.0
     redness: float = 1.0
     seed: float = 0.0
+    folds: np.ndarray | None = None
 
     def __post_init__(self):
         colors = dict(self.colors)
@@ -112,10 +119,12 @@ class Appearance:
             detail = np.asarray(self.detail)
             if detail.ndim != 3 or detail.shape[2] != 4 or detail.dtype != np.uint8:
                 raise ValueError(f"detail must be an (H, W, 4) uint8 array, got {detail.dtype} {detail.shape}")
-        if self.tone is not None:
-            tone = np.asarray(self.tone)
-            if tone.ndim != 3 or tone.shape[2] != 4 or tone.dtype != np.uint8:
-                raise ValueError(f"tone must be an (H, W, 4) uint8 array, got {tone.dtype} {tone.shape}")
+        for name in ("tone", "folds"):
+            value = getattr(self, name)
+            if value is not None:
+                value = np.asarray(value)
+                if value.ndim != 3 or value.shape[2] != 4 or value.dtype != np.uint8:
+                    raise ValueError(f"{name} must be an (H, W, 4) uint8 array, got {value.dtype} {value.shape}")
         for name, top in (("beard", 1.0), ("age", 1.0), ("freckles", 1.0), ("redness", 2.0), ("seed", 1000.0)):
             value = float(getattr(self, name))
             if not 0.0 <= value <= top:
@@ -257,20 +266,20 @@ def character_appearance(character: Character, head, *, blush: float | None = No
     return Appearance(colors=colors, paint=paint_texture(head, round(blush, 3), painted_brows),
                       detail=detail_texture(head), beard=round(beard, 3), age=round(age, 3),
                       tone=tone_texture(head, position_map), freckles=own.freckles, redness=own.redness,
-                      seed=own.seed)
+                      seed=own.seed, folds=fold_texture(head, position_map))
 
 
-DETAIL_SIZE = (2048, 1024)  # rows (v), columns (u) over assets.PAINT_UV_BOX; fine enough that the
-# age lines, shaded from their slopes, show no texel steps in a 1024² still
+DETAIL_SIZE = (2048, 1024)  # rows (v), columns (u) over assets.PAINT_UV_BOX; fine enough for the
+# lids' wet margins, about a millimetre wide
 
 
 #: Bump when the detail recipe changes, so cached detail textures are redone.
-DETAIL_VERSION = 6  # 6: wider grooves; 5: positions upsampled cubically; 4: 2048 rows; 3: sheen on the cheekbones; 2: irregular age lines, an asymmetric nasolabial fold
+DETAIL_VERSION = 7  # 7: the age lines moved to the fold map (facsim.head.skin.fold_texture); 6: wider grooves; 5: positions upsampled cubically; 4: 2048 rows; 3: sheen on the cheekbones; 2: irregular age lines, an asymmetric nasolabial fold
 
 
 @lru_cache(maxsize=2)
 def detail_texture(head) -> np.ndarray:
-    """(rows, cols, 4) uint8 skin detail: redness, beard area, oiliness, age lines (see
+    """(rows, cols, 4) uint8 skin detail: redness, beard area, oiliness, 0 (see
     :class:`Appearance`), placed by anatomy on the base mesh.
     It depends on the base mesh only, so it is computed once and cached on disk."""
     return cached_array(cache_dir() / f"skin-detail-v{DETAIL_VERSION}.npy", lambda: _build_detail(head),
@@ -278,8 +287,8 @@ def detail_texture(head) -> np.ndarray:
 
 
 def _build_detail(head) -> np.ndarray:
-    # Cubic, not bilinear: the age lines are shaded from their slopes, and a bilinear
-    # upsampling's kinks every few texels show as dashes along a slanting line.
+    # Cubic, not bilinear: a bilinear upsampling's kinks every few texels show as dashes
+    # along the thin lid margins.
     from scipy.ndimage import zoom
 
     source = position_map(head)
@@ -289,7 +298,7 @@ def _build_detail(head) -> np.ndarray:
     margin = lid_margin_density(positions, centre, radius)
     channels = (np.maximum(redness_density(positions), caruncle_density(positions, centre, radius)),
                 beard_density(positions) * (1 - np.clip(lips * 2, 0, 1)),
-                np.maximum(oil_density(positions), margin), age_line_density(positions))
+                np.maximum(oil_density(positions), margin), np.zeros(DETAIL_SIZE, np.float32))
     detail = np.empty((*DETAIL_SIZE, 4), np.uint8)
     for k, mask in enumerate(channels):
         detail[..., k] = np.clip(mask * 255 + 0.5, 0, 255)
@@ -348,66 +357,6 @@ def oil_density(positions: np.ndarray) -> np.ndarray:
            + 0.6 * _blob(positions, (0.0, 6.32, 1.48), (0.14, 0.1, 0.2))
            + 0.3 * _blob(positions, (0.42, 7.0, 1.32), (0.12, 0.09, 0.2)))   # cheekbones catch a sheen
     return np.clip(0.35 + oil, 0, 1).astype(np.float32)
-
-
-def age_line_density(positions: np.ndarray) -> np.ndarray:
-    """Lines and folds that come with age: forehead lines, crow's feet, nasolabial and
-    marionette folds, tear troughs, as a depth (0 … 1) that the renderer shades as grooves
-    (their slopes light and shade them) and scales by the character's age.
-
-    Real lines are irregular (issue 13: evenly spaced, even-depth lines looked stamped): each
-    forehead line and each crow's-foot ray has its own depth and length, wanders a little,
-    and fades out along its length; the nasolabial fold is a groove with a steep side toward
-    the lip and a long, gentle slope up onto the cheek (the cheek's bulge over it).
-    """
-    x, y, z = positions[..., 0], positions[..., 1], positions[..., 2]
-    ax = np.abs(x)
-    rng = np.random.default_rng(13)   # fixed: the lines are part of the head model
-    # Forehead: four or five gently arched lines, each with its own depth, extent and waviness.
-    out = np.zeros(np.shape(x))
-    front = smoothstep(1.1, 1.3, z)
-    for k in range(5):
-        height = 7.6 + 0.075 * k + rng.uniform(-0.012, 0.012)
-        wave = rng.uniform(0.006, 0.016) * np.sin(rng.uniform(6, 12) * x + rng.uniform(0, 2 * np.pi))
-        d = (y - 0.12 * ax ** 2 - wave - height) / rng.uniform(0.016, 0.022)
-        reach = rng.uniform(0.22, 0.42)
-        along = (0.55 + 0.45 * np.sin(rng.uniform(8, 16) * x + rng.uniform(0, 2 * np.pi))) * smoothstep(reach, reach - 0.15, ax)
-        out = np.maximum(out, rng.uniform(0.35, 0.7) * np.exp(-d * d) * along * front)
-    # Crow's feet: short rays fanning out from the outer eye corner, each its own length and depth.
-    cx, cy = 0.47, 7.28
-    dx, dy = ax - cx, y - cy
-    radius = np.hypot(dx, dy)
-    angle = np.arctan2(dy, np.maximum(dx, 1e-6))
-    for k in range(6):
-        ray = -0.75 + 0.3 * k + rng.uniform(-0.08, 0.08)
-        bend = ray + rng.uniform(-0.6, 0.6) * (radius - 0.05)
-        width = 0.018 / np.maximum(radius, 0.03)
-        length = rng.uniform(0.09, 0.15)
-        depth = rng.uniform(0.35, 0.7) * smoothstep(0.03, 0.055, radius) * smoothstep(length, length - 0.05, radius)
-        out = np.maximum(out, depth * np.exp(-((angle - bend) / width) ** 2) * (dx > 0) * smoothstep(0.6, 0.9, z))
-    # Folds: distance to the nasolabial (nose wing -> past the lip corner) and marionette
-    # segments; steep toward the midline, a long gentle rise on the lateral (cheek) side.
-    for (ax0, ay0), (ax1, ay1), depth, width in (((0.15, 6.86), (0.29, 6.60), 0.85, 0.016),
-                                                 ((0.26, 6.58), (0.24, 6.38), 0.45, 0.018)):
-        dist, side = _segment_distance(ax, y, ax0, ay0, ax1, ay1), _segment_side(ax, y, ax0, ay0, ax1, ay1)
-        scale = np.where(side > 0, 3.0 * width, width)
-        out = np.maximum(out, depth * np.exp(-(dist / scale) ** 2) * front)
-    # Tear trough: a soft groove under the lower lid, inner half.
-    out = np.maximum(out, 0.5 * _blob(positions, (0.22, 7.13, 1.42), (0.08, 0.035, 0.1)))
-    out = np.where(np.isfinite(out), out, 0.0)
-    return np.clip(out, 0, 1).astype(np.float32)
-
-
-def _segment_side(x, y, x0, y0, x1, y1):
-    """Which side of the line through the segment each point lies: > 0 on its left
-    (going from (x0, y0) to (x1, y1)), < 0 on its right."""
-    return (x1 - x0) * (y - y0) - (y1 - y0) * (x - x0)
-
-
-def _segment_distance(x, y, x0, y0, x1, y1):
-    dx, dy = x1 - x0, y1 - y0
-    t = np.clip(((x - x0) * dx + (y - y0) * dy) / (dx * dx + dy * dy), 0, 1)
-    return np.hypot(x - (x0 + t * dx), y - (y0 + t * dy))
 
 
 @lru_cache(maxsize=4)

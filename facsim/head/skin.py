@@ -14,6 +14,9 @@ character's maps sit on the same features. Channels (0 … 1):
   temples); the renderer shows spots there in proportion to the character's age.
 
 The maps depend on the base mesh only, so they are computed once and cached on disk.
+:func:`fold_texture` is a third map in the same box: the broad folds of the skin that come with
+age and with expression (forehead lines, crow's feet, under-eye lines, the nasolabial and
+marionette folds), as soft grooves a few millimetres across rather than thin painted lines.
 :func:`contact_shadow` places, per vertex, the soft dark lines of small skin folds (nostrils,
 lip line, alar crease, inner eye corners) that the baked ambient occlusion is too coarse to see.
 """
@@ -32,6 +35,11 @@ TONE_SIZE = (512, 256)  # rows (v), columns (u) over assets.PAINT_UV_BOX; the ma
 TONE_VERSION = 1
 #: hm08's left eye centre (joint-l-eye), decimetres.
 EYE_CENTRE = (0.308, 7.284, 1.245)
+
+
+FOLD_SIZE = (1024, 512)  # rows (v), columns (u) over assets.PAINT_UV_BOX: a texel is ~0.8 mm on the face
+#: Bump when the fold recipe changes, so cached fold maps are redone.
+FOLD_VERSION = 1
 
 
 @lru_cache(maxsize=2)
@@ -141,3 +149,142 @@ def contact_shadow(positions: np.ndarray) -> np.ndarray:
     for centre, radius, strength in CONTACT_SHADOWS:
         dark = np.maximum(dark, strength * blob(positions, centre, radius))
     return np.clip(dark, 0, 1).astype(np.float32)
+
+
+# --------------------------------------------------------------------------------------------
+# Folds
+# --------------------------------------------------------------------------------------------
+
+@lru_cache(maxsize=2)
+def fold_texture(head, position_map: Callable) -> np.ndarray:
+    """(rows, cols, 4) uint8 fold map in the paint box (GL row order, like :func:`tone_texture`).
+
+    Channels (0 … 1):
+
+    - R, **expression lines**: the forehead lines and crow's feet, as groove depth. They show
+      with age and deepen where the skin is pushed together (raised brows, 1 and 2, for the
+      forehead; the raised cheek of 6 for the crow's feet), so a young face shows them only then.
+    - G, **under-eye lines**: the tear trough and a soft line under the lower lid, as groove
+      depth; age only (a smile's lower-lid bulge is the geometry's).
+    - B, **fold shade**: the nasolabial and marionette folds as a broad soft shade on the
+      cheek's side of the fold (age only: the smile's deepening fold is the geometry's).
+    - A, **lines drawn here**: where R and G stand in for the expression engine's furrows (the
+      forehead, around the eyes); the renderer fades the engine's crease pattern out there.
+
+    Grooves are 3-5 mm across with gently sloping sides: shaded from their slopes they read as
+    folds of skin, where the thin 1-2 mm lines they replace read as painted strokes (issue 13).
+    """
+    return cached_array(cache_dir() / f"skin-folds-v{FOLD_VERSION}.npy",
+                        lambda: build_folds(position_map(head)),
+                        valid=lambda a: a.shape == (*FOLD_SIZE, 4) and a.dtype == np.uint8)
+
+
+def build_folds(positions: np.ndarray) -> np.ndarray:
+    """The fold map at base-mesh ``positions`` (rows, cols, 3), resampled to :data:`FOLD_SIZE`."""
+    positions = np.asarray(positions, np.float32)
+    if positions.shape[:2] != FOLD_SIZE:
+        from scipy.ndimage import zoom
+
+        # Cubic: the grooves are shaded from their slopes, and bilinear kinks show as dashes.
+        factors = (FOLD_SIZE[0] / positions.shape[0], FOLD_SIZE[1] / positions.shape[1], 1)
+        positions = zoom(positions, factors, order=3)
+    channels = (np.maximum(forehead_line_density(positions), crows_feet_density(positions)),
+                under_eye_line_density(positions), fold_shade_density(positions), fold_region_density(positions))
+    folds = np.empty((*FOLD_SIZE, 4), np.uint8)
+    for k, mask in enumerate(channels):
+        folds[..., k] = np.clip(np.nan_to_num(mask) * 255 + 0.5, 0, 255)
+    return folds
+
+
+def _groove(distance, width):
+    """Depth profile across a groove: 1 at its floor, sides falling as a smooth bell."""
+    return np.exp(-(distance / width) ** 2)
+
+
+def forehead_line_density(positions: np.ndarray) -> np.ndarray:
+    """Four gently arched forehead lines, each its own depth and extent, fading at their ends."""
+    x, y, z = positions[..., 0], positions[..., 1], positions[..., 2]
+    ax = np.abs(x)
+    rng = np.random.default_rng(13)   # fixed: the lines are part of the head model
+    out = np.zeros(np.shape(x))
+    for k in range(4):
+        height = 7.57 + 0.075 * k + rng.uniform(-0.01, 0.01)
+        sway = rng.uniform(0.004, 0.01) * np.sin(rng.uniform(3, 6) * x + rng.uniform(0, 2 * np.pi))
+        across = y - 0.12 * ax ** 2 - sway - height
+        reach = rng.uniform(0.25, 0.42)
+        along = (0.7 + 0.3 * np.sin(rng.uniform(5, 9) * x + rng.uniform(0, 2 * np.pi))) \
+            * smoothstep(reach, reach - 0.18, ax)
+        out = np.maximum(out, rng.uniform(0.55, 0.9) * _groove(across, 0.026) * along)
+    return np.clip(out * smoothstep(1.1, 1.3, z), 0, 1).astype(np.float32)
+
+
+#: Where the crow's feet fan out from: beside hm08's outer eye corner (x, y, decimetres).
+CROWS_FEET_CENTRE = (0.47, 7.28)
+
+
+def crows_feet_density(positions: np.ndarray) -> np.ndarray:
+    """Five soft rays fanning out from beside the outer eye corner over the temple and the top
+    of the cheek, each its own length and depth. They begin 5 mm out from the corner: the
+    corner itself folds tightly in 6, where a groove drawn on the skin breaks into blocks."""
+    x, y, z = positions[..., 0], positions[..., 1], positions[..., 2]
+    dx, dy = np.abs(x) - CROWS_FEET_CENTRE[0], y - CROWS_FEET_CENTRE[1]
+    radius = np.hypot(dx, dy)
+    angle = np.arctan2(dy, np.maximum(dx, 1e-6))
+    rng = np.random.default_rng(6)
+    out = np.zeros(np.shape(x))
+    for k in range(5):
+        ray = -0.75 + 0.35 * k + rng.uniform(-0.06, 0.06)
+        bend = ray + rng.uniform(-0.3, 0.3) * (radius - 0.05)
+        across = (angle - bend) * np.maximum(radius, 0.04)     # distance across the ray (dm)
+        length = rng.uniform(0.16, 0.22)
+        along = smoothstep(0.05, 0.09, radius) * smoothstep(length, length - 0.08, radius)
+        out = np.maximum(out, rng.uniform(0.5, 0.75) * _groove(across, 0.026) * along)
+    return np.clip(out * (dx > 0) * smoothstep(0.6, 0.9, z), 0, 1).astype(np.float32)
+
+
+def under_eye_line_density(positions: np.ndarray) -> np.ndarray:
+    """The tear trough (inner half, under the lower lid) and a soft lid-cheek line beside it."""
+    x, y, z = EYE_CENTRE
+    trough = blob(positions, (0.22, 7.13, 1.42), (0.08, 0.04, 0.1))
+    lid_cheek = 0.5 * blob(positions, (x + 0.02, y - 0.165, z + 0.14), (0.13, 0.045, 0.12))
+    return np.clip(np.maximum(trough, lid_cheek) * _front(positions), 0, 1).astype(np.float32)
+
+
+#: The nasolabial (nose wing to past the lip corner) and marionette folds: segment ends on the
+#: base mesh (x, y, decimetres, mirrored), strength, and the shade's reach toward the lip and
+#: onto the cheek (the cheek's bulge over the fold shades a broad band on its side).
+FOLD_LINES = (
+    ((0.15, 6.86), (0.29, 6.60), 1.0, (0.018, 0.07)),   # nasolabial
+    ((0.26, 6.58), (0.24, 6.38), 0.55, (0.02, 0.05)),   # marionette
+)
+
+
+def fold_shade_density(positions: np.ndarray) -> np.ndarray:
+    """A soft shade along the nasolabial and marionette folds, broad on the cheek's side."""
+    ax, y = np.abs(positions[..., 0]), positions[..., 1]
+    out = np.zeros(np.shape(ax))
+    for (x0, y0), (x1, y1), strength, (inner, outer) in FOLD_LINES:
+        distance = _segment_distance(ax, y, x0, y0, x1, y1)
+        reach = np.where(_segment_side(ax, y, x0, y0, x1, y1) > 0, outer, inner)
+        out = np.maximum(out, strength * _groove(distance, reach))
+    return np.clip(out * smoothstep(1.1, 1.3, positions[..., 2]), 0, 1).astype(np.float32)
+
+
+def fold_region_density(positions: np.ndarray) -> np.ndarray:
+    """Where the fold map draws the lines itself: the forehead above the brows, around the eyes."""
+    x, y, z = EYE_CENTRE
+    forehead = smoothstep(7.5, 7.56, positions[..., 1]) * smoothstep(1.0, 1.2, positions[..., 2])
+    eyes = np.clip(2.5 * blob(positions, (x + 0.12, y - 0.02, z), (0.22, 0.2, 0.4)), 0, 1)
+    return np.clip(np.maximum(forehead, eyes), 0, 1).astype(np.float32)
+
+
+def _segment_side(x, y, x0, y0, x1, y1):
+    """Which side of the line through the segment each point lies: > 0 on its left
+    (going from (x0, y0) to (x1, y1)), < 0 on its right."""
+    return (x1 - x0) * (y - y0) - (y1 - y0) * (x - x0)
+
+
+def _segment_distance(x, y, x0, y0, x1, y1):
+    dx, dy = x1 - x0, y1 - y0
+    t = np.clip(((x - x0) * dx + (y - y0) * dy) / (dx * dx + dy * dy), 0, 1)
+    return np.hypot(x - (x0 + t * dx), y - (y0 + t * dy))

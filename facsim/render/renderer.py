@@ -267,6 +267,7 @@ class Renderer:
         _set_uniform(prog, "u_paint", 0)
         _set_uniform(prog, "u_detail", 2)
         _set_uniform(prog, "u_tone", 3)
+        _set_uniform(prog, "u_folds", 4)
         _set_uniform(prog, "u_wrinkle_darken", self.wrinkle_darken)
         try:
             prog["u_brow_frame"].write(self.brow_uv_frame.T.astype(np.float32).tobytes())
@@ -326,6 +327,7 @@ class Renderer:
         self._paint_tex = None
         self._detail_tex = None
         self._tone_tex = None
+        self._folds_tex = None
         self._depth_vao = self._depth_prog = None
         self._vp_bytes = b""
         self._lights: dict = {}
@@ -387,30 +389,12 @@ class Renderer:
             tex.write(paint.tobytes())
         tex.build_mipmaps()  # an input texture, never rendered into: mipmaps are safe here
         tex.filter = (ctx.LINEAR_MIPMAP_LINEAR, ctx.LINEAR)
-        # Skin detail (redness, beard area, oiliness, age lines); neutral when not given.
-        detail = appearance.detail
-        if detail is None:
-            detail = np.array([[[0, 0, 90, 0]]], dtype=np.uint8)
-        detail = np.ascontiguousarray(detail)
-        if self._detail_tex is not None:
-            self._gl_objects.remove(self._detail_tex)
-            self._detail_tex.release()
-        self._detail_tex = self._track(ctx.texture((detail.shape[1], detail.shape[0]), 4, detail.tobytes()))
-        self._detail_tex.repeat_x = self._detail_tex.repeat_y = False
-        self._detail_tex.build_mipmaps()
-        self._detail_tex.filter = (ctx.LINEAR_MIPMAP_LINEAR, ctx.LINEAR)
-        # Skin tone maps (periorbital darkening, translucency, pores, sun); neutral when not given.
-        tone = appearance.tone
-        if tone is None:
-            tone = np.array([[[0, 0, 128, 0]]], dtype=np.uint8)
-        tone = np.ascontiguousarray(tone)
-        if self._tone_tex is not None:
-            self._gl_objects.remove(self._tone_tex)
-            self._tone_tex.release()
-        self._tone_tex = self._track(ctx.texture((tone.shape[1], tone.shape[0]), 4, tone.tobytes()))
-        self._tone_tex.repeat_x = self._tone_tex.repeat_y = False
-        self._tone_tex.build_mipmaps()
-        self._tone_tex.filter = (ctx.LINEAR_MIPMAP_LINEAR, ctx.LINEAR)
+        # Skin detail (redness, beard area, oiliness), tone maps (periorbital darkening,
+        # translucency, pores, sun) and folds (lines, under-eye lines, fold shade, where the
+        # lines are drawn): neutral when not given.
+        self._detail_tex = self._upload_map(self._detail_tex, appearance.detail, (0, 0, 90, 0))
+        self._tone_tex = self._upload_map(self._tone_tex, appearance.tone, (0, 0, 128, 0))
+        self._folds_tex = self._upload_map(self._folds_tex, appearance.folds, (0, 0, 0, 0))
         self._appearance = appearance
         for name in self._programs:
             self._set_colors(name, appearance)
@@ -419,6 +403,18 @@ class Renderer:
         if not np.array_equal(brows, self._brow_faces):
             self._brow_faces = brows
             self._rebuild_draws()
+
+    def _upload_map(self, texture, data: np.ndarray | None, neutral: tuple) -> object:
+        """A mipmapped RGBA texture of ``data`` (one texel of ``neutral`` when None), replacing ``texture``."""
+        data = np.array([[neutral]], dtype=np.uint8) if data is None else np.ascontiguousarray(data)
+        if texture is not None:
+            self._gl_objects.remove(texture)
+            texture.release()
+        texture = self._track(self._ctx.texture((data.shape[1], data.shape[0]), 4, data.tobytes()))
+        texture.repeat_x = texture.repeat_y = False
+        texture.build_mipmaps()  # an input texture, never rendered into: mipmaps are safe here
+        texture.filter = (self._ctx.LINEAR_MIPMAP_LINEAR, self._ctx.LINEAR)
+        return texture
 
     def _set_colors(self, name: str, appearance: Appearance) -> None:
         prog = self._programs[name]
@@ -825,6 +821,8 @@ class Renderer:
             self._detail_tex.use(2)
         if self._tone_tex is not None:
             self._tone_tex.use(3)
+        if self._folds_tex is not None:
+            self._folds_tex.use(4)
         ctx.front_face = "ccw"
         if self._proxy_draws:
             # Depth of the closed head first (no shading), so hair behind the head fails the

@@ -58,7 +58,10 @@ vec3 specular_light(vec3 n, vec3 v, float shininess) {
 
 #ifdef REGION_SKIN
 uniform sampler2D u_paint;   // R brow hair density, G lips, B eyelids, A cheek blush
-uniform sampler2D u_detail;  // R redness, G beard area, B oiliness, A age lines
+uniform sampler2D u_detail;  // R redness, G beard area, B oiliness
+const float FOLD_TEXELS = 3.0;   // a groove's half-width in fold-map texels (~0.8 mm each on the face)
+uniform sampler2D u_folds;   // R forehead lines + crow's feet, G under-eye lines, B fold shade,
+                             // A where R and G replace the engine's furrows (facsim.head.skin)
 uniform sampler2D u_tone;    // R periorbital darkening, G translucency, B pores, A sun (facsim.head.skin)
 uniform float u_beard;       // 0..1 stubble shadow
 uniform float u_age;         // 0..1 how much the age lines show
@@ -86,6 +89,24 @@ vec2 spots(vec2 p, float prob, float radius, int salt) {
     float cover = 1.0 - smoothstep(r - 0.6 * aa, r + 0.6 * aa, length(p - centre));
     cover = mix(PI * r * r, cover, clamp(3.0 * r / aa - 1.0, 0.0, 1.0));   // sub-pixel: mean
     return vec2(cover * step(h, prob), fract(h * 13.7));
+}
+
+// Skin's specular (Fresnel F0 = SKIN_F0) from one light, in its two lobes (broad, tight):
+// GGX distributions of roughness SKIN_ROUGHNESS (alpha = roughness²) with Hammon's
+// approximation of the height-correlated Smith visibility, times N.L.
+const float SKIN_F0 = 0.028;
+const vec2 SKIN_ROUGHNESS = vec2(0.5, 0.3);
+const float PEACH_FUZZ = 0.05;   // grazing sheen of the vellus hair, of the light reaching it
+vec2 skin_specular(vec3 n, vec3 l, vec3 v, float ndv) {
+    vec3 h = normalize(l + v);
+    float ndl = max(dot(n, l), 0.0);
+    float ndh = max(dot(n, h), 0.0);
+    vec2 alpha = SKIN_ROUGHNESS * SKIN_ROUGHNESS;
+    vec2 a2 = alpha * alpha;
+    vec2 d = ndh * ndh * (a2 - 1.0) + 1.0;
+    vec2 distribution = a2 / (PI * d * d);
+    vec2 visibility = 0.5 / mix(vec2(2.0 * ndl * ndv), vec2(ndl + ndv), alpha);
+    return distribution * visibility * (schlick(SKIN_F0, max(dot(v, h), 0.0)) * ndl);
 }
 
 #ifdef USE_WRINKLE
@@ -316,28 +337,41 @@ void main() {
 #endif
     float hair = brow.x;
     albedo = mix(albedo, u_brows * brow.y, hair);
-    // Age lines and folds (detail.a: forehead lines, crow's feet, nasolabial and marionette
-    // folds, tear troughs) are grooves in the skin, not paint: only their floor darkens a
-    // little; their slopes shade them (below), lit on one flank and in soft shade on the other.
-    // They deepen where the skin is pushed together: a smile's compression deepens the
-    // nasolabial fold and the crow's feet, raised brows the forehead lines, on any face (the
-    // lines of a young face show only then).
+    // Folds of skin (u_folds): the forehead lines and crow's feet, the under-eye lines, the
+    // nasolabial and marionette folds, as soft grooves 3-5 mm across, not painted strokes: their
+    // sloping sides shade them (lit on one flank, in soft shade on the other) and their floor
+    // darkens only a little. Age shows them; the forehead lines and crow's feet also deepen
+    // where the skin is pushed together (raised brows for the forehead, the raised cheek of 6
+    // for the crow's feet: the lines of a young face show only then). The nasolabial and
+    // marionette folds are a soft shade on the cheek's side (the smile's deepening fold is in
+    // the geometry), not a line.
+    vec4 folds = texture(u_folds, v_uv);
 #ifdef USE_WRINKLE
-    float line_depth = min(u_age + 0.5 * smoothstep(0.03, 0.35, v_wrinkle), 1.5);
+    float line_depth = min(u_age + 1.1 * smoothstep(0.03, 0.35, v_wrinkle), 1.4);
 #else
     float line_depth = u_age;
 #endif
-    float cavity = 1.0 - 0.25 * line_depth * detail.a;
+    float lines = folds.r * line_depth, under_eye = folds.g * u_age;
+    float cavity = (1.0 - 0.1 * lines - 0.04 * under_eye) * (1.0 - 0.12 * u_age * folds.b);
     // Surface frame for bump mapping from screen derivatives (Mikkelsen's surface gradient):
     // a height h tilts the normal to normalize(|det| n - sign(det) (dh/dx r1 + dh/dy r2)).
     vec3 dpdx = dFdx(v_pos), dpdy = dFdy(v_pos);
     vec3 r1 = cross(dpdy, n), r2 = cross(n, dpdx);
     float det = dot(dpdx, r1);
     vec3 n_smooth = n;
-    float age_h = -0.022 * line_depth * detail.a;   // up to 3 mm deep (dm), ~2 mm across
-    n = normalize(abs(det) * n - sign(det) * (dFdx(age_h) * r1 + dFdy(age_h) * r2));
+    // The grooves' slopes (up to ~3 mm deep, dm) come from the map alone, their depth held
+    // constant across them: the wrinkle amount is interpolated per triangle, and its slope
+    // broke the grooves into facets where 6 squeezes the outer eye corner. They fade out where
+    // they would be narrower than about two pixels (a pre-filter: the slope is constant over
+    // each 2x2 pixel quad, so narrower grooves would break into light and dark blocks).
+    vec2 texel = v_uv * vec2(textureSize(u_folds, 0));
+    float groove_px = FOLD_TEXELS / max(max(length(dFdx(texel)), length(dFdy(texel))), 1e-6);
+    vec2 depth = vec2(-0.024 * line_depth, -0.006 * u_age) * clamp(groove_px - 1.5, 0.0, 1.0);
+    float dh_dx = dot(dFdx(folds.rg), depth), dh_dy = dot(dFdy(folds.rg), depth);
+    n = normalize(abs(det) * n - sign(det) * (dh_dx * r1 + dh_dy * r2));
 #ifdef USE_WRINKLE
-    Fold fold = crease_fold(v_wrinkle, v_crease, v_uv);
+    // The engine's furrows, except where the fold map draws the lines itself (folds.a).
+    Fold fold = crease_fold(v_wrinkle * (1.0 - folds.a), v_crease, v_uv);
     // Compressed skin is a little darker overall (blood pushed together, less light between
     // the rolls), and the crevices' bottoms darker still.
     cavity *= (1.0 - u_wrinkle_darken * clamp(v_wrinkle, 0.0, 1.0)) * (1.0 - 0.5 * fold.crevice);
@@ -414,24 +448,29 @@ void main() {
     float back_rim = clamp(dot(v, -normalize(u_rim_dir + 0.4 * n)), 0.0, 1.0);
     vec3 glow = back_rim * back_rim * u_rim_col * occ;
     diffuse += tone.g * 0.55 * glow * u_skin * vec3(1.0, 0.42, 0.3);
-    // Specular in two lobes, as skin has: a broad one from the rough horny layer and a tight
-    // one from the oil film. The film is patchy: the T-zone (detail.b) has most, in patches,
-    // the cheeks little (matte), the lips are wet but broken by their furrows; brow hair has
-    // none. Micro-relief (grain) breaks the sheen into a speckle instead of a plastic glaze,
-    // and the rough surface keeps the grazing-angle Fresnel sheen low.
-    float ndv = max(dot(n, v), 0.0);
-    float fres = mix(0.028, schlick(0.028, ndv), 0.55);
+    // Specular in two GGX lobes, as measured on skin: a broad one (roughness 0.5) from the
+    // rough horny layer and a tighter one (0.3) from the oil film, with Fresnel from skin's
+    // reflectance at normal incidence (F0 = 0.028, IOR 1.4). The film is patchy: the T-zone
+    // (detail.b) has most, in patches, and shines more in the tight lobe; the cheeks are
+    // nearly matte; the lips are wet but broken by their furrows; brow hair has none.
+    // Micro-relief (grain) breaks the sheen into a speckle instead of a plastic glaze.
+    float ndv = max(dot(n, v), 1e-4);
     float oil = detail.b * (1.0 - 0.35 * u_age) * mix(0.55, 1.3, patches) * (1.0 - lips);
     // Wet, but the film is broken by the furrows and by the lips' fine mottle: a continuous
     // glossy band along the lip read as rubber.
     float wet = lips * (1.0 - 0.85 * lip_line) * (0.55 + 0.45 * blotch);
-    // (The fill is too weak to show in a broad lobe: key and rim only.)
-    float broad_shine = mix(8.0, 14.0, oil);
-    vec3 broad = (blinn(bumped, u_key_dir, v, broad_shine) * u_key_col
-                  + blinn(bumped, u_rim_dir, v, broad_shine) * u_rim_col) * mix(0.2, 0.75, oil);
-    vec3 tight = blinn(bumped, u_key_dir, v, mix(32.0, 70.0, wet)) * u_key_col
-               * (mix(0.12, 3.2, oil * oil) + 1.2 * wet);
-    vec3 spec = (broad + tight) * fres * (1.0 - hair) * (0.6 + 0.8 * grain) * spec_break;
+    // Lobe weights (broad, tight); the fill is too weak to show: key and rim only.
+    vec2 weight = vec2(mix(0.3, 0.7, oil), mix(0.05, 0.8, oil * oil) + 0.25 * wet);
+    vec3 spec = dot(skin_specular(bumped, u_key_dir, v, ndv), weight) * u_key_col
+              + dot(skin_specular(bumped, u_rim_dir, v, ndv), weight) * u_rim_col;
+    spec *= (1.0 - hair) * (0.6 + 0.8 * grain) * spec_break;
+    // Peach fuzz: the fine vellus hair on the cheeks and forehead scatters a faint, soft sheen
+    // where the skin turns away from the eye (toward the face's outline), never a highlight.
+    float graze = 1.0 - ndv;
+    graze *= graze;
+    vec3 fuzz_light = u_key_col * max(dot(n_smooth, u_key_dir), 0.0) + u_rim_col * max(dot(n_smooth, u_rim_dir), 0.0)
+                    + hemisphere(n_smooth);
+    spec += PEACH_FUZZ * graze * graze * fuzz_light * mix(vec3(1.0), albedo, 0.5) * (1.0 - lips) * (1.0 - hair);
 #ifdef USE_WRINKLE
     // Light reaching a crevice's floor has passed through the skin around it: redder.
     vec3 crevice_tint = mix(vec3(1.0), vec3(1.0, 0.94, 0.92), fold.crevice * scatter);
