@@ -3,7 +3,7 @@
 // cost, even when a uniform switches one off). Variants:
 //   REGION_SKIN (+ USE_UV, USE_WRINKLE; + USE_BROWS for triangles under painted brows),
 //   REGION_EYEBALL (+ USE_EYE, USE_LIDS), REGION_TEETH, REGION_TONGUE, REGION_MOUTH_INTERIOR,
-//   REGION_LASHES (+ USE_LASH).
+//   REGION_LASHES (+ USE_LASH), REGION_GARMENT (the body's clothes).
 // All colour uniforms are linear RGB (render.py linearises the appearance's sRGB colours).
 
 #include "common.glsl"
@@ -213,7 +213,7 @@ const vec2 LOWER_LID_SHADE = vec2(0.2, 3.0);
 const float UPPER_TEETH[8] = float[8](0.0, 0.085, 0.150, 0.225, 0.295, 0.360, 0.460, 0.560);
 const float LOWER_TEETH[8] = float[8](0.0, 0.052, 0.108, 0.176, 0.246, 0.316, 0.426, 0.530);
 #endif
-#if defined(ONE_ALBEDO) || defined(REGION_MOUTH_INTERIOR) || defined(REGION_LASHES)
+#if defined(ONE_ALBEDO) || defined(REGION_MOUTH_INTERIOR) || defined(REGION_LASHES) || defined(REGION_GARMENT)
 uniform vec3 u_albedo;
 #endif
 
@@ -660,6 +660,17 @@ void main() {
     vec3 deep = 0.12 * mix(vec3(dot(u_albedo, vec3(0.33))), u_albedo, 0.5);
     radiance = (diffuse_light(n, vec3(0.3, 0.1, 0.1), 1.0) * u_albedo * 0.45 + spec) * mouth_shade
              + deep * (1.0 - mouth_shade);
+#endif
+
+#ifdef REGION_GARMENT
+    // Cloth: matte (no specular highlight), a soft wrap of light past the terminator, a faint
+    // sheen at grazing angles (fibres standing off the surface catch the light) and a fine knit
+    // grain, fading to its mean where it would be finer than a pixel.
+    vec2 knit_uv = vec2(v_pos.x * 90.0, v_pos.y * 60.0);
+    float knit = mix(0.5, value_noise(knit_uv, 0), clamp(2.0 - 1.5 * max(fwidth(knit_uv.x), fwidth(knit_uv.y)), 0.0, 1.0));
+    vec3 cloth = u_albedo * (0.94 + 0.12 * knit);
+    float grazing = pow(1.0 - clamp(dot(n, v), 0.0, 1.0), 3.0);
+    radiance = diffuse_light(n, vec3(0.25), occ) * cloth * (1.0 + 0.25 * grazing);
 #endif
 
 #ifdef REGION_LASHES
