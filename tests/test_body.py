@@ -121,3 +121,34 @@ def test_render_body_option_on_the_command_line(tmp_path):
     with pytest.raises(SystemExit):
         build_parser().parse_args(["render", "12", "-o", str(tmp_path / "x.png"), "--body", "kilt"])
 
+
+
+def test_gltf_has_the_body_as_its_own_mesh_joined_to_the_face(face_of):
+    from test_exchange_gltf import accessor, read_glb
+
+    from facsim.exchange.gltf import METRES, glb_bytes
+
+    face = face_of("kwame")
+    doc, blob = read_glb(glb_bytes(face, aus=[12], normals=False))
+    names = [m["name"] for m in doc["meshes"]]
+    assert names.count("body") == 1
+    body = doc["meshes"][names.index("body")]
+    node = next(n for n in doc["nodes"] if n.get("mesh") == names.index("body"))
+    assert node["name"] == "body" and node["skin"] == 0
+    materials = [doc["materials"][p["material"]]["name"] for p in body["primitives"]]
+    assert materials == ["skin", "garment"]
+    garment = doc["materials"][body["primitives"][1]["material"]]["pbrMetallicRoughness"]
+    assert garment["roughnessFactor"] == 1.0 and "metallicFactor" in garment
+    # The body's top ring lies exactly on the face mesh's neck cut: no gap between the meshes.
+    body_points = accessor(doc, blob, body["primitives"][0]["attributes"]["POSITION"])
+    cut = face.neutral[face.head.neck_loop] * METRES
+    gap = np.linalg.norm(body_points[:, None] - cut[None], axis=2).min(axis=0)
+    assert gap.max() < 1e-6
+    # The neck near the cut turns with the head joint; the chest does not.
+    weights = accessor(doc, blob, body["primitives"][0]["attributes"]["WEIGHTS_0"])
+    assert weights[:, 1].max() > 0.2 and weights[:, 1].min() == 0.0
+
+    bare, _ = read_glb(glb_bytes(face, aus=[12], normals=False, body="none"))
+    assert "body" not in [m["name"] for m in bare["meshes"]]
+    assert "garment" not in [m["name"] for m in bare["materials"]]
+    assert len(bare["meshes"]) == len(doc["meshes"]) - 1
