@@ -167,7 +167,9 @@ class BodyModel:
     triangles : (T, 3) int
         Over head geometry indices (the shared neck cut) and N_head + k (body rows).
     corner_uv : (T, 3, 2) float32
-        Skin corners' UVs in the head's paint-box coordinates; -1 on the garment.
+        Skin corners' UVs in the head's paint-box coordinates; on the garment, cloth
+        coordinates (:func:`_cloth_coordinates`: arc length around the neck in dm, distance
+        from the neckline in collar-band widths).
     neckline_distance : (K,) float32
         Base-mesh distance from the garment's neckline (0 on it), for the collar band and folds.
     neck_loop : (L,) int
@@ -280,7 +282,6 @@ def build_body(data, head, style: str = "crewneck") -> BodyModel:
     u0, v0, u1, v1 = PAINT_UV_BOX
     skin_uv = (uv_table[skin_tris[..., 1]] - (u0, v0)) / (u1 - u0, v1 - v0)
     triangles = np.concatenate([skin_tris[..., 0], shell_tris, rim_tris]).astype(np.int64)
-    corner_uv = np.concatenate([skin_uv, np.full((len(shell_tris) + len(rim_tris), 3, 2), -1.0)]).astype(np.float32)
 
     region = np.where(kind == 0, REGIONS.index("skin"), REGIONS.index("garment")).astype(np.uint8)
     from scipy.spatial import cKDTree
@@ -288,6 +289,9 @@ def build_body(data, head, style: str = "crewneck") -> BodyModel:
     snapped_base = base.copy()
     snapped_base[snapped] += snap_t[snapped, None] * (base[snap_to[snapped]] - base[snapped])
     distance = cKDTree(snapped_base[neckline]).query(snapped_base[source])[0].astype(np.float32)
+    cloth_uv = _cloth_coordinates(np.concatenate([shell_tris, rim_tris]) - n_head, snapped_base[source],
+                                  distance, centre, spec["band_width"])
+    corner_uv = np.concatenate([skin_uv, cloth_uv]).astype(np.float32)
     row_snap = np.where(kind > 0, snap_to[source], -1)
     edges = _boundary_edges(quads[garment_quads])
     edges = edges[np.isin(edges, neckline).all(axis=1)]
@@ -320,6 +324,18 @@ def _neckline(garment_quads: np.ndarray, base: np.ndarray, cut_height: float) ->
     top = (base[edges][:, :, 1] > cut_height + 0.25).all(axis=1)
     near_neck = (np.abs(base[edges][:, :, 0]) < 1.5).all(axis=1)
     return np.unique(edges[top & near_neck])
+
+
+def _cloth_coordinates(triangles, points, distance, centre, band_width: float) -> np.ndarray:
+    """(T, 3, 2) per garment triangle corner: (arc length around the neck, dm; distance from the
+    neckline / ``band_width``), so the shader draws the collar's ribs across its band. The angle
+    is unwrapped per triangle, so the triangles across the back seam interpolate no jump."""
+    on_neckline = distance < 1e-3
+    radius = float(np.median(np.hypot(points[on_neckline, 0] - centre[0], points[on_neckline, 2] - centre[2])))
+    theta = np.arctan2(points[:, 0] - centre[0], points[:, 2] - centre[2])[triangles]
+    wraps = (theta.max(axis=1) - theta.min(axis=1)) > np.pi
+    theta[wraps] = np.where(theta[wraps] < 0, theta[wraps] + 2 * np.pi, theta[wraps])
+    return np.stack([theta * radius, (distance / band_width)[triangles]], axis=-1)
 
 
 def _neckline_snap(garment_quads: np.ndarray, inside: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -100,7 +100,7 @@ _PASSES = {
     "teeth": ("REGION_TEETH", "USE_UV"),
     "tongue": ("REGION_TONGUE", "USE_UV"),
     "eyeball": ("REGION_EYEBALL", "USE_EYE", "USE_LIDS"),
-    "garment": ("REGION_GARMENT",),
+    "garment": ("REGION_GARMENT", "USE_UV"),
     "lashes": ("REGION_LASHES", "USE_LASH"),
 }
 #: Shader variants for frames without creases (no wrinkle field): the skin skips the crease

@@ -3,7 +3,7 @@
 // cost, even when a uniform switches one off). Variants:
 //   REGION_SKIN (+ USE_UV, USE_WRINKLE; + USE_BROWS for triangles under painted brows),
 //   REGION_EYEBALL (+ USE_EYE, USE_LIDS), REGION_TEETH, REGION_TONGUE, REGION_MOUTH_INTERIOR,
-//   REGION_LASHES (+ USE_LASH), REGION_GARMENT (the body's clothes).
+//   REGION_LASHES (+ USE_LASH), REGION_GARMENT (+ USE_UV: cloth coordinates; the body's clothes).
 // All colour uniforms are linear RGB (render.py linearises the appearance's sRGB colours).
 
 #include "common.glsl"
@@ -669,6 +669,13 @@ void main() {
     vec2 knit_uv = vec2(v_pos.x * 90.0, v_pos.y * 60.0);
     float knit = mix(0.5, value_noise(knit_uv, 0), clamp(2.0 - 1.5 * max(fwidth(knit_uv.x), fwidth(knit_uv.y)), 0.0, 1.0));
     vec3 cloth = u_albedo * (0.94 + 0.12 * knit);
+    // The collar: a ribbed band along the neckline (v_uv: arc length around the neck in dm,
+    // distance from the neckline in band widths), its ribs ~3 mm apart, a shade darker and
+    // denser than the body of the garment, its edge in the rim's shade.
+    float band = 1.0 - smoothstep(0.8, 1.0, v_uv.y);
+    float rib_x = v_uv.x * 33.0;
+    float rib = mix(0.5, 0.5 + 0.5 * cos(2.0 * PI * rib_x), clamp(2.0 - 2.0 * fwidth(rib_x), 0.0, 1.0));
+    cloth *= mix(1.0, 0.86 + 0.1 * rib, band);
     float grazing = pow(1.0 - clamp(dot(n, v), 0.0, 1.0), 3.0);
     radiance = diffuse_light(n, vec3(0.25), occ) * cloth * (1.0 + 0.25 * grazing);
 #endif
