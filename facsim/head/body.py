@@ -15,7 +15,7 @@ Three stages, each a plain function:
    a garment shell over the rest with a collar's rim, all as rows appended after the head's
    geometry vertices.
 3. :func:`rig_body` - one character's :class:`BodyRig`: rest positions (garment offsets,
-   ribbed collar, soft folds) and how each row follows the neck cut;
+   the collar band) and how each row follows the neck cut;
    :meth:`BodyRig.positions` places the body for a frame from the head's positions.
 
 Examples
@@ -450,16 +450,11 @@ def rig_body(model: BodyModel, body_positions: np.ndarray, neutral: np.ndarray) 
     normals /= np.linalg.norm(normals, axis=1, keepdims=True) + 1e-12
     points = _smooth_along(points, model.neckline_edges, iterations=spec["neckline_smoothing"])
 
-    # Garment rows stand off the skin: the shell by its thickness (more in the collar band) and
-    # the soft folds below the band; the rim sits just under the skin, closing the edge.
+    # Garment rows stand off the skin: the shell by its thickness (more in the collar band; the
+    # folds under it are shading, face.frag.glsl), the rim just under the skin, closing the edge.
     d = model.neckline_distance.astype(np.float64)
     band = 1.0 - smoothstep(0.6 * spec["band_width"], spec["band_width"], d)
-    angle = np.arctan2(points[:, 0], points[:, 2] - neck[:, 2].mean())
-    front = np.clip(np.cos(angle), 0.0, 1.0) ** 0.7
-    ridge = 0.5 - 0.5 * np.cos(spec["folds"] * angle)
-    below = np.clip((d - spec["band_width"]) / spec["fold_length"], 0.0, 1.0)
-    fold = spec["fold_depth"] * front * ridge * smoothstep(0.0, 0.25, below) * (1.0 - smoothstep(0.4, 1.0, below))
-    offset = np.where(model.kind == 1, spec["thickness"] + spec["band_thickness"] * band + fold,
+    offset = np.where(model.kind == 1, spec["thickness"] + spec["band_thickness"] * band,
                       np.where(model.kind == 2, -0.01, 0.0))
     rest = points + offset[:, None] * normals
 

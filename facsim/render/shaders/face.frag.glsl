@@ -226,6 +226,13 @@ uniform vec3 u_albedo;
 const float LASH_STRANDS_PER_DM = 300.0;
 #endif
 
+#ifdef REGION_GARMENT
+const float FOLD_SPACING = 0.34;  // dm between the folds' ridges along the neckline
+const float FOLD_DEPTH = 0.08;    // dm
+const float FOLD_LENGTH = 5.0;    // band widths below the neckline where they have faded
+const float FOLD_REACH = 0.5;     // dm along the neckline from the front where they fade
+#endif
+
 void main() {
     vec3 n = surface_normal();
     vec3 v = normalize(u_cam_pos - v_pos);
@@ -666,6 +673,19 @@ void main() {
     // Cloth: matte (no specular highlight), a soft wrap of light past the terminator, a faint
     // sheen at grazing angles (fibres standing off the surface catch the light) and a fine knit
     // grain, fading to its mean where it would be finer than a pixel.
+    // Soft folds under the collar at the front: a few shallow ridges running down from the
+    // band (FOLD_SPACING dm apart along the neckline, FOLD_DEPTH dm deep, fading over
+    // FOLD_LENGTH band widths below it and away from the front), shaded by bumping the normal
+    // along the surface gradient of their height (screen-space derivatives, no tangents needed).
+    float fold_along = v_uv.x / FOLD_SPACING;
+    float fold_env = smoothstep(0.9, 1.6, v_uv.y) * (1.0 - smoothstep(1.6, FOLD_LENGTH, v_uv.y))
+                   * exp(-v_uv.x * v_uv.x / (FOLD_REACH * FOLD_REACH));
+    float fold_h = FOLD_DEPTH * fold_env * (0.5 - 0.5 * cos(2.0 * PI * fold_along));
+    vec3 dpdx = dFdx(v_pos), dpdy = dFdy(v_pos);
+    vec3 r1 = cross(dpdy, n), r2 = cross(n, dpdx);
+    float det = dot(dpdx, r1);
+    vec3 surface_grad = sign(det) * (dFdx(fold_h) * r1 + dFdy(fold_h) * r2);
+    n = normalize(abs(det) * n - surface_grad);
     vec2 knit_uv = vec2(v_pos.x * 90.0, v_pos.y * 60.0);
     float knit = mix(0.5, value_noise(knit_uv, 0), clamp(2.0 - 1.5 * max(fwidth(knit_uv.x), fwidth(knit_uv.y)), 0.0, 1.0));
     vec3 cloth = u_albedo * (0.94 + 0.12 * knit);
