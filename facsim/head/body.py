@@ -232,15 +232,15 @@ def build_body(data, head, style: str = "crewneck") -> BodyModel:
     loop_base = head.base_index[head.neck_loop]
 
     # The neckline: at a distance from the head's neck cut that goes from `drop`[0] at the
-    # front through [1] at the sides to [2] at the back (so it follows each character's neck
-    # base); what lies further from the cut is covered.
+    # front through [1] at the sides to [2] at the back, what lies further from the cut is
+    # covered (measured on the base mesh; each character's body carries the neckline along).
     from scipy.spatial import cKDTree
 
     cut = base[loop_base]
     centre = cut.mean(axis=0)
-    angle = np.cos(np.arctan2(base[:, 0] - centre[0], base[:, 2] - centre[2]))
+    facing = np.cos(np.arctan2(base[:, 0] - centre[0], base[:, 2] - centre[2]))  # 1 front, -1 back
     front, side, back = spec["drop"]
-    drop = side + (front - side) * np.clip(angle, 0, 1) ** 2 + (back - side) * np.clip(-angle, 0, 1) ** 2
+    drop = side + (front - side) * np.clip(facing, 0, 1) ** 2 + (back - side) * np.clip(-facing, 0, 1) ** 2
     inside = cKDTree(cut).query(base)[0] - drop
     covered = inside > 0
 
@@ -284,8 +284,6 @@ def build_body(data, head, style: str = "crewneck") -> BodyModel:
     triangles = np.concatenate([skin_tris[..., 0], shell_tris, rim_tris]).astype(np.int64)
 
     region = np.where(kind == 0, REGIONS.index("skin"), REGIONS.index("garment")).astype(np.uint8)
-    from scipy.spatial import cKDTree
-
     snapped_base = base.copy()
     snapped_base[snapped] += snap_t[snapped, None] * (base[snap_to[snapped]] - base[snapped])
     distance = cKDTree(snapped_base[neckline]).query(snapped_base[source])[0].astype(np.float32)
