@@ -284,16 +284,20 @@ def build_body(data, head, style: str = "crewneck") -> BodyModel:
     triangles = np.concatenate([skin_tris[..., 0], shell_tris, rim_tris]).astype(np.int64)
 
     region = np.where(kind == 0, REGIONS.index("skin"), REGIONS.index("garment")).astype(np.uint8)
-    snapped_base = base.copy()
-    snapped_base[snapped] += snap_t[snapped, None] * (base[snap_to[snapped]] - base[snapped])
-    distance = cKDTree(snapped_base[neckline]).query(snapped_base[source])[0].astype(np.float32)
-    cloth_uv = _cloth_coordinates(np.concatenate([shell_tris, rim_tris]) - n_head, snapped_base[source],
-                                  distance, centre, spec["band_width"])
-    corner_uv = np.concatenate([skin_uv, cloth_uv]).astype(np.float32)
-    row_snap = np.where(kind > 0, snap_to[source], -1)
     edges = _boundary_edges(quads[garment_quads])
     edges = edges[np.isin(edges, neckline).all(axis=1)]
     neckline_rows = np.concatenate([row_of[1][edges], row_of[2][edges]]) - n_head
+    # Distances from the neckline as the rig places it on the base mesh (snapped, smoothed),
+    # so the collar band's edge runs parallel to it.
+    snapped_base = base.copy()
+    snapped_base[snapped] += snap_t[snapped, None] * (base[snap_to[snapped]] - base[snapped])
+    row_points = _smooth_along(snapped_base[source], neckline_rows, iterations=spec["neckline_smoothing"])
+    row_points[kind == 0] = base[source[kind == 0]]
+    distance = cKDTree(row_points[np.unique(neckline_rows)]).query(row_points)[0].astype(np.float32)
+    cloth_uv = _cloth_coordinates(np.concatenate([shell_tris, rim_tris]) - n_head, row_points,
+                                  distance, centre, spec["band_width"])
+    corner_uv = np.concatenate([skin_uv, cloth_uv]).astype(np.float32)
+    row_snap = np.where(kind > 0, snap_to[source], -1)
     return BodyModel(style=style, head_vertex_count=n_head, source=source, kind=kind, region=region,
                      triangles=triangles, corner_uv=corner_uv, neckline_distance=distance,
                      neckline_edges=neckline_rows, snap_to=row_snap, snap_t=np.where(row_snap >= 0, snap_t[source], 0.0).astype(np.float32),

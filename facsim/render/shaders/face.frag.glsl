@@ -228,7 +228,7 @@ const float LASH_STRANDS_PER_DM = 300.0;
 
 #ifdef REGION_GARMENT
 const float FOLD_SPACING = 0.34;  // dm between the folds' ridges along the neckline
-const float FOLD_DEPTH = 0.08;    // dm
+const float FOLD_DEPTH = 0.06;    // dm
 const float FOLD_LENGTH = 5.0;    // band widths below the neckline where they have faded
 const float FOLD_REACH = 0.5;     // dm along the neckline from the front where they fade
 #endif
