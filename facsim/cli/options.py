@@ -155,7 +155,7 @@ def _size(text: str):
 def add_view_options(p: argparse.ArgumentParser) -> None:
     """Options shared by every command that renders."""
     from facsim.engines import DEFAULT_ENGINE, ENGINES
-    from facsim.render.options import VIEWS
+    from facsim.render.options import DEFAULT_BODY, VIEWS
 
     p.add_argument("--character", "-c", default="ava", help="preset name (see `facsim characters`) or random:SEED")
     p.add_argument("--hair", help="hair style (bob01, bob02, short01-04, long01, ponytail01, braid01, afro01) "
@@ -171,6 +171,19 @@ def add_view_options(p: argparse.ArgumentParser) -> None:
                    help="MSAA samples (1 = off, 4 = default) or fxaa (fast post-process smoothing)")
     p.add_argument("--intensities", choices=("hapfacs", "facshuman"), default="hapfacs",
                    help="what the letters A-E mean (HapFACS: 15/30/55/85/100 %%)")
+    p.add_argument("--body", type=body_style, default=DEFAULT_BODY,
+                   help=f"neck and shoulders in a garment under the head ({DEFAULT_BODY}, the default; "
+                        "facsim/data/body.yaml) or none for the head alone")
+
+
+def body_style(text: str) -> str:
+    """An argparse type: a garment of ``facsim/data/body.yaml`` or ``none`` (the table is read
+    only when ``--body`` is given, so ``--help`` stays light)."""
+    from facsim.head.body import body_styles
+
+    if text not in body_styles():
+        raise argparse.ArgumentTypeError(f"choose from {', '.join(body_styles())}, got {text!r}")
+    return text
 
 
 def character_of(args, fallback=None):
@@ -186,7 +199,7 @@ def character_of(args, fallback=None):
 def render_options(args) -> dict:
     """The Face.render keyword arguments from the shared view options."""
     return dict(view=args.view, yaw=args.yaw, pitch=args.pitch, size=args.size, projection=args.projection,
-                background=args.background, antialias=args.antialias)
+                background=args.background, antialias=args.antialias, body=args.body)
 
 
 def add_overwrite_option(parser: argparse.ArgumentParser) -> None:

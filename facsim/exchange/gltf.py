@@ -28,6 +28,10 @@ What the file holds
       child, same place). Each vertex follows ``head`` by the register
       engine's neck blend (smoothstep over height), so rotating ``head``
       reproduces codes 51–56 (and translating it 57/58) as the engine does.
+    * Mesh ``body`` (unless ``body="none"``): hm08's neck, shoulders and chest top
+      under the head in the character's garment (``facsim.head.body``), primitives
+      ``skin`` and ``garment`` (matte, double-sided), skinned like the face so the
+      neck twists into the shoulders when ``head`` turns; no morph targets.
     * Nodes ``eye_L``/``eye_R`` (children of ``head``) at the eye centres,
       each with an eyeball mesh (material ``eye``: baked sclera, iris and
       pupil texture), so rotating them turns the eyes (61–66).
@@ -53,6 +57,7 @@ from facsim.facs.activations import Activations
 
 from facsim.engines.rigid import eye_motion, head_motion
 from facsim.exchange import write_file
+from facsim.render.options import DEFAULT_BODY
 
 #: facsim decimetres → glTF metres.
 METRES = 0.1
@@ -66,7 +71,7 @@ DELTA_EPSILON = 1e-7
 PRIMITIVES = ("skin", "mouth_interior", "teeth", "tongue", "lashes")
 #: Metallic-roughness per material: (roughness, double-sided).
 MATERIALS = {"skin": (0.55, False), "mouth_interior": (0.8, False), "teeth": (0.3, False),
-             "tongue": (0.4, False), "lashes": (0.9, True), "eye": (0.08, False)}
+             "tongue": (0.4, False), "lashes": (0.9, True), "eye": (0.08, False), "garment": (1.0, True)}
 SKIN_TEXTURE_SIZE = (2048, 1024)  # rows (v), columns (u): the paint's own resolution
 EYE_TEXTURE_SIZE = 512
 #: Eye texture geometry, as the renderer's eye shader (fractions of the eyeball radius across the gaze).
@@ -262,7 +267,7 @@ def _quaternions(rotvecs: np.ndarray) -> np.ndarray:
 
 
 def glb_bytes(face, timeline=None, *, aus="all", interpolation: str = "LINEAR", normals: bool = True,
-              fps: float | None = None) -> bytes:
+              fps: float | None = None, body: str = DEFAULT_BODY) -> bytes:
     """The character of ``face`` as GLB bytes (see the module docstring and :func:`export_glb`)."""
     interpolation = interpolation.upper()
     if interpolation not in ("LINEAR", "STEP"):
@@ -271,7 +276,8 @@ def glb_bytes(face, timeline=None, *, aus="all", interpolation: str = "LINEAR", 
     head = face.head
     pivot = head.joint(face.base_positions, "joint-neck").astype(np.float64)
     b = GlbBuilder()
-    materials, material_index = _materials(b, face.appearance)
+    rig = face.body_rig(body)
+    materials, material_index = _materials(b, face.appearance, garment=rig is not None)
     meshes = [_face_mesh(b, face, keys, pivot, material_index, normals)]
     nodes = [{"name": "neck", "translation": _floats(pivot * METRES), "children": [1]},
              {"name": "head", "children": [2, 3]}]
@@ -291,6 +297,10 @@ def glb_bytes(face, timeline=None, *, aus="all", interpolation: str = "LINEAR", 
         meshes.append(mesh)
         scene_nodes.append(len(nodes))
         nodes.append({"name": mesh["name"], "mesh": len(meshes) - 1, "skin": 0})
+    if rig is not None:
+        meshes.append(_body_mesh(b, face, rig, material_index, normals))
+        scene_nodes.append(len(nodes))
+        nodes.append({"name": "body", "mesh": len(meshes) - 1, "skin": 0})
     document = {
         "asset": {"version": "2.0", "generator": _generator(),
                   "extras": {"character": face.character.name or "custom",
@@ -365,6 +375,45 @@ def _face_mesh(b: GlbBuilder, face, keys, pivot, material_index: dict, normals: 
         mesh["weights"] = [0.0] * len(targets)
         mesh["extras"] = {"targetNames": [target_name(*k) for k in keys]}
     return mesh
+
+
+def _body_mesh(b: GlbBuilder, face, rig, material_index: dict, normals: bool) -> dict:
+    """Mesh ``body``: the neck, shoulders and garment under the head (:mod:`facsim.head.body`), one
+    primitive each for ``skin`` and ``garment``, skinned to neck/head as the neck cut it hangs
+    from (so turning ``head`` twists the neck into the shoulders), without morph targets."""
+    from facsim.engines.rigid import neck_weight
+    from facsim.head.mesh import REGIONS
+    from facsim.head.surface import vertex_normals
+
+    model = rig.model
+    faces, render_to_geo, uv, region = model.render_topology()
+    positions = rig.with_body(face.neutral).astype(np.float64)
+    topo = face.render_topology(model.style)
+    attributes = {"POSITION": b.accessor(positions[render_to_geo] * METRES, "VEC3", target=ARRAY_BUFFER, bounds=True)}
+    if normals:
+        attributes["NORMAL"] = b.accessor(vertex_normals(positions, topo.geo_faces)[render_to_geo], "VEC3",
+                                          target=ARRAY_BUFFER)
+    attributes["TEXCOORD_0"] = b.accessor(uv, "VEC2", target=ARRAY_BUFFER)
+    follow_head = neck_weight(face.head, np.asarray(face.neutral, np.float64), face.base_positions)
+    head_weight = np.concatenate([follow_head, rig.follow @ follow_head[model.neck_loop]])
+    weights = np.zeros((len(render_to_geo), 4), np.float32)
+    weights[:, 1] = np.clip(head_weight[render_to_geo], 0.0, 1.0)
+    weights[:, 0] = 1.0 - weights[:, 1]
+    joints = np.zeros((len(render_to_geo), 4), np.uint8)
+    joints[:, 1] = weights[:, 1] > 0
+    attributes["JOINTS_0"] = b.accessor(joints, "VEC4", UBYTE, target=ARRAY_BUFFER)
+    attributes["WEIGHTS_0"] = b.accessor(weights, "VEC4", target=ARRAY_BUFFER)
+    majority = np.where((region[faces[:, 1]] == region[faces[:, 2]]), region[faces[:, 1]], region[faces[:, 0]])
+    primitives = []
+    for name in ("skin", "garment"):
+        tris = faces[majority == REGIONS.index(name)]
+        primitives.append({
+            "attributes": {k: v for k, v in attributes.items() if name == "skin" or k != "TEXCOORD_0"},
+            "indices": b.accessor(tris.reshape(-1).astype(np.uint32), "SCALAR",
+                                  USHORT if len(render_to_geo) < 65536 else UINT, target=ELEMENT_ARRAY_BUFFER,
+                                  bounds=True),
+            "material": material_index[name], "mode": 4})
+    return {"name": "body", "primitives": primitives}
 
 
 def _proxy_meshes(b: GlbBuilder, face, keys, pivot, materials: dict) -> list[dict]:
@@ -451,17 +500,20 @@ def _generator() -> str:
     return f"facsim {__version__}"
 
 
-def _materials(b: GlbBuilder, appearance) -> tuple[dict, dict]:
-    """glTF materials, textures, images and samplers; and material index per region name."""
+def _materials(b: GlbBuilder, appearance, *, garment: bool = False) -> tuple[dict, dict]:
+    """glTF materials, textures, images and samplers; and material index per region name
+    (``garment`` only with a body: an unused material would be an unused object)."""
     colours = appearance.colors
     base = {"skin": "skin", "mouth_interior": "mouth_interior", "teeth": "teeth", "tongue": "tongue",
-            "lashes": "lashes", "eye": "sclera"}
+            "lashes": "lashes", "eye": "sclera", "garment": "garment"}
     images = [{"name": "skin", "mimeType": "image/png", "bufferView": b.image(_png(skin_texture(appearance)))},
               {"name": "eye", "mimeType": "image/png", "bufferView": b.image(_png(eye_texture(appearance)))}]
     samplers = [{"magFilter": 9729, "minFilter": 9987, "wrapS": 33071, "wrapT": 33071}]
     textures = [{"source": 0, "sampler": 0, "name": "skin"}, {"source": 1, "sampler": 0, "name": "eye"}]
     materials, index = [], {}
     for name, (roughness, double) in MATERIALS.items():
+        if name == "garment" and not garment:
+            continue
         pbr = {"metallicFactor": 0.0, "roughnessFactor": roughness}
         if name in ("skin", "eye"):
             pbr["baseColorTexture"] = {"index": 0 if name == "skin" else 1}
@@ -519,7 +571,7 @@ def _animation(b: GlbBuilder, timeline, keys, fps, interpolation: str) -> dict:
 
 
 def export_glb(face, path, timeline=None, *, aus="all", interpolation: str = "LINEAR", normals: bool = True,
-               fps: float | None = None) -> Path:
+               fps: float | None = None, body: str = DEFAULT_BODY) -> Path:
     """Write ``face``'s character as a ``.glb`` (atomically); returns the path.
 
     Parameters
@@ -535,6 +587,8 @@ def export_glb(face, path, timeline=None, *, aus="all", interpolation: str = "LI
     interpolation : {"LINEAR", "STEP"}
     normals : bool
         Store vertex normals and their morph deltas (about twice the size).
+    body : str
+        A garment (``"crewneck"``) adds mesh ``body``; ``"none"`` exports the head alone.
     """
     return write_file(path, glb_bytes(face, timeline, aus=aus, interpolation=interpolation, normals=normals,
-                                        fps=fps))
+                                        fps=fps, body=body))

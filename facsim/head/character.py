@@ -52,7 +52,7 @@ _NEGATIVE_ENDS = ("decr", "down", "in", "backward", "concave", "compress")
 _POSITIVE_ENDS = ("incr", "up", "out", "forward", "convex", "uncompress")
 #: The colours a character has (display sRGB, 0..1), each overridable in ``colors``.
 COLOR_NAMES = ("skin", "lips", "brows", "lashes", "sclera", "iris", "pupil", "teeth", "tongue",
-               "mouth_interior", "eyelid", "cheek")
+               "mouth_interior", "eyelid", "cheek", "garment")
 #: Colours a character has beyond the face renderer's: the scalp hair (its proxy's tint).
 EXTRA_COLOR_NAMES = ("hair",)
 

@@ -24,8 +24,11 @@ import numpy as np
 
 from facsim.head.assets import PAINT_UV_BOX
 
-#: Region names; ``RenderTopology.region`` holds indices into this tuple.
-REGIONS = ("skin", "mouth_interior", "teeth", "tongue", "eyeball", "lashes")
+#: The head model's regions ...
+HEAD_REGIONS = ("skin", "mouth_interior", "teeth", "tongue", "eyeball", "lashes")
+#: ... and every region name (the body's garment too, :mod:`facsim.head.body`);
+#: ``RenderTopology.region`` holds indices into this tuple.
+REGIONS = HEAD_REGIONS + ("garment",)
 
 
 @dataclass(frozen=True, eq=False)
@@ -240,9 +243,7 @@ def build_head(data) -> HeadModel:
     quads = np.asarray(data.quads)
     group_id = {str(n): i for i, n in enumerate(data.group_names)}
     body = data.quad_group == group_id["body"]
-
-    head_quads = body & _label_quads(data, HEAD_LABELS)
-    head_quads = _grow(quads, head_quads, body, NECK_RINGS)
+    head_quads = head_quad_mask(data)
 
     # Geometry vertices: skin, then parts, then generated eyes and the cap.
     skin = np.unique(quads[head_quads])
@@ -334,6 +335,15 @@ def build_head(data) -> HeadModel:
         masks={str(n): data.masks[i] for i, n in enumerate(data.mask_names)},
         mirror=_geo_mirror(np.asarray(data.mirror), base_index, eye_vertices, eye_local, n_geo),
     )
+
+
+def head_quad_mask(data) -> np.ndarray:
+    """(F,) bool: the base mesh's quads that make up the head's skin (the head, mouth and eye
+    sockets by the segmentation, grown :data:`NECK_RINGS` rings into the neck)."""
+    quads = np.asarray(data.quads)
+    names = [str(n) for n in data.group_names]
+    body = data.quad_group == names.index("body")
+    return _grow(quads, body & _label_quads(data, HEAD_LABELS), body, NECK_RINGS)
 
 
 # ------------------------------------------------------------------ helpers

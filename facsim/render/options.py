@@ -27,6 +27,9 @@ VIEWS: dict[str, tuple[float, float]] = {
 
 PROJECTIONS = ("perspective", "orthographic")
 
+#: What is under the head unless asked otherwise: a garment of ``facsim/data/body.yaml``.
+DEFAULT_BODY = "crewneck"
+
 #: Image sides facsim renders (pixels): below, faces are unreadable; above, llvmpipe runs out of memory.
 SIZE_RANGE = (16, 8192)
 #: MSAA samples accepted (llvmpipe's maximum is 4; a GPU's driver caps higher counts).
@@ -116,6 +119,9 @@ class RenderOptions:
         None renders a transparent background.
     antialias : int or str
         MSAA samples, ``"fxaa"`` or ``"ssaaN"`` (see :func:`parse_antialias`).
+    body : str
+        What is under the head: a garment of ``facsim/data/body.yaml`` over hm08's neck and
+        shoulders (``"crewneck"``), or ``"none"`` for the head alone (see :mod:`facsim.head.body`).
     """
 
     view: str = "front"
@@ -125,6 +131,7 @@ class RenderOptions:
     projection: str = "perspective"
     background: tuple[float, float, float] | None = (1.0, 1.0, 1.0)
     antialias: int | str = 4
+    body: str = DEFAULT_BODY
 
     def __post_init__(self):
         if self.view not in VIEWS:
@@ -138,6 +145,9 @@ class RenderOptions:
             raise ValueError(f"pitch must be between -90 and 90 degrees (exclusive), got {self.pitch:g}")
         set_(self, "size", size_pair(self.size))
         set_(self, "background", _background(self.background))
+        from facsim.head.body import check_body_style
+
+        check_body_style(self.body)
         samples, method = parse_antialias(self.antialias)
         set_(self, "antialias", "fxaa" if method == "fxaa" else f"ssaa{samples}" if method == "ssaa" else samples)
 

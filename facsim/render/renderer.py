@@ -100,6 +100,7 @@ _PASSES = {
     "teeth": ("REGION_TEETH", "USE_UV"),
     "tongue": ("REGION_TONGUE", "USE_UV"),
     "eyeball": ("REGION_EYEBALL", "USE_EYE", "USE_LIDS"),
+    "garment": ("REGION_GARMENT", "USE_UV"),
     "lashes": ("REGION_LASHES", "USE_LASH"),
 }
 #: Shader variants for frames without creases (no wrinkle field): the skin skips the crease
@@ -111,7 +112,7 @@ _VARIANTS = {**_PASSES, **{plain: tuple(d for d in _PASSES[name] if d != "USE_WR
 #: are two-sided (teeth bands, lash cards, the inside of the mouth).
 _CULLED = ("skin", "skin_brows", "eyeball")
 _SINGLE_COLOR = {"mouth_interior": "mouth_interior", "teeth": "teeth", "tongue": "tongue",
-                 "lashes": "lashes"}
+                 "lashes": "lashes", "garment": "garment"}
 
 
 # --------------------------------------------------------------------------------------------

@@ -3,7 +3,7 @@
 // cost, even when a uniform switches one off). Variants:
 //   REGION_SKIN (+ USE_UV, USE_WRINKLE; + USE_BROWS for triangles under painted brows),
 //   REGION_EYEBALL (+ USE_EYE, USE_LIDS), REGION_TEETH, REGION_TONGUE, REGION_MOUTH_INTERIOR,
-//   REGION_LASHES (+ USE_LASH).
+//   REGION_LASHES (+ USE_LASH), REGION_GARMENT (+ USE_UV: cloth coordinates; the body's clothes).
 // All colour uniforms are linear RGB (render.py linearises the appearance's sRGB colours).
 
 #include "common.glsl"
@@ -253,7 +253,7 @@ const vec2 LOWER_LID_SHADE = vec2(0.2, 3.0);
 const float UPPER_TEETH[8] = float[8](0.0, 0.085, 0.150, 0.225, 0.295, 0.360, 0.460, 0.560);
 const float LOWER_TEETH[8] = float[8](0.0, 0.052, 0.108, 0.176, 0.246, 0.316, 0.426, 0.530);
 #endif
-#if defined(ONE_ALBEDO) || defined(REGION_MOUTH_INTERIOR) || defined(REGION_LASHES)
+#if defined(ONE_ALBEDO) || defined(REGION_MOUTH_INTERIOR) || defined(REGION_LASHES) || defined(REGION_GARMENT)
 uniform vec3 u_albedo;
 #endif
 
@@ -264,6 +264,13 @@ uniform vec3 u_albedo;
 // the head's frame) whose strands end at random lengths, so the lash strips read as tapering
 // hairs rather than a dark band.
 const float LASH_STRANDS_PER_DM = 300.0;
+#endif
+
+#ifdef REGION_GARMENT
+const float FOLD_SPACING = 0.34;  // dm between the folds' ridges along the neckline
+const float FOLD_DEPTH = 0.06;    // dm
+const float FOLD_LENGTH = 5.0;    // band widths below the neckline where they have faded
+const float FOLD_REACH = 0.5;     // dm along the neckline from the front where they fade
 #endif
 
 void main() {
@@ -750,6 +757,37 @@ void main() {
     vec3 deep = 0.12 * mix(vec3(dot(u_albedo, vec3(0.33))), u_albedo, 0.5);
     radiance = (diffuse_light(n, vec3(0.3, 0.1, 0.1), 1.0) * u_albedo * 0.45 + spec) * mouth_shade
              + deep * (1.0 - mouth_shade);
+#endif
+
+#ifdef REGION_GARMENT
+    // Cloth: matte (no specular highlight), a soft wrap of light past the terminator, a faint
+    // sheen at grazing angles (fibres standing off the surface catch the light) and a fine knit
+    // grain, fading to its mean where it would be finer than a pixel.
+    // Soft folds under the collar at the front: a few shallow ridges running down from the
+    // band (FOLD_SPACING dm apart along the neckline, FOLD_DEPTH dm deep, fading over
+    // FOLD_LENGTH band widths below it and away from the front), shaded by bumping the normal
+    // along the surface gradient of their height (screen-space derivatives, no tangents needed).
+    float fold_along = v_uv.x / FOLD_SPACING;
+    float fold_env = smoothstep(0.9, 1.6, v_uv.y) * (1.0 - smoothstep(1.6, FOLD_LENGTH, v_uv.y))
+                   * exp(-v_uv.x * v_uv.x / (FOLD_REACH * FOLD_REACH));
+    float fold_h = FOLD_DEPTH * fold_env * (0.5 - 0.5 * cos(2.0 * PI * fold_along));
+    vec3 dpdx = dFdx(v_pos), dpdy = dFdy(v_pos);
+    vec3 r1 = cross(dpdy, n), r2 = cross(n, dpdx);
+    float det = dot(dpdx, r1);
+    vec3 surface_grad = sign(det) * (dFdx(fold_h) * r1 + dFdy(fold_h) * r2);
+    n = normalize(abs(det) * n - surface_grad);
+    vec2 knit_uv = vec2(v_pos.x * 90.0, v_pos.y * 60.0);
+    float knit = mix(0.5, value_noise(knit_uv, 0), clamp(2.0 - 1.5 * max(fwidth(knit_uv.x), fwidth(knit_uv.y)), 0.0, 1.0));
+    vec3 cloth = u_albedo * (0.94 + 0.12 * knit);
+    // The collar: a ribbed band along the neckline (v_uv: arc length around the neck in dm,
+    // distance from the neckline in band widths), its ribs ~3 mm apart, a shade darker and
+    // denser than the body of the garment, its edge in the rim's shade.
+    float band = 1.0 - smoothstep(0.8, 1.0, v_uv.y);
+    float rib_x = v_uv.x * 33.0;
+    float rib = mix(0.5, 0.5 + 0.5 * cos(2.0 * PI * rib_x), clamp(2.0 - 2.0 * fwidth(rib_x), 0.0, 1.0));
+    cloth *= mix(1.0, 0.86 + 0.1 * rib, band);
+    float grazing = pow(1.0 - clamp(dot(n, v), 0.0, 1.0), 3.0);
+    radiance = diffuse_light(n, vec3(0.25), occ) * cloth * (1.0 + 0.25 * grazing);
 #endif
 
 #ifdef REGION_LASHES
