@@ -34,15 +34,17 @@ def marks(head):
 
 
 @functools.lru_cache(maxsize=None)
-def _face(character: str, engine: str = "registers"):
+def _face(character: str, engine: str = "registers", symmetric: bool = True):
     from facsim.face import Face
+    from facsim.head.character import resolve_character
 
-    return Face(character, engine=engine)
+    return Face(resolve_character(character).with_(symmetric=symmetric), engine=engine)
 
 
 @pytest.fixture(scope="session")
 def face_of():
-    """``face_of("ava")`` → a cached :class:`facsim.Face` (shared by the whole session)."""
+    """``face_of("ava")`` → a cached :class:`facsim.Face` (shared by the whole session), symmetric
+    (``Character.symmetric``) unless ``symmetric=False`` is given."""
     return _face
 
 

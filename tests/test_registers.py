@@ -383,3 +383,15 @@ def test_half_an_emotion_shows_more_than_half_its_movement(engine, marks):
     assert half > 0.06 and half > 0.6 * full
     sad = _emotion_moved(engine, "sadness", 0.5)
     assert sad[marks["inner_brow_left"], 1] - sad[marks["outer_brow_left"], 1] > 0.05
+
+
+def test_a_character_s_natural_asymmetry_moves_one_side_more(face_of):
+    """Session 14: unless symmetric, a character's AUs act a little more strongly on one side
+    (its seeded gain), every register alike; the symmetric faces the other tests use have none."""
+    engine = face_of("liam", symmetric=False).engine
+    gain = engine.side_gain
+    assert 0.01 < abs(gain["left"] - gain["right"]) < 0.2
+    weights = engine.weights(activations(parse("12")))
+    smile = {c.side: w for c, w in weights.items() if c.target.startswith("faceunits/mouthSmile")}
+    assert smile["left"] / smile["right"] == pytest.approx(gain["left"] / gain["right"])
+    assert face_of("liam").engine.side_gain == {"left": 1.0, "right": 1.0}

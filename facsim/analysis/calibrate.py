@@ -60,7 +60,9 @@ def measure_character(name: str, channels, detector, *, views=VIEWS, size: int =
 
     from .correspondence import surface_points
 
-    face = Face(name)
+    from facsim.head.character import resolve_character
+
+    face = Face(resolve_character(name).with_(symmetric=True))   # the AUs' own motion, mirror-exact
     surface = surface_points(face.base_positions)
     cams, jac, neutral_px = [], [], []
     for yaw in views:
@@ -128,11 +130,20 @@ def load_measured() -> dict[str, np.ndarray]:
     return load_arrays(DATA_FILE.removeprefix("data/"))
 
 
-def main() -> None:
+def main(argv=None) -> None:
+    """Rebuild the shipped basis (``--help`` says so and does nothing else)."""
+    import argparse
     from importlib import resources
 
     from facsim.atomic import atomic_write
 
+    parser = argparse.ArgumentParser(
+        prog="python -m facsim.analysis.calibrate",
+        description=f"Re-measure the AU basis the camera processor fits ({DATA_FILE}) on facsim's own "
+                    f"renders: {', '.join(CHARACTERS)} (symmetric), yaws {', '.join(f'{v:g}' for v in VIEWS)}, "
+                    f"{SIZE}². Run it after changing how the register engine moves an AU "
+                    "(facsim/data/registers.yaml) or the faces' looks; a few minutes.")
+    parser.parse_args(argv)
     arrays = build()
     path = resources.files("facsim").joinpath(DATA_FILE)
 

@@ -155,11 +155,11 @@ def combination_scales(act: Activations, code: int, side: str) -> dict[str, floa
     between them is the same, so is the rule (fear at 50 % keeps raised inner brows).
 
     >>> round(combination_scales(Activations({(1, "left"): 1.0, (4, "left"): 1.0}), 4, "left")["faceunits/browDown{Side}"], 6)
-    0.45
+    0.7
     >>> round(combination_scales(Activations({(1, "left"): 0.5, (4, "left"): 0.5}), 4, "left")["faceunits/browDown{Side}"], 6)
-    0.45
+    0.7
     >>> round(combination_scales(Activations({(1, "left"): 0.5, (4, "left"): 1.0}), 4, "left")["faceunits/browDown{Side}"], 6)
-    0.725
+    0.85
     >>> combination_scales(Activations({(4, "left"): 1.0}), 4, "left")
     {}
     >>> combination_scales(Activations({(1, "left"): 1.0, (4, "left"): 1.0, (5, "left"): 1.0}), 5, "left")
@@ -201,6 +201,10 @@ class RegisterEngine:
         self.data = data
         self.base_positions = np.asarray(base_positions, np.float32)
         self.ethnicity = character.ethnicity
+        from facsim.head.character import natural_asymmetry
+
+        #: Side → factor on every AU's register weights there (the character's natural asymmetry).
+        self.side_gain = dict(natural_asymmetry(character).expression)
         # The sculpted face (MakeHuman's staring lids); the rest is it with relaxed lids (:attr:`neutral`).
         self.sculpted = head.positions(self.base_positions)
         x = self.base_positions[head.base_index, 0]
@@ -269,10 +273,11 @@ class RegisterEngine:
         return self.deform(Activations()).positions
 
     def weights(self, act: Activations) -> dict[Column, float]:
-        """Column weights of ``act`` (Eq. 1) plus the relaxed lids' share of the closing target."""
+        """Column weights of ``act`` (Eq. 1), each side's by the character's gain there (its natural
+        asymmetry), plus the relaxed lids' share of the closing target."""
         from facsim.engines.lids import rest_table
 
-        weights = register_weights(act)
+        weights = {col: w * self.side_gain[col.side] for col, w in register_weights(act).items()}
         for side in ("left", "right"):
             share = self.rest_lids.share(act, side)
             if share:

@@ -33,6 +33,7 @@ Examples
 from __future__ import annotations
 
 import re
+import zlib
 from dataclasses import dataclass, field, replace
 from functools import lru_cache
 from typing import Mapping
@@ -85,6 +86,11 @@ class Character:
         (``facsim/data/hair.yaml``).
     name : str
         Preset name, or "" for a custom character.
+    symmetric : bool
+        True: the face's halves are mirror images (for FACS validation and tests). False
+        (the default): the character's own small, seeded asymmetry (:func:`natural_asymmetry`,
+        ``asymmetry`` in ``characters.yaml``) - its halves differ a little in shape, and its
+        expressions act a little more strongly on one side.
     """
 
     gender: float = 0.5
@@ -101,6 +107,7 @@ class Character:
     lashes: str = ""
     name: str = ""
     description: str = ""
+    symmetric: bool = False
 
     def __post_init__(self):
         for key in ("gender", "muscle", "weight", "african", "asian", "caucasian"):
@@ -121,6 +128,8 @@ class Character:
             value = getattr(self, key)
             if value not in ("", "none", *names):
                 raise CharacterError(f"unknown {key} {value!r}; choose from {', '.join(names)} or 'none'")
+        if not isinstance(self.symmetric, bool):
+            raise CharacterError(f"character parameter 'symmetric' must be true or false, got {self.symmetric!r}")
         object.__setattr__(self, "face", dict(self.face))
         object.__setattr__(self, "colors", dict(self.colors))
 
@@ -224,10 +233,76 @@ def slider_names(available) -> list[str]:
 
 
 def character_weights(character: Character, available: set[str]) -> dict[str, float]:
-    """All target weights (macro + face shape) for ``character``."""
+    """All target weights (macro + face shape, with the character's natural asymmetry) for ``character``."""
     weights = {f"macrodetails/{k}": v for k, v in macro_weights(character).items()}
-    weights.update(face_shape_weights(character.face, available))
+    weights.update(face_shape_weights(asymmetric_face(character), available))
     return weights
+
+
+# ------------------------------------------------------------ asymmetry
+
+
+@dataclass(frozen=True)
+class Asymmetry:
+    """A character's natural asymmetry: how its two halves differ.
+
+    ``shape``: sided slider (``"eyes/l-eye-trans"``) → value added on that side;
+    ``expression``: side (``"left"``/``"right"``) → factor on every AU's register weights there.
+    """
+
+    shape: Mapping[str, float]
+    expression: Mapping[str, float]
+
+
+NO_ASYMMETRY = Asymmetry({}, {"left": 1.0, "right": 1.0})
+
+
+def asymmetry_seed(character: Character) -> int:
+    """The seed of a character's asymmetry: the CRC-32 of its name (0 for an unnamed one, so changing
+    a custom character's sliders does not redraw its asymmetry)."""
+    return zlib.crc32(character.name.encode())
+
+
+def natural_asymmetry(character: Character) -> Asymmetry:
+    """The character's own small differences between its halves (``asymmetry`` in ``characters.yaml``).
+
+    Each listed sided slider moves apart on the two sides by a draw of N(0, sd), half each way;
+    every AU acts on one side stronger by a draw of N(0, sd) of its weight, half each way. Draws
+    are clipped to two sd and seeded by :func:`asymmetry_seed`, so a character always has the same face.
+    A ``symmetric`` character has none.
+
+    >>> natural_asymmetry(Character(symmetric=True)) == NO_ASYMMETRY
+    True
+    >>> natural_asymmetry(preset("ava")) == natural_asymmetry(preset("ava"))
+    True
+    """
+    if character.symmetric:
+        return NO_ASYMMETRY
+    table = _preset_table()["asymmetry"]
+    rng = np.random.default_rng([asymmetry_seed(character), 14])
+
+    def draw(sd: float) -> float:
+        return float(np.clip(rng.normal(0.0, sd), -2.0 * sd, 2.0 * sd))
+
+    shape = {}
+    for slider, sd in table["shape"].items():
+        folder, _, stem = slider.partition("/")
+        apart = draw(float(sd))
+        shape[f"{folder}/l-{stem}"], shape[f"{folder}/r-{stem}"] = apart / 2, -apart / 2
+    gain = draw(float(table["expression"]))
+    return Asymmetry(shape, {"left": 1.0 + gain / 2, "right": 1.0 - gain / 2})
+
+
+def asymmetric_face(character: Character) -> dict[str, float]:
+    """The character's face-shape sliders with its natural asymmetry added, side by side."""
+    face = dict(character.face)
+    for sided, offset in natural_asymmetry(character).shape.items():
+        folder, _, stem = sided.partition("/")
+        both = f"{folder}/{stem[2:]}"   # the slider for both sides, now given per side
+        base = character.face.get(sided, character.face.get(both, 0.0))
+        face.pop(both, None)
+        face[sided] = float(np.clip(base + offset, -1.0, 1.0))
+    return face
 
 
 def apply_targets(base: np.ndarray, data, weights: Mapping[str, float]) -> np.ndarray:
@@ -280,15 +355,16 @@ def character_from_mapping(entry: Mapping) -> Character:
 
 
 def random_character(seed: int) -> Character:
-    """A seeded random adult: the same seed always gives the same person."""
+    """A seeded random adult: the same seed always gives the same person.
+
+    Face-shape sliders and head shapes are drawn as ``random`` in ``characters.yaml`` says.
+    """
+    table = _preset_table()["random"]
     rng = np.random.default_rng(seed)
     mix = rng.dirichlet([0.6, 0.6, 0.6])
-    face = {
-        slider: float(np.clip(rng.normal(0.0, 0.2), -0.5, 0.5))
-        for slider in ("nose/nose-scale-horiz", "nose/nose-hump", "nose/nose-point-width", "mouth/mouth-scale-horiz",
-                       "mouth/mouth-lowerlip-volume", "chin/chin-width", "chin/chin-prominent", "cheek/cheek-bones",
-                       "eyes/eye-scale", "head/head-scale-horiz", "forehead/forehead-scale-vert", "eyebrows/eyebrows-angle")
-    }
+    sd = float(table["sd"])
+    face = {slider: float(np.clip(rng.normal(0.0, sd), -2.5 * sd, 2.5 * sd)) for slider in table["sliders"]}
+    face[str(rng.choice(table["head_shapes"]))] = float(rng.uniform(0.0, table["head_shape_max"]))
     return Character(
         gender=float(np.clip(rng.integers(0, 2) + rng.normal(0.0, 0.08), 0, 1)),
         age=float(rng.uniform(18, 80)),

@@ -134,6 +134,7 @@ def run_validation(*, engines=("registers", "muscle"), characters=None, quick: b
     from facsim.engines.rigid import eye_levels, head_levels
     from facsim.facs.activations import activations
     from facsim.face import Face
+    from facsim.head.character import resolve_character
     from facsim.facs.notation import parse
 
     t0 = time.perf_counter()
@@ -150,7 +151,8 @@ def run_validation(*, engines=("registers", "muscle"), characters=None, quick: b
     with LandmarkDetector() as detector:
         for engine in engines:
             for character in characters:
-                face = Face(character, engine=engine)
+                # symmetric: the loop scores AUs, not the character's natural asymmetry
+                face = Face(resolve_character(character).with_(symmetric=True), engine=engine)
                 for yaw, pitch in views:
                     view = f"yaw {yaw:+g}" + (f" pitch {pitch:+g}" if pitch else "")
                     neutral = detector.faces(face.render(None, yaw=yaw, pitch=pitch, size=size)[..., :3])
