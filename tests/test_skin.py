@@ -248,7 +248,7 @@ def test_fold_lines_deepen_where_their_au_acts_and_nowhere_else(face_of, head, e
 
     def luma(folds):
         appearance = dataclasses.replace(face.appearance, folds=folds)
-        image = face.renderer(size=size).render(positions, appearance=appearance, camera=camera,
+        image = face.renderer(size=size, body="none").render(positions, appearance=appearance, camera=camera,
                                                 wrinkle=deformation.wrinkle, crease_phase=deformation.crease_phase,
                                                 occlusion=face.frame_occlusion(positions))
         return image[..., :3].astype(float) @ np.array([0.2126, 0.7152, 0.0722])

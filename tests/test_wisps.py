@@ -87,7 +87,7 @@ def test_the_face_draws_wisps_that_follow_the_hair_and_soften_its_outline(face_o
 
     from facsim.render.options import RenderOptions
 
-    options = RenderOptions(size=160, background=None, antialias=1)
+    options = RenderOptions(size=160, background=None, antialias=1, body="none")
     camera = face.camera(view=options.view, size=options.size)
     p = face.neutral
 
