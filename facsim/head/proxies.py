@@ -400,17 +400,11 @@ def hair_volume_offset(style: str, fitted: np.ndarray, head, neutral_geometry: n
     fitted = np.asarray(fitted, np.float64)
     if mm == 0.0:
         return np.zeros_like(fitted, dtype=np.float32)
-    from facsim.head.surface import smoothstep, vertex_normals
+    from facsim.head.scalp import hairline_height, outward_skin
+    from facsim.head.surface import smoothstep
 
-    n_skin = head.skin_vertex_count
     geo = np.asarray(neutral_geometry, np.float64)
-    tris = np.asarray(head.topology.geo_faces)
-    tris = tris[np.all(tris < n_skin, axis=1)]
-    skin = geo[:n_skin]
-    normals = vertex_normals(skin, tris).astype(np.float64)
-    if np.einsum("ij,ij->i", normals, skin - skin.mean(axis=0)).mean() < 0:  # wound inward
-        normals = -normals
-    from facsim.head.scalp import hairline_height
+    skin, _, normals = outward_skin(head, geo)
 
     nearest = cKDTree(skin).query(fitted)[1]
     eyes = np.concatenate([np.asarray(v) for v in head.eye_vertices.values()])

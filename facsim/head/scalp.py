@@ -42,6 +42,19 @@ VERSION = 2  # 2: afro01's cards stand off the skull (volume_mm in hair.yaml)
 TILE = (0.1, 0.2)
 
 
+def outward_skin(head, neutral_geometry) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The neutral skin's points (N_skin, 3), triangles (T, 3) and vertex normals (N_skin, 3),
+    all float64 and wound outward (the mesh's winding is turned if it faces inward)."""
+    n_skin = head.skin_vertex_count
+    skin = np.asarray(neutral_geometry, np.float64)[:n_skin]
+    tris = np.asarray(head.topology.geo_faces)
+    tris = tris[np.all(tris < n_skin, axis=1)]
+    normals = vertex_normals(skin, tris).astype(np.float64)
+    if np.einsum("ij,ij->i", normals, skin - skin.mean(axis=0)).mean() < 0:
+        tris, normals = tris[:, ::-1], -normals
+    return skin, tris, normals
+
+
 def hairline_height(normals: np.ndarray, skin_z: np.ndarray, eye_y: float, eye_z: float, hairline: dict) -> np.ndarray:
     """(N,) height (dm) below which skin facing along ``normals`` (at depths ``skin_z``)
     grows no scalp hair.
@@ -265,13 +278,7 @@ def scalp_layer(head, neutral_geometry: np.ndarray, cards: np.ndarray, card_tria
     ``eye_y``, ``eye_z``: the eyes' centres' height and depth (the hairline is placed from them).
     """
     n_skin = head.skin_vertex_count
-    geo = np.asarray(neutral_geometry, np.float64)
-    tris = np.asarray(head.topology.geo_faces)
-    tris = tris[np.all(tris < n_skin, axis=1)]
-    skin = geo[:n_skin]
-    normals = vertex_normals(skin, tris).astype(np.float64)
-    if np.einsum("ij,ij->i", normals, skin - skin.mean(axis=0)).mean() < 0:  # wound inward: turn it
-        tris, normals = tris[:, ::-1], -normals
+    skin, tris, normals = outward_skin(head, neutral_geometry)
     density = scalp_density(skin, normals, cards, card_triangles, floor_y=hairline_height(normals, skin[:, 2], eye_y, eye_z, hairline))
     keep = tris[(density[tris] > 0.0).any(axis=1)]
     if not len(keep):

@@ -54,14 +54,19 @@ def tone_texture(head, position_map: Callable) -> np.ndarray:
                         valid=lambda a: a.shape == (*TONE_SIZE, 4) and a.dtype == np.uint8)
 
 
+def _resampled(positions: np.ndarray, size: tuple[int, int], order: int) -> np.ndarray:
+    """Base-mesh ``positions`` (rows, cols, 3) as float32, resampled to ``size`` (spline ``order``)."""
+    positions = np.asarray(positions, np.float32)
+    if positions.shape[:2] == tuple(size):
+        return positions
+    from scipy.ndimage import zoom
+
+    return zoom(positions, (size[0] / positions.shape[0], size[1] / positions.shape[1], 1), order=order)
+
+
 def build_tone(positions: np.ndarray) -> np.ndarray:
     """The tone maps at base-mesh ``positions`` (rows, cols, 3), resampled to :data:`TONE_SIZE`."""
-    positions = np.asarray(positions, np.float32)
-    if positions.shape[:2] != TONE_SIZE:
-        from scipy.ndimage import zoom
-
-        factors = (TONE_SIZE[0] / positions.shape[0], TONE_SIZE[1] / positions.shape[1], 1)
-        positions = zoom(positions, factors, order=1)
+    positions = _resampled(positions, TONE_SIZE, order=1)
     channels = (periorbital_density(positions), translucency_density(positions),
                 pore_density(positions), sun_density(positions))
     tone = np.empty((*TONE_SIZE, 4), np.uint8)
@@ -181,13 +186,8 @@ def fold_texture(head, position_map: Callable) -> np.ndarray:
 
 def build_folds(positions: np.ndarray) -> np.ndarray:
     """The fold map at base-mesh ``positions`` (rows, cols, 3), resampled to :data:`FOLD_SIZE`."""
-    positions = np.asarray(positions, np.float32)
-    if positions.shape[:2] != FOLD_SIZE:
-        from scipy.ndimage import zoom
-
-        # Cubic: the grooves are shaded from their slopes, and bilinear kinks show as dashes.
-        factors = (FOLD_SIZE[0] / positions.shape[0], FOLD_SIZE[1] / positions.shape[1], 1)
-        positions = zoom(positions, factors, order=3)
+    # Cubic: the grooves are shaded from their slopes, and bilinear kinks show as dashes.
+    positions = _resampled(positions, FOLD_SIZE, order=3)
     channels = (np.maximum(forehead_line_density(positions), crows_feet_density(positions)),
                 under_eye_line_density(positions), fold_shade_density(positions), fold_region_density(positions))
     folds = np.empty((*FOLD_SIZE, 4), np.uint8)
