@@ -404,3 +404,21 @@ def test_a_half_smile_narrows_the_eye_from_below(engine, marks):
     half = _emotion_moved(engine, "happiness", 0.5)
     assert half[marks["lower_lid_left"], 1] > 0.02
     assert abs(half[marks["upper_lid_left"], 1]) < 0.005
+
+
+def test_14_sinks_a_dimple_beyond_the_corner(engine, marks):
+    """Session 15 (14 hardly showed on dark skin or unilaterally): the buccinator pulls the corner
+    back and the skin just beyond it into a dimple, a pit deeper than the corner itself goes:
+    at E over 3.5 mm deeper, where the lips stretched by 20 sink that skin under 3 mm."""
+    from facsim.head.assets import load_face_data
+
+    base, _ = load_face_data(progress=False).target("mouth/mouth-dimples-in")
+    pit_skin = engine.head.geo_of_base[base]
+    pit_skin = pit_skin[(pit_skin >= 0) & (engine.neutral[np.maximum(pit_skin, 0), X] > 0)]  # the left pit
+
+    def pit(text):
+        moved = _moved(engine, text)
+        return moved[marks["lip_corner_left"], Z] - moved[pit_skin, Z].min()
+
+    assert pit("14") > 0.035
+    assert pit("20") < 0.03
