@@ -69,14 +69,15 @@ float pixel_strands_uv(vec2 uv, vec2 base, vec2 offset) {
 
 // Strands and clumps about two pixels across at any size: value noise on the neutral head
 // (``rest``, dm; so it runs on across the cards' edges and moves with the hair), smeared along
-// the strands (``along``; three samples two cells apart, a short line-integral
+// the strands (``along``; four samples over three and a half cells, a short line-integral
 // convolution: a global coordinate along a curving direction would shear the pattern), with
 // ``cells_per_dm`` cells to the decimetre, taken at the octave whose cells come nearest two
 // pixels across (at most 4x finer), blended with the next one so nothing pops as the hair
 // nears or leaves the camera. Noise of fixed frequency fades to its mean at stimulus sizes (a
 // flat, clay-like mass); this keeps strand-level variation in every image. [0, 1], mean 0.5.
 float smeared_noise(vec3 p, vec3 step) {
-    return (value_noise3(p - step) + value_noise3(p) + value_noise3(p + step)) * (1.0 / 3.0);
+    return (value_noise3(p - 1.5 * step) + value_noise3(p - 0.5 * step) + value_noise3(p + 0.5 * step)
+            + value_noise3(p + 1.5 * step)) * 0.25;
 }
 
 float pixel_strands(vec3 rest, vec3 along, float cells_per_dm) {
@@ -86,10 +87,11 @@ float pixel_strands(vec3 rest, vec3 along, float cells_per_dm) {
     float k = clamp(floor(level), 0.0, 2.0);
     float f = clamp(level - k, 0.0, 1.0) * step(k, 1.5);
     float s0 = exp2(k);
-    float n0 = smeared_noise(p * s0 + 3.0, 2.0 * along);
-    float n1 = f > 0.02 ? smeared_noise(p * (2.0 * s0) + 11.0, 2.0 * along) : 0.5;
-    // (a mean of three samples varies ~1/1.6 as much as one)
-    float n = 0.5 + 1.6 * (mix(n0, n1, f) - 0.5) / sqrt(f * f + (1.0 - f) * (1.0 - f));
+    float n0 = f < 0.98 ? smeared_noise(p * s0 + 3.0, 0.9 * along) : 0.5;
+    float n1 = f > 0.02 ? smeared_noise(p * (2.0 * s0) + 11.0, 0.9 * along) : 0.5;
+    // (a mean of four samples along a few cells varies ~1/1.7 as much as one; a little of that
+    // is given back, so the darkest strands do not stand out as dots)
+    float n = 0.5 + 1.45 * (mix(n0, n1, f) - 0.5) / sqrt(f * f + (1.0 - f) * (1.0 - f));
     return clamp(n, 0.0, 1.0);
 }
 
@@ -320,7 +322,7 @@ void main() {
     cp += 0.5 * phase;
     clump = mix(0.5, value_noise(cp, 0), along_v * clamp(2.0 - 1.5 * fwidth(cp.x), 0.0, 1.0));
     // (px: strands and clumps a couple of pixels across, so the breakup shows at any size.)
-    float strand = (0.62 + 0.76 * tex.r) * (0.7 + 0.6 * fine) * (0.55 + 0.9 * px) * (0.8 + 0.4 * mid)
+    float strand = (0.62 + 0.76 * tex.r) * (0.7 + 0.6 * fine) * (0.6 + 0.8 * px) * (0.8 + 0.4 * mid)
                  * (0.9 + 0.2 * clump);
 #ifdef PASS_OPAQUE
 #ifdef COILY
@@ -352,7 +354,7 @@ void main() {
                       * mix(mix(0.8, 0.92, light_hair), 1.0, clump) * mix(0.8, 1.0, mid)
     // and the narrow gaps between clumps are in their neighbours' shade: light and dark
     // alternate across the mass at the scale of clumps, not one smooth shell.
-                      * mix(mix(0.62, 0.78, light_hair), 1.0, smoothstep(0.08, 0.38, px));
+                      * mix(mix(0.74, 0.85, light_hair), 1.0, smoothstep(0.02, 0.32, px));
     float jitter = 0.22 * (tex.r - 0.5) + 0.12 * (fine - 0.5) + 0.18 * (mid - 0.5) + 0.1 * (clump - 0.5)
                  + 0.25 * (px - 0.5);
     // Key light: strand diffuse blended with a squared half-Lambert, which keeps the volume
@@ -392,7 +394,7 @@ void main() {
     vec2 gp = v_uv * vec2(400.0, 9.0) + 13.0 + 3.0 * phase;
     float glint = smoothstep(0.86, 0.96, value_noise(gp, 0)) * along_v
                 * clamp(1.6 - 1.2 * fwidth(gp.x), 0.0, 1.0);
-    vec3 spec = u_key_col * gate * (0.16 * strands * tint * exp2(40.0 * log2(s1))
+    vec3 spec = u_key_col * gate * (0.24 * strands * tint * exp2(28.0 * log2(s1))
                                     + 0.55 * sparkle * u_color * exp2(10.0 * log2(s2))
                                     + 0.25 * glint * tint * exp2(40.0 * log2(s1)));
 #else
