@@ -69,15 +69,27 @@ float pixel_strands_uv(vec2 uv, vec2 base, vec2 offset) {
 
 // Strands and clumps about two pixels across at any size: value noise on the neutral head
 // (``rest``, dm; so it runs on across the cards' edges and moves with the hair), smeared along
-// the strands (``along``; four samples over three and a half cells, a short line-integral
+// the strands (``along``; three samples over two cells and a bit, a short line-integral
 // convolution: a global coordinate along a curving direction would shear the pattern), with
 // ``cells_per_dm`` cells to the decimetre, taken at the octave whose cells come nearest two
 // pixels across (at most 4x finer), blended with the next one so nothing pops as the hair
 // nears or leaves the camera. Noise of fixed frequency fades to its mean at stimulus sizes (a
 // flat, clay-like mass); this keeps strand-level variation in every image. [0, 1], mean 0.5.
+float lattice_noise3(vec3 p) {   // value_noise3 without its fade (the caller picks the octave)
+    vec3 i = floor(p);
+    vec3 f = p - i;
+    vec3 u = f * f * (3.0 - 2.0 * f);
+    ivec3 c = ivec3(i);
+    int z0 = 7919 * c.z, z1 = 7919 * (c.z + 1);
+    float a = mix(mix(hash2(ivec2(c.x, c.y + z0)), hash2(ivec2(c.x + 1, c.y + z0)), u.x),
+                  mix(hash2(ivec2(c.x, c.y + 1 + z0)), hash2(ivec2(c.x + 1, c.y + 1 + z0)), u.x), u.y);
+    float b = mix(mix(hash2(ivec2(c.x, c.y + z1)), hash2(ivec2(c.x + 1, c.y + z1)), u.x),
+                  mix(hash2(ivec2(c.x, c.y + 1 + z1)), hash2(ivec2(c.x + 1, c.y + 1 + z1)), u.x), u.y);
+    return mix(a, b, u.z);
+}
+
 float smeared_noise(vec3 p, vec3 step) {
-    return (value_noise3(p - 1.5 * step) + value_noise3(p - 0.5 * step) + value_noise3(p + 0.5 * step)
-            + value_noise3(p + 1.5 * step)) * 0.25;
+    return (lattice_noise3(p - step) + lattice_noise3(p) + lattice_noise3(p + step)) * (1.0 / 3.0);
 }
 
 float pixel_strands(vec3 rest, vec3 along, float cells_per_dm) {
@@ -85,14 +97,17 @@ float pixel_strands(vec3 rest, vec3 along, float cells_per_dm) {
     float cells = max(length(fwidth(p)), 1e-5);  // base cells per pixel
     float level = log2(0.6 / cells);
     float k = clamp(floor(level), 0.0, 2.0);
-    float f = clamp(level - k, 0.0, 1.0) * step(k, 1.5);
+    // Two octaves are blended only near the switch from one to the next (each costs
+    // llvmpipe twenty-four hashes); elsewhere one is taken.
+    float f = smoothstep(0.35, 0.65, clamp(level - k, 0.0, 1.0)) * step(k, 1.5);
     float s0 = exp2(k);
-    float n0 = f < 0.98 ? smeared_noise(p * s0 + 3.0, 0.9 * along) : 0.5;
-    float n1 = f > 0.02 ? smeared_noise(p * (2.0 * s0) + 11.0, 0.9 * along) : 0.5;
-    // (a mean of four samples along a few cells varies ~1/1.7 as much as one; a little of that
-    // is given back, so the darkest strands do not stand out as dots)
-    float n = 0.5 + 1.45 * (mix(n0, n1, f) - 0.5) / sqrt(f * f + (1.0 - f) * (1.0 - f));
-    return clamp(n, 0.0, 1.0);
+    float n0 = f < 0.999 ? smeared_noise(p * s0 + 3.0, 1.1 * along) : 0.5;
+    float n1 = f > 0.001 ? smeared_noise(p * (2.0 * s0) + 11.0, 1.1 * along) : 0.5;
+    // (a mean of three samples along a few cells varies ~1/1.5 as much as one; most of that
+    // is given back, not all, so the darkest strands do not stand out as dots)
+    float n = 0.5 + 1.3 * (mix(n0, n1, f) - 0.5) / sqrt(f * f + (1.0 - f) * (1.0 - f));
+    // Where even the coarsest octave is finer than a pixel, its mean.
+    return mix(0.5, clamp(n, 0.0, 1.0), clamp(2.2 - 1.6 * cells, 0.0, 1.0));
 }
 
 // Kajiya-Kay: light scattered by a thin cylinder along t.
