@@ -271,8 +271,15 @@ void main() {
     // crown) on the neutral head along the strands' direction, running on across the cards.
     // (Long cards' own texture strands carry most of their detail already: a strong breakup over
     // them draws dark blotches across the lengths.)
+#ifdef COILY
+    // Coily hair gathers into clumps of coils a few millimetres across, placed on the
+    // neutral head: their crevices fall dark and the outline breaks up around them.
+    float coil_clump = value_noise3(v_rest * 18.0 + 1.0);
+    float px = 0.5;
+#else
     float px = u_along_v > 0.5 ? mix(0.5, pixel_strands_uv(v_uv, vec2(40.0, 1.5), vec2(5.0, 5.0) + 2.0 * phase), 0.4)
                                : pixel_strands(v_rest, normalize(v_rest_tangent + vec3(0.0, 1e-4, 0.0)), 60.0);
+#endif
     // The hair's outline: where the volume turns away from the eye, its outer strands stand
     // apart, so the outline breaks into strands and clumps with the background between them
     // instead of ending in the cards' cut edge. Inside the mass the cards' own alpha rules.
@@ -292,6 +299,10 @@ void main() {
         // the volume's edge is a halo of curls with the background between them, not a rim.
         float halo = value_noise3(v_rest * 70.0 + 2.0);
         alpha *= 1.0 - u_coil * outline * (1.0 - smoothstep(0.35, 0.65, halo)) * 0.95;
+        // and a wider band of the outline goes in and out with the clumps, so the mass's
+        // silhouette is lumpy, not a smooth dome.
+        float lumps = 1.0 - smoothstep(0.05, 0.45, dot(n, v));
+        alpha *= 1.0 - u_coil * lumps * (1.0 - smoothstep(0.3, 0.6, coil_clump));
     }
 #endif
     // Over a thinning hairline (v_cover < 1, see facsim/head/scalp.py) the cards break up into
@@ -339,22 +350,28 @@ void main() {
     // (px: strands and clumps a couple of pixels across, so the breakup shows at any size.)
     float strand = (0.62 + 0.76 * tex.r) * (0.7 + 0.6 * fine) * (0.6 + 0.8 * px) * (0.8 + 0.4 * mid)
                  * (0.9 + 0.2 * clump);
-#ifdef PASS_OPAQUE
 #ifdef COILY
     {
-        // Coily hair: at any distance its curls blend into a fine, even, matte texture. The
+        // Coily hair (both passes: its translucent fringe at the hairline drew a flat light
+        // band otherwise): at any distance its curls blend into a fine, even, matte texture. The
         // texture's tufts keep a little of their contrast (it is laid out mirrored from card
         // to card, and at full contrast drew that tiling on the cap: ngozi's grey afro read as
         // a cap); curls a millimetre and a few millimetres across, placed on the neutral face
         // (v_rest) rather than in the cards' UVs, add the rest.
         float kink = value_noise3(v_rest * 110.0);
         float curls = value_noise3(v_rest * 35.0 + 5.0);
-        strand = mix(strand, (0.82 + 0.36 * tex.r) * (0.6 + 0.8 * kink) * (0.62 + 0.76 * curls), u_coil);
+        // The clumps' crevices are deep and dark; their crowns catch the light. The crevices
+        // run where the clump noise crosses its mean: a connected network around rounded
+        // clumps, not dark spots on a light field.
+        float crown = smoothstep(0.0, 0.22, abs(coil_clump - 0.5));
+        strand = mix(strand, (0.88 + 0.24 * tex.r) * (0.6 + 0.8 * kink) * (0.62 + 0.76 * curls)
+                             * mix(0.55, 1.1, crown), u_coil);
+        // Greying coily hair mixes white, grey and dark strands curl by curl and clump by
+        // clump (placed on the head, not in the cards' mirrored UVs).
+        float white = clamp(u_grey + 0.5 * (value_noise3(v_rest * 22.0 + 4.0) - 0.5) + 0.45 * (kink - 0.5)
+                            + 0.2 * (crown - 0.5), 0.0, 1.0);
+        albedo = (u_grey > 0.0 ? mix(u_pigment, u_white, white) : u_color) * strand;
     }
-#endif
-#endif
-#ifdef COILY
-    albedo = hair_colour(v_uv * 40.0) * strand;
 #else
     albedo = hair_colour(v_uv * vec2(45.0, 1.2) + 7.0 + 0.5 * phase) * strand;
 #endif
