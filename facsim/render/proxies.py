@@ -71,6 +71,11 @@ class ProxyMesh:
         as ribbons ``strand_width`` dm wide at the root (at least a pixel, fainter where
         widened) turned toward the camera, tapering to the tip. ``depth``: 0 at the root …
         1 at the tip.
+    end_height : float, optional
+        Hair and wisps: the height (y on the neutral face, dm) where the hair ends. MakeHuman's
+        long styles hang on through where the shoulders are; below ``END_FADE`` over this
+        height their strands end one by one at different lengths, tapering, instead of being
+        cut by the shoulders or the image's edge. None: the hair is drawn to its cards' ends.
     """
 
     name: str
@@ -85,6 +90,7 @@ class ProxyMesh:
     coily: bool = False
     strand_points: int = 0
     strand_width: float = 0.0
+    end_height: float | None = None
 
     def __post_init__(self):
         if self.kind not in PROXY_KINDS:
@@ -229,6 +235,9 @@ def triangle_strand_directions(mesh: "ProxyMesh", shaded: np.ndarray) -> np.ndar
     d = shaded[row, col, 1:3].astype(np.float32) / 127.5 - 1.0
     return d / (np.linalg.norm(d, axis=1, keepdims=True) + 1e-12)
 
+
+#: Height (dm) over which long hair's strands end (:attr:`ProxyMesh.end_height`).
+END_FADE = 0.6
 
 #: Radius (dm) of the rounded top of the hair volume (about a head's half width).
 VOLUME_RADIUS = 0.9
@@ -452,6 +461,8 @@ class ProxyLayer:
             _set_uniform(prog, "u_texture", 1)
             _set_uniform(prog, "u_along_v", self._along_v)
             _set_uniform(prog, "u_strand_width", float(mesh.strand_width))
+            _set_uniform(prog, "u_end_height", -1e3 if mesh.end_height is None else float(mesh.end_height))
+            _set_uniform(prog, "u_end_fade", END_FADE)
             self.programs[stage] = prog
             self.vaos[stage] = track(ctx.vertex_array(
                 prog, [(self._vbo, "3f 3f 3f 1f 1f", "in_pos", "in_normal", "in_tangent", "in_depth", "in_edge"),

@@ -24,6 +24,8 @@ uniform float u_coil;         // hair: 0 straight ... 1 coily
 uniform vec3 u_pigment;       // greying hair: its pigmented strands' colour (linear RGB) ...
 uniform vec3 u_white;         // ... its white strands' ...
 uniform float u_grey;         // ... and the fraction of white strands (u_color is their mean)
+uniform float u_end_height;   // hair, wisps: where long hair ends (y on the neutral face, dm) ...
+uniform float u_end_fade;     // ... its strands ending one by one over this height above it
 
 out vec4 f_color;
 
@@ -182,7 +184,8 @@ void main() {
 #endif
     vec4 tex = texture(u_texture, v_uv);
     // Faint where it leaves the mass, then thinning to nothing at the tip.
-    float alpha = tex.a * v_cover * u_density * smoothstep(0.0, 0.15, v_depth) * (1.0 - smoothstep(0.55, 1.0, v_depth));
+    float alpha = tex.a * v_cover * u_density * smoothstep(0.0, 0.15, v_depth) * (1.0 - smoothstep(0.55, 1.0, v_depth))
+                * smoothstep(0.3, 1.0, (v_rest.y - u_end_height) / u_end_fade);   // none where long hair ends
     if (alpha < 0.01) discard;
     vec3 n = normalize(v_normal);
     vec3 t = normalize(v_tangent);
@@ -277,8 +280,17 @@ void main() {
     float coil_clump = value_noise3(v_rest * 18.0 + 1.0);
     float px = 0.5;
 #else
-    float px = u_along_v > 0.5 ? mix(0.5, pixel_strands_uv(v_uv, vec2(40.0, 1.5), vec2(5.0, 5.0) + 2.0 * phase), 0.4)
+    float px = u_along_v > 0.5 ? pixel_strands_uv(v_uv, vec2(40.0, 1.5), vec2(5.0, 5.0) + 2.0 * phase)
                                : pixel_strands(v_rest, normalize(v_rest_tangent + vec3(0.0, 1e-4, 0.0)), 60.0);
+    // Long hair ends strand by strand above u_end_height (MakeHuman's long cards hang on
+    // through the shoulders): each strand at its own length, thinning to its tip, so the hair
+    // ends in tapered strands, not in blocks cut by the shoulders or the image's edge.
+    float ends = (v_rest.y - u_end_height) / u_end_fade;
+    if (ends < 1.0) {
+        float length_at = 0.05 + 0.9 * px;
+        alpha *= smoothstep(length_at - 0.15, length_at + 0.15, ends) * smoothstep(0.15, 0.5, ends);
+    }
+    if (u_along_v > 0.5) px = mix(0.5, px, 0.4);
 #endif
     // The hair's outline: where the volume turns away from the eye, its outer strands stand
     // apart, so the outline breaks into strands and clumps with the background between them
