@@ -156,8 +156,18 @@ class Face:
         return [ProxyMesh(b.proxy.name, b.proxy.kind, b.proxy.triangles, b.proxy.corner_vertex, b.proxy.uv,
                           b.proxy.texture, b.depth, b.neutral if b.proxy.kind in ("hair", "wisps") else None,
                           self._card_cover(b) if b.proxy.kind == "hair" else None, b.coil > 0.0,
-                          b.strand_points, b.strand_width)
+                          b.strand_points, b.strand_width,
+                          self._hair_end_height if b.proxy.kind in ("hair", "wisps") else None)
                 for b in self._drawn_proxies]
+
+    @cached_property
+    def _hair_end_height(self) -> float:
+        """Where long hair ends (y on the neutral face, dm): ``ends_above_neck_base_mm`` (``hair.yaml``)
+        above the lowest point of the head's skin, where the neck meets the shoulders."""
+        from facsim.head.proxies import hair_table
+
+        neck_base = float(self.neutral[: self.head.skin_vertex_count, 1].min())
+        return neck_base + float(hair_table()["ends_above_neck_base_mm"]) / 100.0
 
     def _card_cover(self, bound) -> np.ndarray | None:
         """The scalp's hair density under ``bound``'s cards (:func:`facsim.head.scalp.card_cover`)."""

@@ -655,8 +655,11 @@ def hair_shadow(skin_positions: np.ndarray, hair_positions: np.ndarray, *, stren
         # Steps that run along the skin (up a cheek or temple) are in the head's own shade,
         # not the hair's: only steps out in the open count.
         open_air = smoothstep(0.02, 0.06, skin_tree.query(point, distance_upper_bound=0.06)[0])
-        blocked[marched] += smoothstep(0.12, 0.05, near) * open_air
-    shadow = 1.0 - cast * np.clip(blocked / 2.5, 0.0, 1.0)
+        # Hair far from the skin casts a wider, fainter penumbra (the key is a broad soft light):
+        # the shadow is deepest just under a fringe and fades down the forehead, instead of
+        # lying on it as an even band with an edge.
+        blocked[marched] += smoothstep(0.12, 0.05, near) * open_air * np.clip(1.2 - step / 0.45, 0.1, 1.0)
+    shadow = 1.0 - cast * (1.0 - np.exp(-blocked / 1.3))
     return np.minimum(contact, shadow).astype(np.float32)
 
 

@@ -71,6 +71,11 @@ class ProxyMesh:
         as ribbons ``strand_width`` dm wide at the root (at least a pixel, fainter where
         widened) turned toward the camera, tapering to the tip. ``depth``: 0 at the root …
         1 at the tip.
+    end_height : float, optional
+        Hair and wisps: the height (y on the neutral face, dm) where the hair ends. MakeHuman's
+        long styles hang on through where the shoulders are; below ``END_FADE`` over this
+        height their strands end one by one at different lengths, tapering, instead of being
+        cut by the shoulders or the image's edge. None: the hair is drawn to its cards' ends.
     """
 
     name: str
@@ -85,6 +90,7 @@ class ProxyMesh:
     coily: bool = False
     strand_points: int = 0
     strand_width: float = 0.0
+    end_height: float | None = None
 
     def __post_init__(self):
         if self.kind not in PROXY_KINDS:
@@ -229,6 +235,9 @@ def triangle_strand_directions(mesh: "ProxyMesh", shaded: np.ndarray) -> np.ndar
     d = shaded[row, col, 1:3].astype(np.float32) / 127.5 - 1.0
     return d / (np.linalg.norm(d, axis=1, keepdims=True) + 1e-12)
 
+
+#: Height (dm) over which long hair's strands end (:attr:`ProxyMesh.end_height`).
+END_FADE = 0.6
 
 #: Radius (dm) of the rounded top of the hair volume (about a head's half width).
 VOLUME_RADIUS = 0.9
@@ -399,9 +408,6 @@ class ProxyLayer:
         # texture's mirrored layout, and moving with the hair.
         rest = (np.zeros((mesh.vertex_count, 3), np.float32) if mesh.rest is None
                 else np.asarray(mesh.rest, np.float32))
-        static = np.column_stack([np.asarray(mesh.uv, np.float32), cover[mesh.corner_vertex],
-                                  rest[mesh.corner_vertex]])
-        self._uv = track(ctx.buffer(np.ascontiguousarray(static, np.float32).tobytes()))
         # Two orders of the same triangles: front to back for the alpha-tested pass (hidden
         # layers then fail the depth test before they are shaded), back to front for blending.
         self._ibo = {"OPAQUE": track(ctx.buffer(self._triangles.tobytes(), dynamic=True)),
@@ -423,6 +429,15 @@ class ProxyLayer:
             if np.median(along) < 0.9:
                 self._along_v = 0.0
                 self._directions = triangle_strand_directions(mesh, tex)
+        self._smooth = None  # hair: neighbour-averaging operator over corners (from mesh.rest)
+        # Hair: the strands' direction there (as drawn on the neutral face), along which the
+        # shader's strand breakup is stretched (placed on the neutral face, it moves with the hair).
+        rest_tangents = np.zeros((self._n_corners, 3), np.float32)
+        if mesh.kind == "hair" and mesh.rest is not None:
+            rest_tangents = self._strand_tangents(np.asarray(mesh.rest, np.float32))
+        static = np.column_stack([np.asarray(mesh.uv, np.float32), cover[mesh.corner_vertex],
+                                  rest[mesh.corner_vertex], rest_tangents])
+        self._uv = track(ctx.buffer(np.ascontiguousarray(static, np.float32).tobytes()))
         self.texture = track(ctx.texture((tex.shape[1], tex.shape[0]), 4, tex.tobytes()))
         self.texture.build_mipmaps()  # an input texture, never rendered into
         self.texture.filter = (ctx.LINEAR_MIPMAP_LINEAR, ctx.LINEAR)
@@ -432,7 +447,6 @@ class ProxyLayer:
         self.culled = mesh.kind == "scalp"
         self.programs, self.vaos = {}, {}
         self._last = None  # (camera position, vertex positions) of the last upload
-        self._smooth = None  # hair: neighbour-averaging operator over corners (from mesh.rest)
         self.look: tuple = ()  # (linear colour, sheen, density, coil) of this frame
         self._camera_uniforms: tuple = ()  # (view-projection, lights) the programs hold
         self._vertex_triangles = np.asarray(mesh.corner_vertex)[self._triangles]  # ... over vertices
@@ -447,14 +461,16 @@ class ProxyLayer:
             _set_uniform(prog, "u_texture", 1)
             _set_uniform(prog, "u_along_v", self._along_v)
             _set_uniform(prog, "u_strand_width", float(mesh.strand_width))
+            _set_uniform(prog, "u_end_height", -1e3 if mesh.end_height is None else float(mesh.end_height))
+            _set_uniform(prog, "u_end_fade", END_FADE)
             self.programs[stage] = prog
             self.vaos[stage] = track(ctx.vertex_array(
                 prog, [(self._vbo, "3f 3f 3f 1f 1f", "in_pos", "in_normal", "in_tangent", "in_depth", "in_edge"),
-                       (self._uv, "2f 1f 3f", "in_uv", "in_cover", "in_rest")],
+                       (self._uv, "2f 1f 3f 3f", "in_uv", "in_cover", "in_rest", "in_rest_tangent")],
                 index_buffer=self._ibo[stage], index_element_size=4, skip_errors=True))
         self.vaos["SUBSET"] = track(ctx.vertex_array(
             self.programs["OPAQUE"], [(self._vbo, "3f 3f 3f 1f 1f", "in_pos", "in_normal", "in_tangent", "in_depth", "in_edge"),
-                                      (self._uv, "2f 1f 3f", "in_uv", "in_cover", "in_rest")],
+                                      (self._uv, "2f 1f 3f 3f", "in_uv", "in_cover", "in_rest", "in_rest_tangent")],
             index_buffer=self._ibo["SUBSET"], index_element_size=4, skip_errors=True))
 
     def update(self, draw: ProxyDraw, camera_position: np.ndarray) -> None:
@@ -501,18 +517,8 @@ class ProxyLayer:
             if self.mesh.kind == "hair":
                 normals = volume_normals(p, normals)
             buf[:, 3:6] = self._welded(normals)
-            # Tangents stay per corner: strands really do flow apart on the two sides of a parting.
-            tangents = strand_tangents(positions, self.mesh, self._normal_op, self._directions)
-        if self.mesh.kind == "hair" and self.mesh.rest is not None:
-            # Neighbouring cards' strands run the same way: averaged over the cards within a
-            # centimetre or two, the highlight runs on across the cards instead of lighting
-            # some and not their neighbours (a patchwork on the crown).
-            if self._smooth is None:
-                rest = np.asarray(self.mesh.rest, np.float32)[self.mesh.corner_vertex]
-                self._smooth = neighbour_mean_operator(rest, STRAND_SMOOTHING)
-            tangents = np.asarray(self._smooth @ tangents, np.float32)
-        if self.mesh.kind == "hair":
-            tangents = along_volume(tangents, volume_normals(p, normals, card_weight=0.0))
+            tangents = (self._strand_tangents(positions, normals) if self.mesh.kind == "hair"
+                        else strand_tangents(positions, self.mesh, self._normal_op, self._directions))
         buf[:, 6:9] = tangents
         buf[:, 9] = self._depth
         self._vbo.write(buf)
@@ -521,6 +527,24 @@ class ProxyLayer:
         self._ibo["BLEND"].write(self._triangles[order].tobytes())
         self._ibo["OPAQUE"].write(self._triangles[order[::-1]].tobytes())
         self._order = order
+
+    def _strand_tangents(self, positions: np.ndarray, normals: np.ndarray | None = None) -> np.ndarray:
+        """(corners, 3) hair strand directions for vertex ``positions`` (``normals``: the corners'
+        volume normals, found when not given)."""
+        p = positions[self.mesh.corner_vertex]
+        if normals is None:
+            normals = volume_normals(p, vertex_normals(p, self._triangles, self._normal_op))
+        # Tangents stay per corner: strands really do flow apart on the two sides of a parting.
+        tangents = strand_tangents(positions, self.mesh, self._normal_op, self._directions)
+        if self.mesh.rest is not None:
+            # Neighbouring cards' strands run the same way: averaged over the cards within a
+            # centimetre or two, the highlight runs on across the cards instead of lighting
+            # some and not their neighbours (a patchwork on the crown).
+            if self._smooth is None:
+                rest = np.asarray(self.mesh.rest, np.float32)[self.mesh.corner_vertex]
+                self._smooth = neighbour_mean_operator(rest, STRAND_SMOOTHING)
+            tangents = np.asarray(self._smooth @ tangents, np.float32)
+        return along_volume(tangents, volume_normals(p, normals, card_weight=0.0))
 
     @property
     def positions(self) -> np.ndarray | None:

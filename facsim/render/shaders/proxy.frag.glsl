@@ -13,6 +13,7 @@ in float v_edge;
 in vec2 v_uv;
 in float v_cover;
 in vec3 v_rest;
+in vec3 v_rest_tangent;
 
 uniform sampler2D u_texture;  // R: strand brightness (0.5 = mean), GB: strand direction in UV, A: coverage
 uniform vec3 u_color;         // linear RGB
@@ -23,6 +24,8 @@ uniform float u_coil;         // hair: 0 straight ... 1 coily
 uniform vec3 u_pigment;       // greying hair: its pigmented strands' colour (linear RGB) ...
 uniform vec3 u_white;         // ... its white strands' ...
 uniform float u_grey;         // ... and the fraction of white strands (u_color is their mean)
+uniform float u_end_height;   // hair, wisps: where long hair ends (y on the neutral face, dm) ...
+uniform float u_end_fade;     // ... its strands ending one by one over this height above it
 
 out vec4 f_color;
 
@@ -49,6 +52,64 @@ float value_noise3(vec3 p) {
                   mix(hash2(ivec2(c.x, c.y + 1 + z1)), hash2(ivec2(c.x + 1, c.y + 1 + z1)), u.x), u.y);
     float n = mix(a, b, u.z);
     return mix(0.5, n, clamp(2.0 - 1.4 * length(fwidth(p)), 0.0, 1.0));
+}
+
+// The same over a card's strand coordinates (``uv``, with ``base`` cells per texture unit across
+// and along the strands), for textures whose strands run along v throughout: long cards' strands
+// then run unbroken from root to tip (cells grow only with the square root along them).
+float pixel_strands_uv(vec2 uv, vec2 base, vec2 offset) {
+    float cells = max(fwidth(uv.x * base.x), 1e-5);   // base cells per pixel across the strands
+    float level = log2(0.45 / cells);
+    float k = clamp(floor(level), 0.0, 3.0);
+    float f = clamp(level - k, 0.0, 1.0) * step(k, 2.5);
+    float s0 = exp2(k);
+    float n0 = value_noise(uv * base * vec2(s0, sqrt(s0)) + offset, 0);
+    float n1 = value_noise(uv * base * vec2(2.0 * s0, sqrt(2.0 * s0)) + offset + 17.0, 0);
+    float n = 0.5 + (mix(n0, n1, f) - 0.5) / sqrt(f * f + (1.0 - f) * (1.0 - f));
+    return mix(0.5, n, clamp(2.2 - 1.6 * cells, 0.0, 1.0));
+}
+
+// Strands and clumps about two pixels across at any size: value noise on the neutral head
+// (``rest``, dm; so it runs on across the cards' edges and moves with the hair), smeared along
+// the strands (``along``; three samples over two cells and a bit, a short line-integral
+// convolution: a global coordinate along a curving direction would shear the pattern), with
+// ``cells_per_dm`` cells to the decimetre, taken at the octave whose cells come nearest two
+// pixels across (at most 4x finer), blended with the next one so nothing pops as the hair
+// nears or leaves the camera. Noise of fixed frequency fades to its mean at stimulus sizes (a
+// flat, clay-like mass); this keeps strand-level variation in every image. [0, 1], mean 0.5.
+float lattice_noise3(vec3 p) {   // value_noise3 without its fade (the caller picks the octave)
+    vec3 i = floor(p);
+    vec3 f = p - i;
+    vec3 u = f * f * (3.0 - 2.0 * f);
+    ivec3 c = ivec3(i);
+    int z0 = 7919 * c.z, z1 = 7919 * (c.z + 1);
+    float a = mix(mix(hash2(ivec2(c.x, c.y + z0)), hash2(ivec2(c.x + 1, c.y + z0)), u.x),
+                  mix(hash2(ivec2(c.x, c.y + 1 + z0)), hash2(ivec2(c.x + 1, c.y + 1 + z0)), u.x), u.y);
+    float b = mix(mix(hash2(ivec2(c.x, c.y + z1)), hash2(ivec2(c.x + 1, c.y + z1)), u.x),
+                  mix(hash2(ivec2(c.x, c.y + 1 + z1)), hash2(ivec2(c.x + 1, c.y + 1 + z1)), u.x), u.y);
+    return mix(a, b, u.z);
+}
+
+float smeared_noise(vec3 p, vec3 step) {
+    return (lattice_noise3(p - step) + lattice_noise3(p) + lattice_noise3(p + step)) * (1.0 / 3.0);
+}
+
+float pixel_strands(vec3 rest, vec3 along, float cells_per_dm) {
+    vec3 p = rest * cells_per_dm;
+    float cells = max(length(fwidth(p)), 1e-5);  // base cells per pixel
+    float level = log2(0.6 / cells);
+    float k = clamp(floor(level), 0.0, 2.0);
+    // Two octaves are blended only near the switch from one to the next (each costs
+    // llvmpipe twenty-four hashes); elsewhere one is taken.
+    float f = smoothstep(0.35, 0.65, clamp(level - k, 0.0, 1.0)) * step(k, 1.5);
+    float s0 = exp2(k);
+    float n0 = f < 0.999 ? smeared_noise(p * s0 + 3.0, 1.1 * along) : 0.5;
+    float n1 = f > 0.001 ? smeared_noise(p * (2.0 * s0) + 11.0, 1.1 * along) : 0.5;
+    // (a mean of three samples along a few cells varies ~1/1.5 as much as one; most of that
+    // is given back, not all, so the darkest strands do not stand out as dots)
+    float n = 0.5 + 1.3 * (mix(n0, n1, f) - 0.5) / sqrt(f * f + (1.0 - f) * (1.0 - f));
+    // Where even the coarsest octave is finer than a pixel, its mean.
+    return mix(0.5, clamp(n, 0.0, 1.0), clamp(2.2 - 1.6 * cells, 0.0, 1.0));
 }
 
 // Kajiya-Kay: light scattered by a thin cylinder along t.
@@ -123,7 +184,8 @@ void main() {
 #endif
     vec4 tex = texture(u_texture, v_uv);
     // Faint where it leaves the mass, then thinning to nothing at the tip.
-    float alpha = tex.a * v_cover * u_density * smoothstep(0.0, 0.15, v_depth) * (1.0 - smoothstep(0.55, 1.0, v_depth));
+    float alpha = tex.a * v_cover * u_density * smoothstep(0.0, 0.15, v_depth) * (1.0 - smoothstep(0.55, 1.0, v_depth))
+                * smoothstep(0.3, 1.0, (v_rest.y - u_end_height) / u_end_fade);   // none where long hair ends
     if (alpha < 0.01) discard;
     vec3 n = normalize(v_normal);
     vec3 t = normalize(v_tangent);
@@ -201,16 +263,45 @@ void main() {
     float mid = mix(0.5, value_noise(mp, 0), along_v * clamp(2.0 - 1.4 * fwidth(mp.x), 0.0, 1.0));
     vec2 cp = v_uv * vec2(45.0, 1.2) + 7.0;
     float clump = mix(0.5, value_noise(cp, 0), along_v * clamp(2.0 - 1.5 * fwidth(cp.x), 0.0, 1.0));
+    // Shading's strands and clumps: along the strands their phase also follows the card's
+    // place on the head (v_rest). Cards of one row share their texture's v range, and noise
+    // in v alone lit and darkened every card of a row alike: long01's crown drew its rows of
+    // cards as horizontal bands.
+    vec2 phase = vec2(0.0, dot(v_rest, vec3(3.1, 2.3, 2.7)));
+    // Strands and clumps a couple of pixels across whatever the image size (pixel_strands).
+    // Cards whose texture runs along v (long01, bob) take them in the cards' own strand
+    // coordinates, unbroken from root to tip; the others (short02's swept sides, a ponytail's
+    // crown) on the neutral head along the strands' direction, running on across the cards.
+    // (Long cards' own texture strands carry most of their detail already: a strong breakup over
+    // them draws dark blotches across the lengths.)
+#ifdef COILY
+    // Coily hair gathers into clumps of coils a few millimetres across, placed on the
+    // neutral head: their crevices fall dark and the outline breaks up around them.
+    float coil_clump = value_noise3(v_rest * 18.0 + 1.0);
+    float px = 0.5;
+#else
+    float px = u_along_v > 0.5 ? pixel_strands_uv(v_uv, vec2(40.0, 1.5), vec2(5.0, 5.0) + 2.0 * phase)
+                               : pixel_strands(v_rest, normalize(v_rest_tangent + vec3(0.0, 1e-4, 0.0)), 60.0);
+    // Long hair ends strand by strand above u_end_height (MakeHuman's long cards hang on
+    // through the shoulders): each strand at its own length, thinning to its tip, so the hair
+    // ends in tapered strands, not in blocks cut by the shoulders or the image's edge.
+    float ends = (v_rest.y - u_end_height) / u_end_fade;
+    if (ends < 1.0) {
+        float length_at = 0.05 + 0.9 * px;
+        alpha *= smoothstep(length_at - 0.15, length_at + 0.15, ends) * smoothstep(0.15, 0.5, ends);
+    }
+    if (u_along_v > 0.5) px = mix(0.5, px, 0.4);
+#endif
     // The hair's outline: where the volume turns away from the eye, its outer strands stand
     // apart, so the outline breaks into strands and clumps with the background between them
     // instead of ending in the cards' cut edge. Inside the mass the cards' own alpha rules.
     float outline = 1.0 - smoothstep(0.02, 0.28, dot(n, v));
-    float strand_mask = smoothstep(0.3, 0.7, 0.6 * mid + 0.4 * clump);
+    float strand_mask = smoothstep(0.3, 0.7, 0.6 * px + 0.4 * clump);
     // A card's own outline frays the same way: strands end at different lengths across the
     // last triangle before the cut edge, so layers overlap as strand tips, not as steps.
     // Coily hair's textures draw their own loose curls at every edge, and its cap is the
     // dense base the tufts grow from: neither frays.
-    float rag = 0.55 * mid + 0.45 * clump;
+    float rag = 0.45 * px + 0.3 * mid + 0.25 * clump;
     float fray = outline * (1.0 - strand_mask) * 0.9;
     fray = 1.0 - (1.0 - fray) * (1.0 - smoothstep(0.45, 0.75, v_edge + 0.7 * (0.5 - rag)));
     alpha *= 1.0 - fray * (1.0 - u_coil);
@@ -220,6 +311,10 @@ void main() {
         // the volume's edge is a halo of curls with the background between them, not a rim.
         float halo = value_noise3(v_rest * 70.0 + 2.0);
         alpha *= 1.0 - u_coil * outline * (1.0 - smoothstep(0.35, 0.65, halo)) * 0.95;
+        // and a wider band of the outline goes in and out with the clumps, so the mass's
+        // silhouette is lumpy, not a smooth dome.
+        float lumps = 1.0 - smoothstep(0.05, 0.45, dot(n, v));
+        alpha *= 1.0 - u_coil * lumps * (1.0 - smoothstep(0.3, 0.6, coil_clump));
     }
 #endif
     // Over a thinning hairline (v_cover < 1, see facsim/head/scalp.py) the cards break up into
@@ -248,11 +343,6 @@ void main() {
     vec3 albedo = u_color * (0.6 + 0.8 * tex.r);
 
 #ifdef KIND_HAIR
-    // Shading's strands and clumps: along the strands their phase also follows the card's
-    // place on the head (v_rest). Cards of one row share their texture's v range, and noise
-    // in v alone lit and darkened every card of a row alike: long01's crown drew its rows of
-    // cards as horizontal bands. (The cards' fraying above keeps the noise in v alone.)
-    vec2 phase = vec2(0.0, dot(v_rest, vec3(3.1, 2.3, 2.7)));
     vec3 t = normalize(v_tangent);
 #ifdef PASS_OPAQUE
     vec2 sp = v_uv * vec2(420.0, 5.0) + 2.0 * phase;
@@ -269,23 +359,31 @@ void main() {
     mid = mix(0.5, value_noise(mp, 0), along_v * clamp(2.0 - 1.4 * fwidth(mp.x), 0.0, 1.0));
     cp += 0.5 * phase;
     clump = mix(0.5, value_noise(cp, 0), along_v * clamp(2.0 - 1.5 * fwidth(cp.x), 0.0, 1.0));
-    float strand = (0.62 + 0.76 * tex.r) * (0.7 + 0.6 * fine) * (0.76 + 0.48 * mid) * (0.92 + 0.16 * clump);
-#ifdef PASS_OPAQUE
+    // (px: strands and clumps a couple of pixels across, so the breakup shows at any size.)
+    float strand = (0.62 + 0.76 * tex.r) * (0.7 + 0.6 * fine) * (0.6 + 0.8 * px) * (0.8 + 0.4 * mid)
+                 * (0.9 + 0.2 * clump);
 #ifdef COILY
     {
-        // Coily hair: at any distance its curls blend into a fine, even, matte texture. The
+        // Coily hair (both passes: its translucent fringe at the hairline drew a flat light
+        // band otherwise): at any distance its curls blend into a fine, even, matte texture. The
         // texture's tufts keep a little of their contrast (it is laid out mirrored from card
         // to card, and at full contrast drew that tiling on the cap: ngozi's grey afro read as
         // a cap); curls a millimetre and a few millimetres across, placed on the neutral face
         // (v_rest) rather than in the cards' UVs, add the rest.
         float kink = value_noise3(v_rest * 110.0);
         float curls = value_noise3(v_rest * 35.0 + 5.0);
-        strand = mix(strand, (0.82 + 0.36 * tex.r) * (0.6 + 0.8 * kink) * (0.62 + 0.76 * curls), u_coil);
+        // The clumps' crevices are deep and dark; their crowns catch the light. The crevices
+        // run where the clump noise crosses its mean: a connected network around rounded
+        // clumps, not dark spots on a light field.
+        float crown = smoothstep(0.0, 0.22, abs(coil_clump - 0.5));
+        strand = mix(strand, (0.88 + 0.24 * tex.r) * (0.6 + 0.8 * kink) * (0.62 + 0.76 * curls)
+                             * mix(0.55, 1.1, crown), u_coil);
+        // Greying coily hair mixes white, grey and dark strands curl by curl and clump by
+        // clump (placed on the head, not in the cards' mirrored UVs).
+        float white = clamp(u_grey + 0.5 * (value_noise3(v_rest * 22.0 + 4.0) - 0.5) + 0.45 * (kink - 0.5)
+                            + 0.2 * (crown - 0.5), 0.0, 1.0);
+        albedo = (u_grey > 0.0 ? mix(u_pigment, u_white, white) : u_color) * strand;
     }
-#endif
-#endif
-#ifdef COILY
-    albedo = hair_colour(v_uv * 40.0) * strand;
 #else
     albedo = hair_colour(v_uv * vec2(45.0, 1.2) + 7.0 + 0.5 * phase) * strand;
 #endif
@@ -297,8 +395,12 @@ void main() {
     float light_hair = sqrt(clamp(dot(u_color, vec3(0.2126, 0.7152, 0.0722)), 0.0, 1.0)) * (1.0 - 0.6 * u_coil);
     float layer = smoothstep(0.0, 0.95, v_depth);
     float self_shadow = mix(mix(0.3, 0.7, light_hair), 1.0, layer * layer * (1.5 - 0.5 * layer))
-                      * mix(mix(0.8, 0.92, light_hair), 1.0, clump) * mix(0.8, 1.0, mid);
-    float jitter = 0.22 * (tex.r - 0.5) + 0.12 * (fine - 0.5) + 0.18 * (mid - 0.5) + 0.1 * (clump - 0.5);
+                      * mix(mix(0.8, 0.92, light_hair), 1.0, clump) * mix(0.8, 1.0, mid)
+    // and the narrow gaps between clumps are in their neighbours' shade: light and dark
+    // alternate across the mass at the scale of clumps, not one smooth shell.
+                      * mix(mix(0.74, 0.85, light_hair), 1.0, smoothstep(0.02, 0.32, px));
+    float jitter = 0.22 * (tex.r - 0.5) + 0.12 * (fine - 0.5) + 0.18 * (mid - 0.5) + 0.1 * (clump - 0.5)
+                 + 0.25 * (px - 0.5);
     // Key light: strand diffuse blended with a squared half-Lambert, which keeps the volume
     // readable without the flat look of a plain wrap.
     float kl = clamp(dot(n, u_key_dir) * 0.5 + 0.5, 0.0, 1.0);
@@ -324,8 +426,8 @@ void main() {
     float s1 = max(1.0 - th1 * th1, 1e-6);   // sin^2
     float s2 = max(1.0 - th2 * th2, 1e-6);
     float strands = smoothstep(0.25, 0.7, fine) * smoothstep(0.3, 0.65, tex.r) * smoothstep(0.2, 0.7, mid)
-                  * mix(0.5, 1.0, clump);
-    float sparkle = smoothstep(0.45, 0.75, fine) * smoothstep(0.4, 0.7, mid);
+                  * mix(0.5, 1.0, clump) * smoothstep(0.35, 0.7, px) * 1.6;
+    float sparkle = smoothstep(0.45, 0.75, fine) * smoothstep(0.4, 0.7, mid) * smoothstep(0.4, 0.75, px);
     vec3 tint = mix(vec3(1.0), u_color / max(max(u_color.r, u_color.g), max(u_color.b, 1e-4)), 0.5);
     // Light hair's own diffuse is bright already: a full-strength white lobe on it reads as
     // white streaks, so it takes less.
@@ -336,7 +438,7 @@ void main() {
     vec2 gp = v_uv * vec2(400.0, 9.0) + 13.0 + 3.0 * phase;
     float glint = smoothstep(0.86, 0.96, value_noise(gp, 0)) * along_v
                 * clamp(1.6 - 1.2 * fwidth(gp.x), 0.0, 1.0);
-    vec3 spec = u_key_col * gate * (0.16 * strands * tint * exp2(40.0 * log2(s1))
+    vec3 spec = u_key_col * gate * (0.24 * strands * tint * exp2(28.0 * log2(s1))
                                     + 0.55 * sparkle * u_color * exp2(10.0 * log2(s2))
                                     + 0.25 * glint * tint * exp2(40.0 * log2(s1)));
 #else

@@ -7,6 +7,7 @@ in float in_edge;     // hair: 1 on a card's outline, 0 inside
 in vec2 in_uv;
 in float in_cover;
 in vec3 in_rest;      // hair: the vertex on the neutral face (dm), where coily hair's curls lie
+in vec3 in_rest_tangent;  // hair: the strand direction there
 // in_cover: hair: the scalp's hair density under the vertex (1 full ... 0 bare)
 // Wisps (loose strands): in_pos is a point on the strand, in_tangent the strand's direction,
 // in_depth 0 at the root ... 1 at the tip, in_edge the side of the ribbon (-1, 1).
@@ -26,6 +27,7 @@ out float v_edge;
 out vec2 v_uv;
 out float v_cover;
 out vec3 v_rest;
+out vec3 v_rest_tangent;
 
 void main() {
     v_pos = in_pos;
@@ -36,6 +38,7 @@ void main() {
     v_uv = in_uv;
     v_cover = in_cover;
     v_rest = in_rest;
+    v_rest_tangent = in_rest_tangent;
 #ifdef KIND_WISPS
     // A ribbon across the strand, turned toward the camera, tapering to a tenth at the tip.
     // Where it would be narrower than a pixel it is drawn a pixel wide and fainter (v_cover:
