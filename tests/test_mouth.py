@@ -68,6 +68,25 @@ def test_the_tongue_rests_in_the_floor_of_the_mouth(face_of):
     assert along[:, 1].min() == pytest.approx(0) and along[:, 1].max() == pytest.approx(1)
 
 
+@pytest.mark.parametrize("engine", ENGINES)
+def test_the_tongues_back_lies_low_when_the_jaw_drops(face_of, engine):
+    # hm08's dorsum stays level back to the throat and neither engine drops the root with the
+    # jaw, so an open mouth showed the tongue as a ramp up to the upper teeth, a pink wall in
+    # the whole opening. Its back falls toward the root: in 26 and 27 the tongue behind its
+    # front third lies well (4 mm) under the upper teeth's edge (it rose 2 mm over it).
+    face = face_of("ava", engine)
+    parts = _groups(face)
+    along = tongue_coordinates(face.head, face.data, face.base_positions)[parts["tongue"], 1]
+    front, back = along < 0.33, (along > 0.45) & (along < 0.9)
+    rest = face.neutral[parts["tongue"]]
+    assert rest[back, 1].max() < rest[front, 1].max() - 0.005
+    for code in ("26", "27"):
+        moved = np.asarray(face.deform(code).positions)
+        tongue = moved[parts["tongue"]]
+        upper_edge = moved[parts["upper"], 1].min()
+        assert tongue[back, 1].max() < upper_edge - 0.04
+
+
 def test_older_faces_rest_their_upper_teeth_higher(face_of):
     face = face_of("ava")
     data = face.data

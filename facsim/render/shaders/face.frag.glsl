@@ -734,13 +734,14 @@ void main() {
     // v_uv = (across -1..1, along 0 at the tip .. 1 at the root), facsim.head.mouth.tongue_coordinates.
     float across = v_uv.x, along = clamp(v_uv.y, 0.0, 1.0);
     // Median groove, papillae as fine mottling, a paler coat toward the middle.
-    float groove = 1.0 - 0.35 * exp(-across * across / 0.012) * smoothstep(0.05, 0.3, along);
+    float groove = 1.0 - 0.35 * exp(-across * across / 0.012) * smoothstep(0.05, 0.3, along) * (1.0 - smoothstep(0.35, 0.6, along));
     float papillae = 0.85 + 0.3 * value_noise(v_uv * vec2(40.0, 60.0), 0);
-    vec3 albedo = u_albedo * vec3(0.85, 0.72, 0.76) * papillae * groove;
-    // The tongue lies in the shadow of the lips and upper teeth: dim at the tip, dark toward
-    // the throat and at its sides against the teeth.
+    vec3 albedo = u_albedo * vec3(0.88, 0.72, 0.74) * papillae * groove;
+    // The tongue lies in the shadow of the lips and upper teeth: dim at the tip, dark at its
+    // sides against the teeth and falling into the throat's dark toward the root (where it
+    // rises to the back wall: lit there, its sides and groove drew pale and dark stripes).
     // How much light the parted lips let in arrives in occ (facsim.head.mouth.mouth_light).
-    float mouth_shade = mix(0.36, 0.04, smoothstep(0.0, 0.3, along)) * mix(1.0, 0.5, smoothstep(0.4, 1.0, abs(across)))
+    float mouth_shade = mix(0.38, 0.012, smoothstep(0.0, 0.45, along)) * mix(1.0, 0.5, smoothstep(0.4, 1.0, abs(across)))
                       * mix(0.1, 1.0, occ);
     // Moist: a soft sheen broken by the papillae, and a tighter glint on the film of saliva.
     vec3 spec = specular_light(n, v, 40.0) * 0.12 * papillae + specular_light(n, v, 90.0) * 0.3 * smoothstep(0.8, 1.1, papillae);
