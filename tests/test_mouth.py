@@ -195,6 +195,28 @@ def test_open_mouths_show_teeth_brighter_than_the_cavity(face_of, expression):
     assert np.median(_luminance(image[cavity])) < 0.6 * np.median(_luminance(image[teeth]))
 
 
+def test_the_inside_of_the_arch_is_not_a_grey_wall(face_of):
+    # Turned three-quarters, an open mouth shows the far side of the arch from inside. hm08's
+    # bands carry a lingual slope 8-13 mm deep; drawn as enamel it showed as a pale grey wall
+    # (~500 grey enamel pixels at 512 px); only the crowns' inner faces are enamel, the rest
+    # is gum and the floor of the mouth in the arch's shade.
+    from facsim import Face
+
+    face = face_of("ava")
+    deformation = face.deform("1+2+5+26")
+    renders = []
+    for colour in (None, "#ffffff", "#000000"):
+        character = face.character if colour is None else face.character.with_(colors={"teeth": colour})
+        with Face(character) as marked:
+            renders.append(marked.render(deformation=deformation, size=512, view="three-quarter-left",
+                                         antialias=1)[..., :3].astype(float))
+    image, white, black = renders
+    enamel = image[np.abs(white - black).max(axis=-1) > 3]
+    grey = (_luminance(enamel) > 40) & (enamel.max(axis=1) - enamel.min(axis=1) < 40)
+    assert len(enamel) > 200            # the front crowns still show
+    assert grey.sum() < 300
+
+
 def test_at_rest_the_lips_hide_the_teeth(face_of):
     face = face_of("ava")
     _, teeth, _ = _mouth_pixels(face, "registers", "0")
