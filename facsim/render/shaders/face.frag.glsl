@@ -724,7 +724,7 @@ void main() {
     // that edge in this frame (facsim.head.mouth.mouth_light; 1 when nobody passes it). The
     // lower row stands back under the upper teeth and lip and faces up into the mouth:
     // darker, and mostly hidden.
-    float depth_shade = mix(1.0, 0.16, smoothstep(0.12, 0.36, arc));
+    float depth_shade = mix(1.0, 0.09, smoothstep(0.12, 0.36, arc));
     float lip_shadow = mix(0.5, 1.0, smoothstep(-0.002, 0.022, v_occlusion));
     float row_light = mix(1.0, 0.62, lower);
     // The inside of the arch faces the tongue and throat: it only catches light scattered in.
