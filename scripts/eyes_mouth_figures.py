@@ -15,7 +15,8 @@ in pixels, when the lashes are recoloured, in a band 12 px deep under each eye's
 
 Open mouth (``--cavity``), surprise (1+2+5+26) at 512², front: within the mouth's opening (the
 pixels of teeth, tongue and the mouth's lining), the share that is tongue and the share in deep
-shadow (luminance under 30), the share that is tongue in the light (over 30), the mean luminance
+shadow (luminance under 30), the share that is tongue in the light (over 30) and its median and
+99th-percentile luminance (its wet sheen), the mean luminance
 down the midline (5 px wide) at 5, 15 … 95 % of the
 opening's height from the upper lip, and the mean luminance of the opening's outer sixth on each
 side (the corners of the mouth: the buccal corridor's shade).
@@ -112,6 +113,8 @@ def cavity_figures(character, expression="1+2+5+26", size=512, engine="registers
     return {"opening_px": int(opening.sum()), "tongue_share": round(float((tongue & opening).sum() / opening.sum()), 3),
             "lit_tongue_share": round(float((tongue & opening & (luminance > 30)).sum() / opening.sum()), 3),
             "dark_share": round(float((luminance[opening] < 30).mean()), 3),
+            "tongue_luminance_p50_p99": [round(float(np.percentile(luminance[tongue & opening & (luminance > 30)], q)), 1)
+                                         for q in (50, 99)],
             "midline_luminance": profile, "corner_luminance": corners}
 
 

@@ -217,6 +217,26 @@ def test_the_inside_of_the_arch_is_not_a_grey_wall(face_of):
     assert grey.sum() < 300
 
 
+def test_an_open_mouths_tongue_is_wet(face_of):
+    # The tongue's film mirrors the key through the opening: a sheen on its front (its
+    # brightest pixels ~160-180 at 512 px), where the shade of the mouth dimmed it to a
+    # matte 120-140 like the rest of the tongue.
+    from facsim import Face
+
+    face = face_of("ava")
+    deformation = face.deform("1+2+5+26")
+    renders = []
+    for colour in (None, "#ffffff", "#000000"):
+        character = face.character if colour is None else face.character.with_(colors={"tongue": colour})
+        with Face(character) as marked:
+            renders.append(marked.render(deformation=deformation, size=512, antialias=1)[..., :3].astype(float))
+    image, white, black = renders
+    luminance = _luminance(image[np.abs(white - black).max(axis=-1) > 3])
+    lit = luminance[luminance > 30]
+    assert len(lit) > 500
+    assert np.percentile(lit, 99) > 150 > 2 * np.median(lit)
+
+
 def test_at_rest_the_lips_hide_the_teeth(face_of):
     face = face_of("ava")
     _, teeth, _ = _mouth_pixels(face, "registers", "0")

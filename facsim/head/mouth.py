@@ -78,7 +78,8 @@ def rest_mouth(base_positions: np.ndarray, data, *, age: float = 25.0) -> np.nda
     mouth's lining kept :data:`CAVITY_CLEARANCE` behind the skin.
 
     The tongue is squashed toward its underside (about its lowest point) until its top
-    sits :data:`TONGUE_BELOW_TEETH` under the lower incisors' edge; its tip and sides
+    sits :data:`TONGUE_BELOW_TEETH` under the lower incisors' edge, and further behind the
+    tip so its dorsum falls toward the root (:data:`TONGUE_FALL`); its tip and sides
     stay where they are in plan, so it still fills the lower arch. Applied to the
     character's neutral mesh before any expression, so both engines carry the parts
     with the skull and the jaw as they carry hm08's own.

@@ -754,7 +754,11 @@ void main() {
                       * mix(0.1, 1.0, occ);
     // Moist: a soft sheen broken by the papillae, and a tighter glint on the film of saliva.
     vec3 spec = specular_light(n, v, 40.0) * 0.12 * papillae + specular_light(n, v, 90.0) * 0.3 * smoothstep(0.8, 1.1, papillae);
-    radiance = (diffuse_light(n, vec3(0.3, 0.15, 0.1), 1.0) * 0.8 * albedo + spec) * mouth_shade;
+    // The film mirrors the key through the opening wherever the tongue's front faces it: the
+    // sheen is dimmed by how far back it lies and by the light the lips let in, not by the
+    // shade that scattered light falls into (there it was lost, a matte tongue).
+    float sheen_light = mix(0.7, 0.04, smoothstep(0.0, 0.45, along)) * mix(0.1, 1.0, occ);
+    radiance = diffuse_light(n, vec3(0.3, 0.15, 0.1), 1.0) * 0.8 * albedo * mouth_shade + spec * sheen_light;
 #endif
 
 #ifdef REGION_MOUTH_INTERIOR
