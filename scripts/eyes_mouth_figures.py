@@ -13,9 +13,18 @@ view at 512² the pupil's centre less the visible cornea's (px along x; positive
 the camera side: the refracted iris's parallax); the lower lashes' coverage (summed change,
 in pixels, when the lashes are recoloured, in a band 12 px deep under each eye's sclera).
 
+Open mouth (``--cavity``), surprise (1+2+5+26) at 512², front: within the mouth's opening (the
+pixels of teeth, tongue and the mouth's lining), the share that is tongue and the share in deep
+shadow (luminance under 30), the share that is tongue in the light (over 30) and its median and
+99th-percentile luminance (its wet sheen), the mean luminance
+down the midline (5 px wide) at 5, 15 … 95 % of the
+opening's height from the upper lip, and the mean luminance of the opening's outer sixth on each
+side (the corners of the mouth: the buccal corridor's shade).
+
 Usage::
 
     python3 scripts/eyes_mouth_figures.py [CHARACTER ...]      (default: amara liam mei george)
+    python3 scripts/eyes_mouth_figures.py --cavity [--engine muscle] [--expression 27] [CHARACTER ...]
 """
 from __future__ import annotations
 
@@ -31,15 +40,15 @@ LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
 WHITE = (1.0, 1.0, 1.0)
 
 
-def _renders(character, expression, recolours, *, size, view="front", antialias=4):
+def _renders(character, expression, recolours, *, size, view="front", antialias=4, engine="registers"):
     """The frame and the same frame with each of ``recolours`` applied, as float RGB."""
     images = []
-    with Face(character) as face:
+    with Face(character, engine=engine) as face:
         deformation = face.deform(expression)
         images.append(face.render(deformation=deformation, size=size, view=view, antialias=antialias,
                                   background=WHITE))
     for colours in recolours:
-        with Face(character.with_(colors={**character.colors, **colours})) as face:
+        with Face(character.with_(colors={**character.colors, **colours}), engine=engine) as face:
             images.append(face.render(deformation=deformation, size=size, view=view, antialias=antialias,
                                       background=WHITE))
     return [image[..., :3].astype(float) for image in images]
@@ -65,6 +74,48 @@ def teeth_figures(character, expression="6+12+25", size=512) -> dict:
     return {"luminance": round(float((pixels @ LUMINANCE).mean()), 1),
             "chroma": round(float((pixels.max(1) - pixels.min(1)).mean()), 1),
             "edge_bluer_by": round(float((edge[:, 2] - edge[:, 0]).mean() - (crown[:, 2] - crown[:, 0]).mean()), 1)}
+
+
+def cavity_figures(character, expression="1+2+5+26", size=512, engine="registers") -> dict:
+    from PIL import Image, ImageDraw
+
+    from facsim.render.camera import project
+
+    image, *marks = _renders(character, expression, [{part: colour for part in ("teeth", "tongue", "mouth_interior")}
+                                                     for colour in ("#ffffff", "#000000")],
+                             size=size, antialias=1, engine=engine)
+    marks += _renders(character, expression, [{"tongue": "#ffffff"}, {"tongue": "#000000"}],
+                      size=size, antialias=1, engine=engine)[1:]
+    inside = np.abs(marks[0] - marks[1]).max(-1) > 3
+    tongue = np.abs(marks[2] - marks[3]).max(-1) > 3
+    # The opening: inside the lips' inner rim as projected (parts in deep shade barely change
+    # when recoloured, so the recolouring alone would miss the darkest cavity).
+    with Face(character, engine=engine) as face:
+        positions = np.asarray(face.deform(expression).positions)
+        rim = face._mouth_rim
+        loop = np.concatenate([rim.upper, rim.lower[::-1]])
+        points, _ = project(face.camera(size=(size, size)), positions[loop], (size, size))
+    outline = Image.new("L", (size, size), 0)
+    ImageDraw.Draw(outline).polygon([tuple(p) for p in points], fill=1)
+    opening = (np.asarray(outline) > 0) & inside | tongue
+    opening |= (np.asarray(outline) > 0) & ((image @ LUMINANCE) < 30)
+    luminance = image @ LUMINANCE
+    ys, xs = np.nonzero(opening)
+    middle = int(round(np.median(xs)))
+    column = opening[:, middle - 2: middle + 3].any(axis=1)
+    top, bottom = np.flatnonzero(column)[[0, -1]]
+    profile = [round(float(luminance[int(top + f * (bottom - top)), middle - 2: middle + 3].mean()), 1)
+               for f in np.arange(0.05, 1.0, 0.1)]
+    width = xs.max() - xs.min()
+    columns = np.arange(size)[None, :]
+    corners = [round(float(luminance[opening & side].mean()), 1)
+               for side in (columns < xs.min() + width / 6, columns > xs.max() - width / 6)]
+    return {"opening_px": int(opening.sum()), "tongue_share": round(float((tongue & opening).sum() / opening.sum()), 3),
+            "lit_tongue_share": round(float((tongue & opening & (luminance > 30)).sum() / opening.sum()), 3),
+            "dark_share": round(float((luminance[opening] < 30).mean()), 3),
+            "tongue_luminance_p50_p99": [round(float(np.percentile(luminance[tongue & opening & (luminance > 30)], q)), 1)
+                                         for q in (50, 99)],
+            "midline_luminance": profile, "corner_luminance": corners}
 
 
 def catch_light_figures(character, size=320) -> dict:
@@ -102,9 +153,16 @@ def three_quarter_figures(character, size=512) -> dict:
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("characters", nargs="*", default=["amara", "liam", "mei", "george"])
+    parser.add_argument("--cavity", action="store_true", help="the open mouth's figures only")
+    parser.add_argument("--engine", default="registers", choices=["registers", "muscle"])
+    parser.add_argument("--expression", default="1+2+5+26", help="the open mouth's expression (--cavity)")
     args = parser.parse_args(argv)
     for name in args.characters:
         character = preset(name)
+        if args.cavity:
+            figures = cavity_figures(character, args.expression, engine=args.engine)
+            print(name, args.engine, args.expression, "  ".join(f"{k} {v}" for k, v in figures.items()), flush=True)
+            continue
         figures = {**teeth_figures(character), **catch_light_figures(character), **three_quarter_figures(character)}
         print(name, "  ".join(f"{k} {v}" for k, v in figures.items()), flush=True)
 

@@ -289,6 +289,21 @@ def test_timeline_and_muscle_items_render_in_process(tmp_path):
     assert muscle[:8] == registers[:8] == b"\x89PNG\r\n\x1a\n" and muscle != registers
 
 
+def test_a_set_without_a_body_renders_no_shoulders():
+    from facsim.batch.spec import spec_from_dict
+    from facsim.batch.work import render_item
+
+    bottom = {}
+    for body in ("crewneck", "none"):
+        spec = spec_from_dict({"characters": ["liam"], "sizes": [64], "body": body, "blocks": [
+            {"name": "b", "facs": ["0"], "outputs": {"stills": [1]}}]})
+        image = np.asarray(Image.open(io.BytesIO(render_item(expand(spec)[0]))).convert("RGB")).astype(int)
+        bottom[body] = float((np.abs(image[-1] - 255).max(axis=-1) > 10).mean())   # not the white background
+    # The crewneck's shoulders fill the bottom row; without a body only the neck reaches it.
+    assert bottom["crewneck"] > 0.9
+    assert bottom["none"] < 0.7
+
+
 def test_pool_worker_killed_mid_run_is_replaced_and_the_set_completes(spec_file, reference, tmp_path):
     killed = []
 

@@ -71,6 +71,10 @@ def write(tmp_path, text, name="set.yaml"):
      "    outputs: {stills: [1]}\n", ":5: blocks[1].name", "block name 'a' is used twice"),
     ("blocks:\n  - name: a\n    timelines: [missing.yaml]\n    outputs: {video: true}\n",
      ":3: blocks[0].timelines[0]", "no timeline file"),
+    ("body: tshirt\nblocks:\n  - name: a\n    aus: [1]\n    outputs: {stills: [1]}\n", ":1: body",
+     "body must be one of crewneck, none, got 'tshirt'"),
+    ("body: [none]\nblocks:\n  - name: a\n    aus: [1]\n    outputs: {stills: [1]}\n", ":1: body",
+     "expected a string"),
     ("blocks: [\n", ":2", "malformed YAML"),
     ("", "", "expected a mapping with 'blocks' at the top level, got nothing (the file is empty)"),
 ])
@@ -111,6 +115,14 @@ def test_a_timeline_error_is_reported_under_the_spec_field(tmp_path):
 
 
 # ------------------------------------------------------------- expansion ---
+
+def test_the_body_under_the_head_reaches_every_item():
+    # As `--body` on the rendering commands: the crewneck unless the spec says otherwise.
+    assert {it.body for it in expand(spec(block(aus=[12])))} == {"crewneck"}
+    items = expand(spec(block(aus=[12], outputs={"stills": [1], "video": True, "glb": True}), body="none"))
+    assert {it.kind for it in items} == {"still", "video", "glb"}
+    assert {it.body for it in items} == {"none"}
+
 
 def test_full_design_crosses_everything_with_every_character():
     s = spec(block(aus=[1, 12], sides=["both", "left"], intensities=[0.5, 1.0],

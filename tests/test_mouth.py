@@ -68,6 +68,25 @@ def test_the_tongue_rests_in_the_floor_of_the_mouth(face_of):
     assert along[:, 1].min() == pytest.approx(0) and along[:, 1].max() == pytest.approx(1)
 
 
+@pytest.mark.parametrize("engine", ENGINES)
+def test_the_tongues_back_lies_low_when_the_jaw_drops(face_of, engine):
+    # hm08's dorsum stays level back to the throat and neither engine drops the root with the
+    # jaw, so an open mouth showed the tongue as a ramp up to the upper teeth, a pink wall in
+    # the whole opening. Its back falls toward the root: in 26 and 27 the tongue behind its
+    # front third lies well (4 mm) under the upper teeth's edge (it rose 2 mm over it).
+    face = face_of("ava", engine)
+    parts = _groups(face)
+    along = tongue_coordinates(face.head, face.data, face.base_positions)[parts["tongue"], 1]
+    front, back = along < 0.33, (along > 0.45) & (along < 0.9)
+    rest = face.neutral[parts["tongue"]]
+    assert rest[back, 1].max() < rest[front, 1].max() - 0.005
+    for code in ("26", "27"):
+        moved = np.asarray(face.deform(code).positions)
+        tongue = moved[parts["tongue"]]
+        upper_edge = moved[parts["upper"], 1].min()
+        assert tongue[back, 1].max() < upper_edge - 0.04
+
+
 def test_older_faces_rest_their_upper_teeth_higher(face_of):
     face = face_of("ava")
     data = face.data
@@ -174,6 +193,48 @@ def test_open_mouths_show_teeth_brighter_than_the_cavity(face_of, expression):
     assert teeth.sum() > 40 and cavity.sum() > 40
     assert np.median(_luminance(image[teeth])) > 150
     assert np.median(_luminance(image[cavity])) < 0.6 * np.median(_luminance(image[teeth]))
+
+
+def test_the_inside_of_the_arch_is_not_a_grey_wall(face_of):
+    # Turned three-quarters, an open mouth shows the far side of the arch from inside. hm08's
+    # bands carry a lingual slope 8-13 mm deep; drawn as enamel it showed as a pale grey wall
+    # (~500 grey enamel pixels at 512 px); only the crowns' inner faces are enamel, the rest
+    # is gum and the floor of the mouth in the arch's shade.
+    from facsim import Face
+
+    face = face_of("ava")
+    deformation = face.deform("1+2+5+26")
+    renders = []
+    for colour in (None, "#ffffff", "#000000"):
+        character = face.character if colour is None else face.character.with_(colors={"teeth": colour})
+        with Face(character) as marked:
+            renders.append(marked.render(deformation=deformation, size=512, view="three-quarter-left",
+                                         antialias=1)[..., :3].astype(float))
+    image, white, black = renders
+    enamel = image[np.abs(white - black).max(axis=-1) > 3]
+    grey = (_luminance(enamel) > 40) & (enamel.max(axis=1) - enamel.min(axis=1) < 40)
+    assert len(enamel) > 200            # the front crowns still show
+    assert grey.sum() < 300
+
+
+def test_an_open_mouths_tongue_is_wet(face_of):
+    # The tongue's film mirrors the key through the opening: a sheen on its front (its
+    # brightest pixels ~160-180 at 512 px), where the shade of the mouth dimmed it to a
+    # matte 120-140 like the rest of the tongue.
+    from facsim import Face
+
+    face = face_of("ava")
+    deformation = face.deform("1+2+5+26")
+    renders = []
+    for colour in (None, "#ffffff", "#000000"):
+        character = face.character if colour is None else face.character.with_(colors={"tongue": colour})
+        with Face(character) as marked:
+            renders.append(marked.render(deformation=deformation, size=512, antialias=1)[..., :3].astype(float))
+    image, white, black = renders
+    luminance = _luminance(image[np.abs(white - black).max(axis=-1) > 3])
+    lit = luminance[luminance > 30]
+    assert len(lit) > 500
+    assert np.percentile(lit, 99) > 150 > 2 * np.median(lit)
 
 
 def test_at_rest_the_lips_hide_the_teeth(face_of):

@@ -174,6 +174,21 @@ def test_render_is_byte_identical_to_the_cli(client, tmp_path):
     assert r.content == out.read_bytes()
 
 
+def test_render_without_a_body_is_the_clis_head_alone(client, tmp_path):
+    catalogue = client.get("/api/catalogue").json()
+    assert catalogue["bodies"] == ["crewneck", "none"] and catalogue["default_body"] == "crewneck"
+    options = {"size": 48, "body": "none"}
+    r = client.post("/api/render", json={"expression": "12", "character": "liam", "options": options})
+    assert r.status_code == 200
+    out = tmp_path / "cli.png"
+    subprocess.run([sys.executable, "-c", "import sys; from facsim.cli import main; sys.exit(main(sys.argv[1:]))",
+                    "render", "12", "-c", "liam", "--size", "48", "--body", "none", "-o", str(out)],
+                   check=True, capture_output=True)
+    assert r.content == out.read_bytes()
+    dressed = client.post("/api/render", json={"expression": "12", "character": "liam", "options": {"size": 48}})
+    assert dressed.content != r.content
+
+
 @pytest.mark.parametrize("body, field", [
     ({"expression": "12", "options": {"size": 4096}}, "size"),
     ({"expression": "12", "options": {"size": 15}}, "size"),
@@ -181,6 +196,7 @@ def test_render_is_byte_identical_to_the_cli(client, tmp_path):
     ({"expression": "12", "options": {"antialias": 3}}, "antialias"),
     ({"expression": "12", "options": {"background": "#zzzzzz"}}, "background"),
     ({"expression": "12", "options": {"yaw": "left"}}, "yaw"),
+    ({"expression": "12", "options": {"body": "tshirt"}}, "body"),
     ({"expression": "12", "engine": "magic"}, "engine"),
     ({"expression": "12+X"}, "expression"),
     ({"expression": "12", "character": {"gender": 2}}, "character"),
@@ -258,6 +274,18 @@ def test_export_jobs(client, kind, magic):
     job = client.post("/api/jobs", json=body).json()
     assert wait_job(client, job["id"])["state"] == "done"
     assert client.get(f"/api/jobs/{job['id']}/download").content.startswith(magic)
+
+
+def test_a_glb_export_leaves_the_body_out_when_asked(client):
+    meshes = {}
+    for body in ("crewneck", "none"):
+        job = client.post("/api/jobs", json={"kind": "glb", "timeline": CLIP, "options": {"body": body}}).json()
+        assert wait_job(client, job["id"])["state"] == "done"
+        data = client.get(f"/api/jobs/{job['id']}/download").content
+        length = int.from_bytes(data[12:16], "little")           # the glb's JSON chunk
+        meshes[body] = {m["name"] for m in json.loads(data[20:20 + length])["meshes"]}
+    assert "body" in meshes["crewneck"] and "body" not in meshes["none"]
+    problem(client.post("/api/jobs", json={"kind": "glb", "timeline": CLIP, "options": {"body": "cape"}}), 422)
 
 
 def test_jobs_refuse_bad_input_and_unknown_ids(client):

@@ -129,6 +129,8 @@ def test_render_returns_the_cli_bytes(page, tmp_path):
     page.select_option("#view", "three-quarter-left")
     page.select_option("#antialias", "2")
     page.select_option("#background", "grey")
+    assert page.eval_on_selector("#body", "e => e.value") == "crewneck"
+    page.select_option("#body", "none")
     page.click("#render")
     page.wait_for_function("document.querySelector('#render').textContent === 'Render' && "
                            "!document.querySelector('#render-figure').hidden", timeout=120_000)
@@ -136,7 +138,7 @@ def test_render_returns_the_cli_bytes(page, tmp_path):
                                  "document.querySelector('#render-image').src)).arrayBuffer()))"))
     out = tmp_path / "cli.png"
     subprocess.run([sys.executable, "-c", CLI, "render", "1+2+5B+26", "-c", "kwame", "--size", "96", "--view",
-                    "three-quarter-left", "--antialias", "2", "--background", "grey", "-o", str(out)],
+                    "three-quarter-left", "--antialias", "2", "--background", "grey", "--body", "none", "-o", str(out)],
                    check=True, capture_output=True)
     assert served == out.read_bytes()
 

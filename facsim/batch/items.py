@@ -43,6 +43,8 @@ from typing import Iterator
 
 import numpy as np
 
+from facsim.render.options import DEFAULT_BODY
+
 from .spec import Block, SpecError, Stimulus, StimulusSet, VideoOutput
 
 #: Letters for blind names: no 0/o, 1/l; 10 of them give ~2**48 names.
@@ -98,6 +100,7 @@ class Item:
     format: str = "png"
     intensities: str = "hapfacs"
     background: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    body: str = DEFAULT_BODY
     antialias: int | str = 4
 
     @property
@@ -185,7 +188,7 @@ def _items_of(spec: StimulusSet, block: Block, list_no: int, character: str, con
     common = dict(block=block.name, list=list_no, character=character, engine=cond.engine, view=cond.view,
                   width=width, height=height, stimulus=stim, peak=cond.intensity,
                   aus=_condition_aus(stim), intensities=spec.intensities,
-                  background=spec.background, antialias=spec.antialias)
+                  background=spec.background, body=spec.body, antialias=spec.antialias)
     out = []
     peak_tag = "" if stim.kind == "timeline" else "_" + _intensity_tag(cond.intensity)
     for level in block.outputs.stills:

@@ -40,6 +40,7 @@ import numpy as np
 
 import facsim
 from facsim.facs.stimuli import hapfacs_stimuli
+from facsim.render.options import DEFAULT_BODY
 from facsim.timeline import io as timeline_io
 from facsim.timeline.model import Hold, TimelineError, Track, parse_level
 
@@ -136,6 +137,7 @@ class StimulusSet:
     key_file: str = "key.csv"
     intensities: str = "hapfacs"
     background: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    body: str = DEFAULT_BODY
     antialias: int | str = 4
     spec_json: str = "{}"
     spec_hash: str = ""
@@ -424,6 +426,15 @@ def _background(value: str) -> tuple[float, float, float]:
         raise SpecError(str(exc), location=("background",)) from None
 
 
+def _body(value: str) -> str:
+    from facsim.head.body import check_body_style
+
+    try:
+        return check_body_style(value)
+    except ValueError as exc:
+        raise SpecError(str(exc), location=("body",)) from None
+
+
 def _check_item_count(blocks: Sequence[Block], counterbalance: str, lists: int) -> None:
     """Refuse a spec that expands to more output files than the limit, before expanding it:
     a few lines of YAML can cross factors into millions of files."""
@@ -511,6 +522,7 @@ def spec_from_dict(data: Any, *, base_dir: str | os.PathLike | None = None) -> S
         blocks=tuple(blocks), name=data.get("name", ""), description=data.get("description", ""),
         seed=top["seed"], counterbalance=counterbalance, lists=lists, naming=naming, key_file=key_file,
         intensities=table, background=_background(data.get("background", "#ffffff")),
+        body=_body(data.get("body", DEFAULT_BODY)),
         antialias=data.get("antialias", 4), spec_json=spec_json, spec_hash=digest.hexdigest(),
     )
 

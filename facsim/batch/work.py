@@ -114,7 +114,7 @@ def render_item(item: Item, threads: int | None = None) -> bytes:
     """
     set_render_threads(threads if "LP_NUM_THREADS" not in os.environ else None)
     face = face_for(item.character, item.engine)
-    options = dict(view=item.view, size=(item.width, item.height))
+    options = dict(view=item.view, size=(item.width, item.height), body=item.body)
     if item.kind == "still":
         from facsim.timeline.sampling import sample
 
@@ -128,7 +128,7 @@ def render_item(item: Item, threads: int | None = None) -> bytes:
         # Morph targets for the item's own AUs keep the file small (2.8 MB with all 68); head and eye
         # positions (51-58, 61-66) are joint rotations, animated whatever the targets.
         morphs = sorted(set(item.aus) & set(register_table()["action_units"]))
-        return glb_bytes(face, item_timeline(item), aus=morphs or "all", fps=item.fps)
+        return glb_bytes(face, item_timeline(item), aus=morphs or "all", fps=item.fps, body=item.body)
     from facsim.pipeline import animate
 
     path = _scratch_dir() / f"{os.getpid()}-item.{item.format}"

@@ -31,6 +31,15 @@ LOWER_ROW_OFFSET = 4.0
 #: tongue fills the closed mouth up to the palate, so an open mouth showed a pink mound
 #: above the lower teeth; a relaxed tongue lies in the floor of the mouth, behind them.
 TONGUE_BELOW_TEETH = 0.012
+#: Behind its tip the tongue's dorsum falls toward the root: its height above the tongue's
+#: underside shrinks by this fraction between :data:`TONGUE_FALL_ALONG` (0 at the tip, 1 at
+#: the root). hm08's dorsum stays level back to the throat, and neither engine drops the
+#: root with the jaw (the muscle engine turns the tongue rigidly about the jaw's hinge,
+#: behind it), so an open mouth (26, 27, surprise) showed the tongue as a ramp rising to the
+#: upper teeth, a pink wall filling the whole opening. In photographs of open mouths the
+#: tongue lies low behind the lower teeth and the dark cavity opens above it.
+TONGUE_FALL = 0.6
+TONGUE_FALL_ALONG = (0.1, 0.6)
 #: The upper teeth rest this far (dm) lower than hm08 puts them, in young adults. hm08
 #: hides the upper incisors 1 mm above the lips' meeting line, so a mouth that opened by
 #: the jaw alone (26, 27) showed no upper teeth; a relaxed young adult shows 2–3 mm of them
@@ -69,7 +78,8 @@ def rest_mouth(base_positions: np.ndarray, data, *, age: float = 25.0) -> np.nda
     mouth's lining kept :data:`CAVITY_CLEARANCE` behind the skin.
 
     The tongue is squashed toward its underside (about its lowest point) until its top
-    sits :data:`TONGUE_BELOW_TEETH` under the lower incisors' edge; its tip and sides
+    sits :data:`TONGUE_BELOW_TEETH` under the lower incisors' edge, and further behind the
+    tip so its dorsum falls toward the root (:data:`TONGUE_FALL`); its tip and sides
     stay where they are in plan, so it still fills the lower arch. Applied to the
     character's neutral mesh before any expression, so both engines carry the parts
     with the skull and the jaw as they carry hm08's own.
@@ -85,10 +95,15 @@ def rest_mouth(base_positions: np.ndarray, data, *, age: float = 25.0) -> np.nda
     y = out[tongue, 1]
     bottom, top = float(y.min()), float(y.max())
     target = float(out[lower, 1].max()) - TONGUE_BELOW_TEETH
-    if top <= target or top - bottom < 1e-6:
+    if top - bottom < 1e-6:
         return out
-    scale = max((target - bottom) / (top - bottom), 0.4)
-    out[tongue, 1] = bottom + scale * (y - bottom)
+    scale = float(np.clip((target - bottom) / (top - bottom), 0.4, 1.0))
+    z = out[tongue, 2]
+    along = (z.max() - z) / max(float(z.max() - z.min()), 1e-6)
+    start, end = TONGUE_FALL_ALONG
+    fall = np.clip((along - start) / (end - start), 0.0, 1.0)
+    fall = fall * fall * (3.0 - 2.0 * fall)
+    out[tongue, 1] = bottom + scale * (1.0 - TONGUE_FALL * fall) * (y - bottom)
     return out
 
 

@@ -51,6 +51,8 @@ _WHERE = {
     "DEFAULT_ENGINE": "facsim.engines",
     "EASINGS": "facsim.timeline.easing",
     "VIEWS": "facsim.render.camera",
+    "DEFAULT_BODY": "facsim.render.options",
+    "body_styles": "facsim.head.body",
     "hex_to_rgb": "facsim.head.colour",
     "rigid_table": "facsim.engines.rigid",
     "register_table": "facsim.engines.registers",

@@ -235,7 +235,13 @@ def render_options(body: Any, *, video: bool = False) -> dict:
         "projection": choice(body.get("projection", "perspective"), PROJECTIONS, "projection"),
         "background": None if (bg := _color(body.get("background", "white"))) is None else list(bg),
         "antialias": choice(body.get("antialias", "fxaa" if video else 4), ANTIALIAS, "antialias"),
+        "body": body_style(body.get("body", compat.DEFAULT_BODY)),
     }
+
+
+def body_style(value: Any) -> str:
+    """What is under the head: a garment of ``facsim/data/body.yaml`` or ``none`` (``--body``)."""
+    return choice(value, tuple(compat.body_styles()), "body")
 
 
 # ---------------------------------------------------------------- timeline ---

@@ -187,6 +187,7 @@ def create_app(*, workdir, token: str | None = None, allowed_hosts: set[str] | N
                 "intensity_tables": {k: dict(v) for k, v in compat.INTENSITY_TABLES.items()},
                 "views": {k: {"yaw": v[0], "pitch": v[1]} for k, v in compat.VIEWS.items()},
                 "engines": list(compat.ENGINES), "antialias": list(checks.ANTIALIAS), "rigid": rigid,
+                "bodies": list(compat.body_styles()), "default_body": compat.DEFAULT_BODY,
                 "max_size": checks.MAX_SIZE, "easings": list(compat.EASINGS),
                 "voices": [v for v in compat.voice_names() if ":" not in v]}
 
@@ -355,6 +356,8 @@ def create_app(*, workdir, token: str | None = None, allowed_hosts: set[str] | N
         else:
             checks.timeline_from_document(body.get("timeline"))   # errors now, not in the worker
             spec = {"timeline": body["timeline"], "character": checks.character_params(body.get("character"))}
+            if kind == "glb":
+                spec["body"] = checks.body_style((body.get("options") or {}).get("body", compat.DEFAULT_BODY))
             if kind == "video":
                 spec.update(format=checks.choice(body.get("format", "mp4"), checks.VIDEO_FORMATS, "format"),
                             engine=checks.engine(body.get("engine")),

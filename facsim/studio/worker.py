@@ -132,7 +132,7 @@ def run_job(job_id: str, folder: str, kind: str, spec: dict) -> str:
 
         _report(job_id, 0, 1)
         data = build(face_for(spec["character"]), timeline, aus="all", interpolation="LINEAR", normals=True,
-                     fps=None)
+                     fps=None, body=spec["body"])
         return _write(folder, "face.glb", data, job_id)
     if kind == "arkit-csv":
         from facsim.exchange.arkit import dumps_arkit_csv

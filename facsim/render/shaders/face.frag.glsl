@@ -703,6 +703,13 @@ void main() {
     enamel *= mix(vec3(1.0), vec3(1.0, 0.93, 0.8), smoothstep(0.3, gum_edge, h));
     vec3 gums = vec3(0.62, 0.27, 0.28) * (0.92 + 0.16 * value_noise(v_uv * vec2(60.0, 8.0), 0));
     vec3 albedo = mix(enamel * gap * convex, gums, gum);
+    // The lingual slope is enamel only near the biting edge (the crowns' inner faces, ~4 mm);
+    // beyond lies the lingual gum and the mouth's floor, wet and in the arch's shade. Drawn as
+    // enamel it showed as a pale grey wall inside the far side of the arch in three-quarter views
+    // and as grey slabs at the corners when the jaw dropped. Dark enough that between the lower
+    // crowns it reads as shade, not as red dots.
+    float lingual_gum = smoothstep(0.25, 0.5, lingual);
+    albedo = mix(albedo, gums * 0.55, lingual_gum);
     // Each crown bulges (~1 mm over its width): its normal turns across it (a surface
     // gradient from screen derivatives, as on the skin), so the key lays a soft highlight
     // down each crown and its flanks turn into shade: separate teeth, not a flat strip.
@@ -717,34 +724,41 @@ void main() {
     // that edge in this frame (facsim.head.mouth.mouth_light; 1 when nobody passes it). The
     // lower row stands back under the upper teeth and lip and faces up into the mouth:
     // darker, and mostly hidden.
-    float depth_shade = mix(1.0, 0.16, smoothstep(0.12, 0.36, arc));
+    float depth_shade = mix(1.0, 0.09, smoothstep(0.12, 0.36, arc));
     float lip_shadow = mix(0.5, 1.0, smoothstep(-0.002, 0.022, v_occlusion));
     float row_light = mix(1.0, 0.62, lower);
     // The inside of the arch faces the tongue and throat: it only catches light scattered in.
-    float mouth_shade = depth_shade * lip_shadow * row_light * mix(1.0, 0.12, smoothstep(0.0, 0.1, lingual));
+    float mouth_shade = depth_shade * lip_shadow * row_light * mix(1.0, 0.12, smoothstep(0.0, 0.1, lingual))
+                      * mix(1.0, 0.5, lingual_gum);
     float wet = specular_light(n, v, 120.0).r * 0.35 + specular_light(n, v, 30.0).r * 0.05;
     vec3 spec = vec3(wet) * (1.0 - 0.6 * gum) * schlick(0.05, max(dot(n, v), 0.0)) * 3.0;
     // Enamel scatters light inside the tooth: a little of its own brightness beyond the lighting.
     radiance = ((diffuse_light(n, vec3(0.3, 0.25, 0.2), 1.0) * 0.9 + 0.16) * albedo + spec) * mouth_shade;
     // What light reaches the back teeth has bounced off the cheeks' red lining: warm, not grey.
-    radiance *= mix(vec3(1.0, 0.6, 0.5), vec3(1.0), depth_shade);
+    // So does what reaches the inside of the arch.
+    radiance *= mix(vec3(1.0, 0.6, 0.5), vec3(1.0), depth_shade * (1.0 - 0.8 * smoothstep(0.0, 0.3, lingual)));
 #endif
 
 #ifdef REGION_TONGUE
     // v_uv = (across -1..1, along 0 at the tip .. 1 at the root), facsim.head.mouth.tongue_coordinates.
     float across = v_uv.x, along = clamp(v_uv.y, 0.0, 1.0);
     // Median groove, papillae as fine mottling, a paler coat toward the middle.
-    float groove = 1.0 - 0.35 * exp(-across * across / 0.012) * smoothstep(0.05, 0.3, along);
+    float groove = 1.0 - 0.35 * exp(-across * across / 0.012) * smoothstep(0.05, 0.3, along) * (1.0 - smoothstep(0.35, 0.6, along));
     float papillae = 0.85 + 0.3 * value_noise(v_uv * vec2(40.0, 60.0), 0);
-    vec3 albedo = u_albedo * vec3(0.85, 0.72, 0.76) * papillae * groove;
-    // The tongue lies in the shadow of the lips and upper teeth: dim at the tip, dark toward
-    // the throat and at its sides against the teeth.
+    vec3 albedo = u_albedo * vec3(0.88, 0.72, 0.74) * papillae * groove;
+    // The tongue lies in the shadow of the lips and upper teeth: dim at the tip, dark at its
+    // sides against the teeth and falling into the throat's dark toward the root (where it
+    // rises to the back wall: lit there, its sides and groove drew pale and dark stripes).
     // How much light the parted lips let in arrives in occ (facsim.head.mouth.mouth_light).
-    float mouth_shade = mix(0.36, 0.04, smoothstep(0.0, 0.3, along)) * mix(1.0, 0.5, smoothstep(0.4, 1.0, abs(across)))
+    float mouth_shade = mix(0.38, 0.015, smoothstep(0.0, 0.5, along)) * mix(1.0, 0.5, smoothstep(0.4, 1.0, abs(across)))
                       * mix(0.1, 1.0, occ);
     // Moist: a soft sheen broken by the papillae, and a tighter glint on the film of saliva.
     vec3 spec = specular_light(n, v, 40.0) * 0.12 * papillae + specular_light(n, v, 90.0) * 0.3 * smoothstep(0.8, 1.1, papillae);
-    radiance = (diffuse_light(n, vec3(0.3, 0.15, 0.1), 1.0) * 0.8 * albedo + spec) * mouth_shade;
+    // The film mirrors the key through the opening wherever the tongue's front faces it: the
+    // sheen is dimmed by how far back it lies and by the light the lips let in, not by the
+    // shade that scattered light falls into (there it was lost, a matte tongue).
+    float sheen_light = mix(0.7, 0.04, smoothstep(0.0, 0.45, along)) * mix(0.1, 1.0, occ);
+    radiance = diffuse_light(n, vec3(0.3, 0.15, 0.1), 1.0) * 0.8 * albedo * mouth_shade + spec * sheen_light;
 #endif
 
 #ifdef REGION_MOUTH_INTERIOR
@@ -754,7 +768,7 @@ void main() {
     // saturated red (seen through the gaps between the teeth, red read as braces' bands).
     float mouth_shade = occ * occ;
     vec3 spec = specular_light(n, v, 30.0) * 0.04;
-    vec3 deep = 0.12 * mix(vec3(dot(u_albedo, vec3(0.33))), u_albedo, 0.5);
+    vec3 deep = 0.18 * mix(vec3(dot(u_albedo, vec3(0.33))), u_albedo, 0.5);
     radiance = (diffuse_light(n, vec3(0.3, 0.1, 0.1), 1.0) * u_albedo * 0.45 + spec) * mouth_shade
              + deep * (1.0 - mouth_shade);
 #endif

@@ -442,7 +442,7 @@ function stop() { S.playing = false; $('#play').textContent = '▶ Play'; if (S.
 // ------------------------------------------------------------------ outputs
 function renderOptions() {
   const view = $('#view').value, o = {size: +$('#size').value, background: $('#background').value,
-    antialias: $('#antialias').value === 'fxaa' ? 'fxaa' : +$('#antialias').value};
+    antialias: $('#antialias').value === 'fxaa' ? 'fxaa' : +$('#antialias').value, body: $('#body').value};
   if (view === 'orbit') { const a = viewer.angles(); o.view = 'front'; o.yaw = +a.yaw.toFixed(1); o.pitch = +a.pitch.toFixed(1); }
   else o.view = view;
   return o;
@@ -552,6 +552,9 @@ async function main() {
     $('#view').append(el('option', {value: name}, label));
   }
   $('#view').append(el('option', {value: 'orbit'}, 'as in the 3-D view'));
+  // what is under the head (facsim/data/body.yaml's garments, or none)
+  for (const name of catalogue.bodies) $('#body').append(el('option', {value: name}, name));
+  $('#body').value = catalogue.default_body;
   // emotions
   for (const [name, t] of Object.entries(emotions.tables)) $('#emotion-table').append(el('option', {value: name, title: t.source}, t.title.length > 28 ? name : t.title));
   for (const name of emotions.names) {
