@@ -24,8 +24,9 @@ def eye_pixels():
     ava = preset("ava").with_(symmetric=True)   # both eyes alike: the shading, not ava's own asymmetry
     normal = _render(ava)
     green_sclera = _render(ava.with_(colors={**ava.colors, "sclera": "#00ff00"}))
-    red_iris = _render(ava.with_(colors={**ava.colors, "iris": "#ff0000"}))
-    iris = np.abs(red_iris - normal).sum(-1) > 60
+    # (White, not a hue: the renderer greys the iris's colour, which would blunt a red marker.)
+    white_iris = _render(ava.with_(colors={**ava.colors, "iris": "#ffffff"}))
+    iris = np.abs(white_iris - normal).sum(-1) > 60
     sclera = (np.abs(green_sclera - normal).sum(-1) > 60) & ~iris
     return normal, sclera, iris
 

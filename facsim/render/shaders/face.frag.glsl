@@ -95,7 +95,7 @@ vec2 spots(vec2 p, float prob, float radius, int salt) {
 // GGX distributions of roughness SKIN_ROUGHNESS (alpha = roughness²) with Hammon's
 // approximation of the height-correlated Smith visibility, times N.L.
 const float SKIN_F0 = 0.028;
-const vec2 SKIN_ROUGHNESS = vec2(0.5, 0.3);
+const vec2 SKIN_ROUGHNESS = vec2(0.6, 0.38);
 const float PEACH_FUZZ = 0.05;   // grazing sheen of the vellus hair, of the light reaching it
 vec2 skin_specular(vec3 n, vec3 l, vec3 v, float ndv) {
     vec3 h = normalize(l + v);
@@ -192,7 +192,7 @@ uniform mat3 u_eye_rot_b = mat3(1.0);
 // an iris 11.7 mm across (the adult mean) and a 4 mm pupil.
 const float IRIS_RADIUS = 0.368;
 const float PUPIL_RADIUS = 0.13;
-const float LIMBUS_WIDTH = 0.22;   // fraction of the iris annulus darkened at its rim
+const float LIMBUS_WIDTH = 0.26;   // fraction of the iris annulus darkened at its rim
 const float CORNEA_RADIUS = 0.49;  // radius of the cornea's curvature, 1.33 iris radii
 // The iris lies in the anterior chamber, behind the cornea: the eyeball's sphere puts it
 // only ~1.1 mm under the corneal apex, the apex is ~3.6 mm in front of it; this is the extra depth
@@ -242,6 +242,10 @@ const vec2 UPPER_SHADOW = vec2(0.6, 2.5);
 // degrees: ~0.28 mm each on hm08); the lower lid's is lighter and shorter.
 const vec2 UPPER_LID_SHADE = vec2(0.6, 8.0);
 const vec2 LOWER_LID_SHADE = vec2(0.2, 3.0);
+// The upper lid's soft cast shadow from the key above (depth at the margin, reach in degrees),
+// on the eyeball's diffuse light only: an evenly lit eyeball to the lid's edge read as glass.
+// (The cornea's reflection of the key is the key seen past the lid: not shaded by it.)
+const vec2 UPPER_LID_CAST = vec2(0.3, 8.0);
 #endif
 
 #if defined(REGION_TEETH) || defined(REGION_TONGUE)
@@ -303,8 +307,11 @@ void main() {
     // Regional colour: redder nose, cheeks and ears (blood close to the surface), in broken
     // capillary patches rather than an airbrushed blob; darker, cooler skin around the eyes
     // (thin skin over vessels and muscle), more so with age; a shaved beard's blue-grey shadow.
-    float red = u_redness * detail.r * mix(0.45, 1.35, smoothstep(0.2, 0.8, 0.55 * blotch + 0.45 * patches));
-    albedo *= mix(vec3(1.0), vec3(1.06, 0.77, 0.75), (0.75 + 0.3 * u_age) * red);   // older: broken veins
+    // Mild: a nose or cheek a shade redder than the skin around it, never pink (a saturated
+    // nose tip read as painted); melanin veils much of it in dark skin.
+    float veil = mix(0.45, 1.0, smoothstep(0.03, 0.3, dot(u_skin, vec3(0.2126, 0.7152, 0.0722))));
+    float red = u_redness * detail.r * veil * mix(0.6, 1.25, smoothstep(0.2, 0.8, 0.55 * blotch + 0.45 * patches));
+    albedo *= mix(vec3(1.0), vec3(1.03, 0.84, 0.83), min((0.75 + 0.3 * u_age) * red, 1.0));   // older: broken veins
     albedo *= mix(vec3(1.0), vec3(0.78, 0.70, 0.75), tone.r * (0.6 + 0.5 * u_age));
     albedo = mix(albedo, albedo * vec3(0.70, 0.72, 0.78), u_beard * detail.g * (1.0 - paint.g));
     // Age spots: sparse, soft tan patches where the sun reaches, growing with age.
@@ -334,7 +341,10 @@ void main() {
     lip_line = mix(0.1, lip_line, clamp(1.6 - 3.0 * fwidth(lip_s), 0.0, 1.0));
     float lip_core = smoothstep(0.45, 0.95, lips);
     float border = lips * (1.0 - lips) * 4.0;
-    vec3 lip_col = u_lips * (0.92 + 0.16 * blotch) * (1.0 - (0.28 + 0.2 * u_age) * lip_line * lip_core);
+    vec3 lip_col = u_lips * (0.92 + 0.16 * blotch) * (1.0 - (0.16 + 0.16 * u_age) * lip_line * lip_core);
+    // Toward the vermilion border the red thins into the skin's own colour (a painted-on
+    // colour with an even edge read as a rubber mask).
+    lip_col = mix(mix(albedo, u_lips, 0.6), lip_col, lip_core);
     albedo = mix(albedo, lip_col, smoothstep(0.0, 1.0, lips));
     albedo *= 1.0 + 0.07 * border * (1.0 - u_age);
 #ifdef USE_BROWS
@@ -417,6 +427,11 @@ void main() {
     cavity *= 1.0 - 0.07 * pit;
     float spec_break = 1.0 - 0.7 * pit;   // pores hold no oil film facing the light
 #endif
+    // The lips' furrows are grooves (~0.1 mm deep), not only darker lines: their slopes catch
+    // the key on one flank and break the lips' sheen into short strokes, so the red reads as
+    // soft, lined tissue rather than smooth rubber.
+    float lip_h = -0.0012 * (1.0 + 0.5 * u_age) * lip_line * lip_core;
+    bumped = normalize(abs(det) * bumped - sign(det) * (dFdx(lip_h) * r1 + dFdy(lip_h) * r2));
     // Contact shadows: the baked visibility is close to 1 on the open face and falls only in
     // the nostrils, the lip line, the eye sockets and under the jaw; squaring it deepens
     // those small shadows (a soft studio key still reaches into them partly).
@@ -455,22 +470,26 @@ void main() {
     float back_rim = clamp(dot(v, -normalize(u_rim_dir + 0.4 * n)), 0.0, 1.0);
     vec3 glow = back_rim * back_rim * u_rim_col * occ;
     diffuse += tone.g * 0.55 * glow * u_skin * vec3(1.0, 0.42, 0.3);
-    // Specular in two GGX lobes, as measured on skin: a broad one (roughness 0.5) from the
-    // rough horny layer and a tighter one (0.3) from the oil film, with Fresnel from skin's
-    // reflectance at normal incidence (F0 = 0.028, IOR 1.4). The film is patchy: the T-zone
-    // (detail.b) has most, in patches, and shines more in the tight lobe; the cheeks are
-    // nearly matte; the lips are wet but broken by their furrows; brow hair has none.
-    // Micro-relief (grain) breaks the sheen into a speckle instead of a plastic glaze.
+    // Specular in two GGX lobes, as measured on skin: a broad one (roughness 0.6) from the
+    // rough horny layer, over the whole face, and a tighter one (0.38) from the oil film, with
+    // Fresnel from skin's reflectance at normal incidence (F0 = 0.028, IOR 1.4). The weights
+    // sum to about one, so skin stays mostly diffuse with a broad soft sheen. The film is thin
+    // and only where the skin is oiliest (detail.b: the forehead's middle, the nose, the chin),
+    // uneven but not in specks (a speckled film of tight highlights read as wet plastic, most
+    // on dark skin); the cheeks keep only the broad sheen; the lips are moist, broken by their
+    // furrows; brow hair has none.
     float ndv = max(dot(n, v), 1e-4);
-    float oil = detail.b * (1.0 - 0.35 * u_age) * mix(0.55, 1.3, patches) * (1.0 - lips);
-    // Wet, but the film is broken by the furrows and by the lips' fine mottle: a continuous
+    float oil = detail.b * (1.0 - 0.35 * u_age) * mix(0.8, 1.15, patches) * (1.0 - lips);
+    float film = smoothstep(0.6, 1.05, oil);
+    // Moist, but the film is broken by the furrows and by the lips' fine mottle: a continuous
     // glossy band along the lip read as rubber.
     float wet = lips * (1.0 - 0.85 * lip_line) * (0.55 + 0.45 * blotch);
     // Lobe weights (broad, tight); the fill is too weak to show: key and rim only.
-    vec2 weight = vec2(mix(0.3, 0.7, oil), mix(0.05, 0.8, oil * oil) + 0.25 * wet);
+    vec2 weight = vec2(0.6 - 0.3 * wet, 0.35 * film + 0.2 * wet);
     vec3 spec = dot(skin_specular(bumped, u_key_dir, v, ndv), weight) * u_key_col
               + dot(skin_specular(bumped, u_rim_dir, v, ndv), weight) * u_rim_col;
-    spec *= (1.0 - hair) * (0.6 + 0.8 * grain) * spec_break;
+    // (Times pi: the diffuse term here is albedo times N.L, without the Lambert 1/pi.)
+    spec *= PI * (1.0 - hair) * (0.85 + 0.3 * grain) * spec_break;
     // Peach fuzz: the fine vellus hair on the cheeks and forehead scatters a faint, soft sheen
     // where the skin turns away from the eye (toward the face's outline), never a highlight.
     float graze = 1.0 - ndv;
@@ -526,14 +545,19 @@ void main() {
     float ridge = exp(-pow(collar_t / 0.035, 2.0));
     float crypt = smoothstep(0.68, 0.9, value_noise(vec2(turns * 0.5, t * 5.0 + 5.0), IRIS_FIBRES / 2))
                 * smoothstep(0.0, 0.1, collar_t) * (1.0 - smoothstep(0.7, 0.9, t)) * fibre_detail;
-    // A little less saturated than the base colour (real irises are greyish).
-    vec3 base_iris = mix(u_iris, vec3(dot(u_iris, vec3(0.3, 0.55, 0.15))), 0.3);
-    vec3 iris = base_iris * (0.45 + 1.1 * fibre);
-    iris *= mix(vec3(1.0), vec3(0.72, 0.64, 0.52), 0.8 * inner);      // darker, warmer pupillary zone
+    // Less saturated than the base colour: a real iris is a greyish stroma over its pigment,
+    // and a clean saturated colour read as a glass or doll's eye (issue: "glassy eyes",
+    // most of all blue ones). The stroma's radial fibres are paler and greyer than the
+    // hollows between them, where the pigment shows.
+    float iris_grey = dot(u_iris, vec3(0.3, 0.55, 0.15));
+    vec3 base_iris = mix(u_iris, vec3(iris_grey), 0.55);
+    vec3 iris = base_iris * (0.42 + 1.05 * fibre);
+    iris = mix(iris, vec3(iris_grey) * vec3(1.05, 1.0, 0.92) * (0.35 + 1.1 * fibre), 0.35 * smoothstep(0.45, 0.8, fibre) * fibre_detail);
+    iris *= mix(vec3(1.0), vec3(0.72, 0.64, 0.52), 0.6 * inner);      // darker, warmer pupillary zone
     iris *= 1.0 - 0.3 * ridge * fibre_detail;                          // the collarette's dark fold
     iris *= 1.0 - 0.3 * crypt;
     iris *= mix(0.45, 1.0, smoothstep(0.0, 0.08, t));                 // pupillary ruff
-    iris *= mix(1.0, 0.28, smoothstep(1.0 - LIMBUS_WIDTH, 1.0, t));   // limbal ring
+    iris *= mix(1.0, 0.2, smoothstep(1.0 - LIMBUS_WIDTH, 1.0, t));    // limbal ring
     // The pupil is not ink: the lens behind it returns a little light (and the cornea in
     // front reflects the room, below).
     vec3 pupil = max(u_pupil, vec3(0.006, 0.0055, 0.0055)) * mix(1.3, 0.8, smoothstep(0.0, 0.8, ri / PUPIL_RADIUS));
@@ -556,8 +580,8 @@ void main() {
     float vessel_w = 0.05 + fwidth(vessel_n);
     float vessels = (1.0 - smoothstep(0.0, vessel_w, abs(vessel_n - 0.75))) * 0.05 / vessel_w
                   * smoothstep(0.45, 0.85, theta) * (0.5 + 0.5 * abs(cos(angle)));
-    vec3 sclera = u_sclera * vec3(0.86, 0.83, 0.79)
-                * mix(vec3(1.0), vec3(1.0, 0.8, 0.74), 0.7 * corner)
+    vec3 sclera = u_sclera * vec3(0.84, 0.8, 0.74)
+                * mix(vec3(1.0), vec3(0.9, 0.7, 0.63), 0.7 * corner)
                 * mix(vec3(1.0), vec3(0.95, 0.55, 0.5), clamp(1.1 * vessels, 0.0, 0.6));
     // Caruncle and plica: a pink, fleshy, wet mound fills the inner corner (e.x toward the
     // nose: -x for the eye on the +x side of the head), a darker fold (the plica) between
@@ -587,12 +611,13 @@ void main() {
     float tear_w = max(TEAR_WIDTH, px);
     float tear = exp(-pow((v_lids.y - WET_RIM - 0.5 * TEAR_WIDTH) / tear_w, 2.0)) * TEAR_WIDTH / tear_w * along_lower;
     float lash_shadow = 1.0 - UPPER_SHADOW.x * exp(-max(v_lids.x, 0.0) / UPPER_SHADOW.y);
+    float lid_cast = 1.0 - UPPER_LID_CAST.x * exp(-max(v_lids.x, 0.0) / UPPER_LID_CAST.y);
     // The lids' broad shade: the thick upper fold stands off the eyeball and hides much of
     // the light above it; the lower lid a little of the light below.
     occ *= (1.0 - UPPER_LID_SHADE.x * exp(-max(v_lids.x, 0.0) / UPPER_LID_SHADE.y))
          * (1.0 - LOWER_LID_SHADE.x * exp(-max(v_lids.y, 0.0) / LOWER_LID_SHADE.y));
 #else
-    float rim = 0.0, wet_rim = 0.0, tear = 0.0, lash_shadow = 1.0;
+    float rim = 0.0, wet_rim = 0.0, tear = 0.0, lash_shadow = 1.0, lid_cast = 1.0;
 #endif
     // The eyeball sits in the lids' shade. The thick upper lid and its lashes shadow a band
     // under its margin and the lower lid a little above its own: that shade follows the lids
@@ -604,7 +629,7 @@ void main() {
     // takes less ambient than the skin.
     float lid_shade = 0.7 * (1.0 - 0.15 * smoothstep(-0.05, 0.3, hy)) * (1.0 - 0.5 * smoothstep(0.32, 0.68, abs(hx)))
                     * lash_shadow;
-    vec3 diffuse = diffuse_light(n, vec3(0.15), occ) * albedo * lid_shade;
+    vec3 diffuse = diffuse_light(n, vec3(0.15), occ) * albedo * lid_shade * lid_cast;
     // Wet surface. The cornea bulges over the iris as a sphere of 1.33 iris radii (7.8 mm
     // over an 11.7-mm iris), so its normal tilts faster than the eyeball's: the catch-light
     // sits on the iris, not beside it (eye_rot turns the corneal normal with the eye). It

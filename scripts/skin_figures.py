@@ -1,0 +1,171 @@
+"""Print objective figures for the skin, eyes and lips as rendered, per character.
+
+Front view at 512², neutral face, the renderer's default anti-aliasing.
+
+Skin (and lips): the specular share of the light leaving the skin, per region. The frame is
+rendered twice, the second time with the skin's colours (skin, cheek, eyelid, lips) at half
+their linear reflectance; the display transform (sRGB, the filmic curve) is inverted per
+pixel, so each pixel's linear radiance L = D + S splits into diffuse D = 2 (L1 - L2) and
+specular S = L1 - D (luminance). Regions are small boxes at landmarks (both sides pooled):
+
+- ``cheek``: mean S / L on the cheeks (a photograph of skin: a few per cent);
+- ``forehead``, ``nose``, ``lower lip``: the same over the forehead's centre, the nose tip, the
+  lower lip;
+- ``hl area``: the share of the face's skin pixels (between the brows' outer ends and the
+  chin) where S is over 30 % of L: how much of the face reads as highlight;
+- ``speckle``: over the forehead box, the mean absolute difference of S between neighbouring
+  pixels over the mean S: a broad soft sheen is near 0, a glittering film of specks high.
+
+Eyes: the iris's pixels (found by rendering again with the iris in a loud colour, as
+``scripts/eyes_mouth_figures.py`` does): mean HSV saturation and value; the sclera's
+pixels likewise: mean RGB and its warmth (R - B, 0-255), and the upper band's luminance
+(the sclera's top quarter by rows) against its whole (the lid's shade on the eyeball).
+
+Usage::
+
+    python3 scripts/skin_figures.py [CHARACTER ...]   (default: amara kwame ngozi kofi ava mei george)
+"""
+from __future__ import annotations
+
+import argparse
+import dataclasses
+
+import numpy as np
+
+from facsim import Face
+from facsim.head.character import preset
+from facsim.render.camera import project
+
+SIZE = 512
+LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
+SKIN_COLOURS = ("skin", "cheek", "eyelid", "lips")
+SHOULDER = 0.55  # facsim/render/shaders/common.glsl tonemap()
+
+
+def srgb_to_linear(c):
+    c = np.asarray(c, float)
+    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+
+
+def linear_to_srgb(c):
+    c = np.clip(np.asarray(c, float), 0, 1)
+    return np.where(c <= 0.0031308, 12.92 * c, 1.055 * c ** (1 / 2.4) - 0.055)
+
+
+def _tonemap(c):
+    c = np.maximum(c, 0.0)
+    c = c * (c + 0.012) / (c + 0.02)
+    over = np.maximum(c - SHOULDER, 0.0) / (1.0 - SHOULDER)
+    return np.minimum(c, SHOULDER) + (1.0 - SHOULDER) * (1.0 - np.exp2(-1.442695 * over))
+
+
+_GRID = np.concatenate([np.linspace(0, 1, 20000) ** 2 * 8.0])
+_CURVE = _tonemap(_GRID)
+
+
+def radiance(image):
+    """Linear radiance (times the exposure) of a display-sRGB uint8 image's RGB."""
+    tonemapped = srgb_to_linear(image[..., :3].astype(float) / 255)
+    return np.interp(tonemapped, _CURVE, _GRID)
+
+
+def _render(face, appearance, deformation):
+    camera = face.camera(size=(SIZE, SIZE))
+    positions = np.asarray(deformation.positions, np.float32)
+    image = face.renderer(size=SIZE, body="none").render(
+        positions, appearance=appearance, camera=camera, wrinkle=deformation.wrinkle,
+        crease_phase=deformation.crease_phase, occlusion=face.frame_occlusion(positions),
+        lids=face.frame_lids(positions), proxies=face.proxy_draws(positions))
+    return image[..., :3], camera
+
+
+def _box(camera, points, r):
+    """Boolean mask: squares of half-size ``r`` px around world ``points``."""
+    mask = np.zeros((SIZE, SIZE), bool)
+    for x, y in project(camera, np.asarray(points), SIZE)[0]:
+        x, y = int(x), int(y)
+        mask[max(y - r, 0):y + r + 1, max(x - r, 0):x + r + 1] = True
+    return mask
+
+
+def _hsv(rgb):
+    rgb = rgb / 255.0
+    v = rgb.max(-1)
+    s = np.where(v > 0, (v - rgb.min(-1)) / np.maximum(v, 1e-6), 0)
+    return s, v
+
+
+def figures(name, expression=""):
+    face = Face(preset(name))
+    try:
+        from facsim.head.landmarks import landmarks
+
+        marks = landmarks(face.head)
+        deformation = face.deform(expression)
+        p = np.asarray(deformation.positions, float)
+        base = face.appearance
+        image, camera = _render(face, base, deformation)
+        darker = {k: tuple(linear_to_srgb(0.5 * srgb_to_linear(base.colors[k]))) for k in SKIN_COLOURS}
+        half, _ = _render(face, dataclasses.replace(base, colors={**base.colors, **darker}), deformation)
+        l1, l2 = radiance(image) @ LUMINANCE, radiance(half) @ LUMINANCE
+        diffuse = np.clip(2 * (l1 - l2), 0, None)
+        specular = np.clip(l1 - diffuse, 0, None)
+        share = specular / np.maximum(l1, 1e-4)
+
+        def pt(key):
+            return p[marks[key]]
+        regions = {
+            "cheek": _box(camera, [pt("cheek_left") + [-0.08, 0.05, 0.1], pt("cheek_right") + [0.08, 0.05, 0.1]], 6),
+            "forehead": _box(camera, [pt("glabella") + [0.0, 0.25, -0.03]], 8),
+            "nose": _box(camera, [pt("nose_tip")], 4),
+            "lower lip": _box(camera, [pt("lower_lip") + [0.0, 0.012, 0.0]], 4),
+        }
+        out = {k: float(np.sum(specular[m]) / np.maximum(np.sum(l1[m]), 1e-6)) for k, m in regions.items()}
+        (x0, _), (x1, _) = project(camera, [pt("outer_brow_left"), pt("outer_brow_right")], SIZE)[0]
+        (_, y0), = project(camera, [pt("outer_brow_left")], SIZE)[0]
+        (_, y1), = project(camera, [pt("chin")], SIZE)[0]
+        face_box = np.zeros((SIZE, SIZE), bool)
+        face_box[int(y0):int(y1), int(min(x0, x1)):int(max(x0, x1))] = True
+        # The skin's own pixels: those that darkened with the skin's colours.
+        skin = face_box & (np.abs(image.astype(float) - half.astype(float)).sum(-1) > 6)
+        out["hl area"] = float((share[skin] > 0.3).mean())
+        forehead = regions["forehead"]
+        ys, xs = np.nonzero(forehead)
+        patch = specular[ys.min():ys.max() + 1, xs.min():xs.max() + 1]
+        out["speckle"] = float(np.abs(np.diff(patch, axis=1)).mean() / max(patch.mean(), 1e-6))
+
+        # Eyes: recolour the iris / sclera and keep the changed pixels.
+        def part(key, colour):
+            marked, _ = _render(face, dataclasses.replace(base, colors={**base.colors, key: colour}), deformation)
+            return np.abs(marked.astype(float) - image.astype(float)).sum(-1) > 60
+        iris = part("iris", (1.0, 1.0, 1.0))
+        sclera = part("sclera", (0.0, 0.0, 0.0)) & ~iris
+        s, v = _hsv(image[iris].astype(float))
+        out["iris sat"], out["iris val"] = float(s.mean()), float(v.mean())
+        sc = image[sclera].astype(float)
+        out["sclera L"] = float((sc @ LUMINANCE).mean())
+        out["sclera R-B"] = float((sc[:, 0] - sc[:, 2]).mean())
+        rows = np.nonzero(sclera)[0]
+        top = sclera & (np.arange(SIZE)[:, None] < np.percentile(rows, 25))
+        out["sclera top/all"] = float((image[top].astype(float) @ LUMINANCE).mean() / out["sclera L"])
+        return out
+    finally:
+        face.close()
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("characters", nargs="*", default=["amara", "kwame", "ngozi", "kofi", "ava", "mei", "george"])
+    parser.add_argument("--expression", default="")
+    args = parser.parse_args(argv)
+    keys = None
+    for name in args.characters:
+        out = figures(name, args.expression)
+        if keys is None:
+            keys = list(out)
+            print(f"{'':8s}" + "".join(f"{k:>15s}" for k in keys))
+        print(f"{name:8s}" + "".join(f"{out[k]:15.3f}" for k in keys))
+
+
+if __name__ == "__main__":
+    main()
