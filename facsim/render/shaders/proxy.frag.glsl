@@ -287,9 +287,12 @@ void main() {
     // ends in tapered strands, not in blocks cut by the shoulders or the image's edge.
     float ends = (v_rest.y - u_end_height) / u_end_fade;
     if (ends < 1.0) {
-        float length_at = 0.05 + 0.9 * px;
+        // (inner layers end higher, behind the outer ones: their shaded ends showed through
+        // the outer layer's tips as dark blots)
+        float length_at = 0.05 + 0.9 * px + 0.5 * (1.0 - smoothstep(0.3, 0.9, v_depth));
         alpha *= smoothstep(length_at - 0.15, length_at + 0.15, ends) * smoothstep(0.15, 0.5, ends);
     }
+    float px_full = px;
     if (u_along_v > 0.5) px = mix(0.5, px, 0.4);
 #endif
     // The hair's outline: where the volume turns away from the eye, its outer strands stand
@@ -386,6 +389,10 @@ void main() {
     }
 #else
     albedo = hair_colour(v_uv * vec2(45.0, 1.2) + 7.0 + 0.5 * phase) * strand;
+    // Greying hair: white, grey and dark strands side by side at the pixel scale too (the
+    // clump-scale mix above fades to one flat grey at stimulus sizes).
+    if (u_grey > 0.0)
+        albedo = mix(albedo, mix(u_pigment, u_white, clamp(u_grey + 0.9 * (px_full - 0.5), 0.0, 1.0)) * strand, 0.7);
 #endif
     // Depth in the volume: layers near the scalp lie under the outer ones and get little
     // light (roots and the under-layers darker), the gaps between clumps are darker still.
@@ -425,8 +432,10 @@ void main() {
     float th2 = dot(normalize(t + (-0.1 + jitter) * n), h);
     float s1 = max(1.0 - th1 * th1, 1e-6);   // sin^2
     float s2 = max(1.0 - th2 * th2, 1e-6);
-    float strands = smoothstep(0.25, 0.7, fine) * smoothstep(0.3, 0.65, tex.r) * smoothstep(0.2, 0.7, mid)
-                  * mix(0.5, 1.0, clump) * smoothstep(0.35, 0.7, px) * 1.6;
+    // (The finer UV scales fade to their means at stimulus sizes: they only modulate, and the
+    // pixel-scale strands px break the band, so it reads at 512² as strands catching the light.)
+    float strands = mix(0.55, 1.0, smoothstep(0.25, 0.7, fine) * smoothstep(0.2, 0.7, mid))
+                  * smoothstep(0.3, 0.65, tex.r) * mix(0.5, 1.0, clump) * smoothstep(0.3, 0.75, px) * 1.5;
     float sparkle = smoothstep(0.45, 0.75, fine) * smoothstep(0.4, 0.7, mid) * smoothstep(0.4, 0.75, px);
     vec3 tint = mix(vec3(1.0), u_color / max(max(u_color.r, u_color.g), max(u_color.b, 1e-4)), 0.5);
     // Light hair's own diffuse is bright already: a full-strength white lobe on it reads as
