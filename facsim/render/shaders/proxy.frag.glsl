@@ -306,7 +306,7 @@ void main() {
     // dense base the tufts grow from: neither frays.
     float rag = 0.45 * px + 0.3 * mid + 0.25 * clump;
     float fray = outline * (1.0 - strand_mask) * 0.9;
-    fray = 1.0 - (1.0 - fray) * (1.0 - smoothstep(0.45, 0.75, v_edge + 0.7 * (0.5 - rag)));
+    fray = 1.0 - (1.0 - fray) * (1.0 - smoothstep(0.3, 0.75, v_edge + 0.9 * (0.5 - rag)));
     alpha *= 1.0 - fray * (1.0 - u_coil);
 #ifdef COILY
     {
