@@ -277,7 +277,12 @@ void main() {
 #ifdef COILY
     // Coily hair gathers into clumps of coils a few millimetres across, placed on the
     // neutral head: their crevices fall dark and the outline breaks up around them.
-    float coil_clump = value_noise3(v_rest * 18.0 + 1.0);
+    // (Two lattices turned against each other and the head's axes: one axis-aligned lattice drew
+    // its grid as rows of bricks where the surface faces the camera.)
+    const mat3 turn_a = mat3(0.788, 0.418, -0.452, -0.360, 0.908, 0.214, 0.500, -0.017, 0.866);
+    const mat3 turn_b = mat3(0.643, -0.543, 0.540, 0.766, 0.456, -0.453, 0.000, 0.705, 0.709);
+    float coil_clump = 0.5 + 1.3 * (0.5 * (value_noise3(turn_a * v_rest * 18.0 + 1.0)
+                                           + value_noise3(turn_b * v_rest * 18.0 + 7.0)) - 0.5);
     float px = 0.5;
 #else
     float px = u_along_v > 0.5 ? pixel_strands_uv(v_uv, vec2(40.0, 1.5), vec2(5.0, 5.0) + 2.0 * phase)
@@ -308,6 +313,12 @@ void main() {
     float fray = outline * (1.0 - strand_mask) * 0.9;
     fray = 1.0 - (1.0 - fray) * (1.0 - smoothstep(0.3, 0.75, v_edge + 0.9 * (0.5 - rag)));
     alpha *= 1.0 - fray * (1.0 - u_coil);
+    // A card seen edge-on at the outline (its own face, not the volume's, turned away) is a
+    // line a pixel wide standing off the mass: it fades, so the outline does not draw strokes
+    // around the head.
+    vec3 card_normal = cross(dFdx(v_pos), dFdy(v_pos));
+    float face_on = abs(dot(card_normal, v)) / max(length(card_normal), 1e-12);
+    alpha *= mix(1.0, smoothstep(0.06, 0.3, face_on), smoothstep(0.3, 0.8, outline));
 #ifdef COILY
     {
         // Coily hair's outline breaks up in curls (placed on the neutral face, see below):
@@ -318,6 +329,9 @@ void main() {
         // silhouette is lumpy, not a smooth dome.
         float lumps = 1.0 - smoothstep(0.05, 0.45, dot(n, v));
         alpha *= 1.0 - u_coil * lumps * (1.0 - smoothstep(0.3, 0.6, coil_clump));
+        // The cards' thin margins (the blended pass: the hairline, the temples) break into
+        // curls with skin between them instead of lying over the skin as a pale glassy film.
+        alpha *= mix(1.0, smoothstep(0.4, 0.6, halo), u_coil * (1.0 - smoothstep(0.3, 0.6, alpha)));
     }
 #endif
     // Over a thinning hairline (v_cover < 1, see facsim/head/scalp.py) the cards break up into
