@@ -295,7 +295,7 @@ void main() {
         // (inner layers end higher, behind the outer ones: their shaded ends showed through
         // the outer layer's tips as dark blots)
         float length_at = 0.05 + 0.9 * px + 0.5 * (1.0 - smoothstep(0.3, 0.9, v_depth));
-        alpha *= smoothstep(length_at - 0.15, length_at + 0.15, ends) * smoothstep(0.15, 0.5, ends);
+        alpha *= smoothstep(length_at - 0.05, length_at + 0.35, ends) * smoothstep(0.15, 0.5, ends);
     }
     float px_full = px;
     if (u_along_v > 0.5) px = mix(0.5, px, 0.4);
