@@ -233,3 +233,23 @@ def test_afro_stands_off_the_skull_but_meets_the_skin_at_the_hairline(face_of):
     assert np.allclose(lift[y > np.percentile(y, 90)], 0.01 * mm, rtol=1e-3)
     assert np.median(lift[y < np.percentile(y, 5)]) < 0.1 * 0.01 * mm
     assert not proxies.hair_volume_offset("long01", hair.neutral, face.head, face.neutral).any()
+
+
+def test_long_hair_ends_above_the_shoulders_not_in_blocks_at_the_image_corners(face_of):
+    # MakeHuman's long01 hangs on through where the shoulders are: the bust cut it into dark
+    # blocks at the front view's bottom corners. Its strands end above the neck's base instead.
+    from facsim.face import Face
+
+    face = face_of("mei")  # long01, black hair
+    meshes = {m.kind: m for m in face.proxy_meshes}
+    neck_base = face.neutral[: face.head.skin_vertex_count, 1].min()
+    assert neck_base < meshes["hair"].end_height < neck_base + 0.1
+    assert meshes["wisps"].end_height == meshes["hair"].end_height and meshes["eyebrows"].end_height is None
+    with Face(face.character.with_(hair="none")) as bald:
+        without = bald.render(None, size=128).astype(int)
+    with_hair = face.render(None, size=128).astype(int)
+    corners = np.concatenate([(with_hair - without)[-16:, :24], (with_hair - without)[-16:, -24:]])
+    assert (np.abs(corners[..., :3]).max(axis=-1) > 60).mean() < 0.05
+    # the hair still frames the face down to the jaw
+    sides = np.concatenate([(with_hair - without)[70:90, :30], (with_hair - without)[70:90, -30:]])
+    assert (np.abs(sides[..., :3]).max(axis=-1) > 60).mean() > 0.2

@@ -277,7 +277,12 @@ void main() {
 #ifdef COILY
     // Coily hair gathers into clumps of coils a few millimetres across, placed on the
     // neutral head: their crevices fall dark and the outline breaks up around them.
-    float coil_clump = value_noise3(v_rest * 18.0 + 1.0);
+    // (Two lattices turned against each other and the head's axes: one axis-aligned lattice drew
+    // its grid as rows of bricks where the surface faces the camera.)
+    const mat3 turn_a = mat3(0.788, 0.418, -0.452, -0.360, 0.908, 0.214, 0.500, -0.017, 0.866);
+    const mat3 turn_b = mat3(0.643, -0.543, 0.540, 0.766, 0.456, -0.453, 0.000, 0.705, 0.709);
+    float coil_clump = 0.5 + 1.3 * (0.5 * (value_noise3(turn_a * v_rest * 18.0 + 1.0)
+                                           + value_noise3(turn_b * v_rest * 18.0 + 7.0)) - 0.5);
     float px = 0.5;
 #else
     float px = u_along_v > 0.5 ? pixel_strands_uv(v_uv, vec2(40.0, 1.5), vec2(5.0, 5.0) + 2.0 * phase)
@@ -287,9 +292,12 @@ void main() {
     // ends in tapered strands, not in blocks cut by the shoulders or the image's edge.
     float ends = (v_rest.y - u_end_height) / u_end_fade;
     if (ends < 1.0) {
-        float length_at = 0.05 + 0.9 * px;
-        alpha *= smoothstep(length_at - 0.15, length_at + 0.15, ends) * smoothstep(0.15, 0.5, ends);
+        // (inner layers end higher, behind the outer ones: their shaded ends showed through
+        // the outer layer's tips as dark blots)
+        float length_at = 0.05 + 0.9 * px + 0.5 * (1.0 - smoothstep(0.3, 0.9, v_depth));
+        alpha *= smoothstep(length_at - 0.05, length_at + 0.35, ends) * smoothstep(0.15, 0.5, ends);
     }
+    float px_full = px;
     if (u_along_v > 0.5) px = mix(0.5, px, 0.4);
 #endif
     // The hair's outline: where the volume turns away from the eye, its outer strands stand
@@ -303,8 +311,14 @@ void main() {
     // dense base the tufts grow from: neither frays.
     float rag = 0.45 * px + 0.3 * mid + 0.25 * clump;
     float fray = outline * (1.0 - strand_mask) * 0.9;
-    fray = 1.0 - (1.0 - fray) * (1.0 - smoothstep(0.45, 0.75, v_edge + 0.7 * (0.5 - rag)));
+    fray = 1.0 - (1.0 - fray) * (1.0 - smoothstep(0.3, 0.75, v_edge + 0.9 * (0.5 - rag)));
     alpha *= 1.0 - fray * (1.0 - u_coil);
+    // A card seen edge-on at the outline (its own face, not the volume's, turned away) is a
+    // line a pixel wide standing off the mass: it fades, so the outline does not draw strokes
+    // around the head.
+    vec3 card_normal = cross(dFdx(v_pos), dFdy(v_pos));
+    float face_on = abs(dot(card_normal, v)) / max(length(card_normal), 1e-12);
+    alpha *= mix(1.0, smoothstep(0.06, 0.3, face_on), smoothstep(0.3, 0.8, outline));
 #ifdef COILY
     {
         // Coily hair's outline breaks up in curls (placed on the neutral face, see below):
@@ -315,6 +329,9 @@ void main() {
         // silhouette is lumpy, not a smooth dome.
         float lumps = 1.0 - smoothstep(0.05, 0.45, dot(n, v));
         alpha *= 1.0 - u_coil * lumps * (1.0 - smoothstep(0.3, 0.6, coil_clump));
+        // The cards' thin margins (the blended pass: the hairline, the temples) break into
+        // curls with skin between them instead of lying over the skin as a pale glassy film.
+        alpha *= mix(1.0, smoothstep(0.4, 0.6, halo), u_coil * (1.0 - smoothstep(0.3, 0.6, alpha)));
     }
 #endif
     // Over a thinning hairline (v_cover < 1, see facsim/head/scalp.py) the cards break up into
@@ -386,6 +403,10 @@ void main() {
     }
 #else
     albedo = hair_colour(v_uv * vec2(45.0, 1.2) + 7.0 + 0.5 * phase) * strand;
+    // Greying hair: white, grey and dark strands side by side at the pixel scale too (the
+    // clump-scale mix above fades to one flat grey at stimulus sizes).
+    if (u_grey > 0.0)
+        albedo = mix(albedo, mix(u_pigment, u_white, clamp(u_grey + 0.9 * (px_full - 0.5), 0.0, 1.0)) * strand, 0.7);
 #endif
     // Depth in the volume: layers near the scalp lie under the outer ones and get little
     // light (roots and the under-layers darker), the gaps between clumps are darker still.
@@ -425,8 +446,10 @@ void main() {
     float th2 = dot(normalize(t + (-0.1 + jitter) * n), h);
     float s1 = max(1.0 - th1 * th1, 1e-6);   // sin^2
     float s2 = max(1.0 - th2 * th2, 1e-6);
-    float strands = smoothstep(0.25, 0.7, fine) * smoothstep(0.3, 0.65, tex.r) * smoothstep(0.2, 0.7, mid)
-                  * mix(0.5, 1.0, clump) * smoothstep(0.35, 0.7, px) * 1.6;
+    // (The finer UV scales fade to their means at stimulus sizes: they only modulate, and the
+    // pixel-scale strands px break the band, so it reads at 512² as strands catching the light.)
+    float strands = mix(0.55, 1.0, smoothstep(0.25, 0.7, fine) * smoothstep(0.2, 0.7, mid))
+                  * smoothstep(0.3, 0.65, tex.r) * mix(0.5, 1.0, clump) * smoothstep(0.3, 0.75, px) * 1.5;
     float sparkle = smoothstep(0.45, 0.75, fine) * smoothstep(0.4, 0.7, mid) * smoothstep(0.4, 0.75, px);
     vec3 tint = mix(vec3(1.0), u_color / max(max(u_color.r, u_color.g), max(u_color.b, 1e-4)), 0.5);
     // Light hair's own diffuse is bright already: a full-strength white lobe on it reads as
