@@ -38,8 +38,8 @@ TONGUE_BELOW_TEETH = 0.012
 #: behind it), so an open mouth (26, 27, surprise) showed the tongue as a ramp rising to the
 #: upper teeth, a pink wall filling the whole opening. In photographs of open mouths the
 #: tongue lies low behind the lower teeth and the dark cavity opens above it.
-TONGUE_FALL = 0.6
-TONGUE_FALL_ALONG = (0.1, 0.6)
+TONGUE_FALL = 0.8
+TONGUE_FALL_ALONG = (0.1, 0.5)
 #: The upper teeth rest this far (dm) lower than hm08 puts them, in young adults. hm08
 #: hides the upper incisors 1 mm above the lips' meeting line, so a mouth that opened by
 #: the jaw alone (26, 27) showed no upper teeth; a relaxed young adult shows 2–3 mm of them
