@@ -376,14 +376,14 @@ void main() {
     vec3 r1 = cross(dpdy, n), r2 = cross(n, dpdx);
     float det = dot(dpdx, r1);
     vec3 n_smooth = n;
-    // The grooves' slopes (up to ~3 mm deep, dm) come from the map alone, their depth held
+    // The grooves' slopes (up to ~2.5 mm deep, dm) come from the map alone, their depth held
     // constant across them: the wrinkle amount is interpolated per triangle, and its slope
     // broke the grooves into facets where 6 squeezes the outer eye corner. They fade out where
     // they would be narrower than about two pixels (a pre-filter: the slope is constant over
     // each 2x2 pixel quad, so narrower grooves would break into light and dark blocks).
     vec2 texel = v_uv * vec2(textureSize(u_folds, 0));
     float groove_px = FOLD_TEXELS / max(max(length(dFdx(texel)), length(dFdy(texel))), 1e-6);
-    vec2 depth = vec2(-0.024 * line_depth, -0.006 * u_age) * clamp(groove_px - 1.5, 0.0, 1.0);
+    vec2 depth = vec2(-0.018 * line_depth, -0.006 * u_age) * clamp(groove_px - 1.5, 0.0, 1.0);
     float dh_dx = dot(dFdx(folds.rg), depth), dh_dy = dot(dFdy(folds.rg), depth);
     n = normalize(abs(det) * n - sign(det) * (dh_dx * r1 + dh_dy * r2));
 #ifdef USE_WRINKLE
