@@ -415,16 +415,17 @@ void main() {
     // the 2x2-quad derivative is smooth) tilts the normal a little, which breaks the sheen
     // into the irregular highlights of real skin instead of a plastic glaze.
     // Pores show at this size too where they are largest (nose, the cheeks beside it: tone.b),
-    // as a speckle of small pits about a millimetre apart that darken a little and break
-    // the sheen; faded to nothing where they would be finer than a pixel.
+    // as a faint speckle of small pits about a millimetre apart that darken a little and break
+    // the sheen; faded to nothing where they would be finer than a pixel. (Shallow: pixel-sized
+    // pits as deep as a pore read as red dots, blotchy skin.)
     // (The grain's own peaks, so no further noise is evaluated; it is already faded to its
     // flat mean where it would be finer than a pixel.)
     float pit = smoothstep(0.64, 0.9, grain) * smoothstep(0.3, 0.9, tone.b) * (1.0 - paint.g) * (1.0 - hair);
-    float relief_h = mottle - 1.0 * pit;
+    float relief_h = mottle - 0.6 * pit;
     vec3 grad = sign(det) * (dFdx(relief_h) * r1 + dFdy(relief_h) * r2);
     float relief = (0.0012 + 0.0008 * u_age) * (0.5 + tone.b) * (1.0 - paint.g) * (1.0 - hair);
     vec3 bumped = normalize(abs(det) * n - relief * grad);
-    cavity *= 1.0 - 0.07 * pit;
+    cavity *= 1.0 - 0.04 * pit;
     float spec_break = 1.0 - 0.7 * pit;   // pores hold no oil film facing the light
 #endif
     // The lips' furrows are grooves (~0.1 mm deep), not only darker lines: their slopes catch
