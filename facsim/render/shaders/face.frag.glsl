@@ -202,7 +202,8 @@ const float ANTERIOR_CHAMBER = 0.15;
 const float CORNEA_INDEX = 1.376;
 const int IRIS_FIBRES = 96;        // radial noise cells around the iris
 const float COLLARETTE = 0.33;     // where the collarette lies across the iris annulus (0 pupil, 1 rim)
-const vec2 CARUNCLE = vec2(0.5, 0.58);   // nasal e.x where the caruncle begins and is full
+const vec2 CARUNCLE = vec2(0.5, 0.58);
+const float IRIS_CAUSTIC = 0.5;    // how much brighter the iris's lower rim is (the key is above)   // nasal e.x where the caruncle begins and is full
 // The key's reflection in the cornea: the softbox's half-size (radians, across and up) and
 // strength; the room's faint reflection over the whole cornea. (Issue 13: at 0.22 x 0.19
 // with the fill's at 0.6, two large bright patches read as glossy doll's eyes.)
@@ -533,8 +534,10 @@ void main() {
     // Stroma: fine radial fibres (long along the radius, narrow around it), coarser bundles,
     // faded to their mean where they would be finer than a pixel (small images stay calm).
     float fibre_detail = clamp(1.6 - 0.6 * fwidth(turns), 0.0, 1.0);
-    float fibre = 0.55 * value_noise(vec2(turns, t * 3.0), IRIS_FIBRES)
-                + 0.3 * value_noise(vec2(turns * 2.0, t * 1.5 + 3.0), IRIS_FIBRES * 2)
+    // (The fibres wander: evenly spaced straight spokes read as a wheel of glass.)
+    float wander = 1.6 * (value_noise(vec2(turns * 0.125, t * 4.0 + 21.0), IRIS_FIBRES / 8) - 0.5);
+    float fibre = 0.55 * value_noise(vec2(turns + wander, t * 3.0), IRIS_FIBRES)
+                + 0.3 * value_noise(vec2(turns * 2.0 + 2.0 * wander, t * 1.5 + 3.0), IRIS_FIBRES * 2)
                 + 0.15 * value_noise(vec2(turns * 0.25, t * 6.0 + 11.0), IRIS_FIBRES / 4);
     fibre = mix(0.5, fibre, fibre_detail);
     // The collarette, a third of the way out, is a wavy ridge (it zigzags around the iris):
@@ -559,6 +562,10 @@ void main() {
     iris *= 1.0 - 0.3 * crypt;
     iris *= mix(0.45, 1.0, smoothstep(0.0, 0.08, t));                 // pupillary ruff
     iris *= mix(1.0, 0.2, smoothstep(1.0 - LIMBUS_WIDTH, 1.0, t));    // limbal ring
+    // The cornea gathers the key's light from above onto the iris's lower part (the limbal
+    // caustic): in photographs the iris glows below its pupil and darkens under the upper lid,
+    // where a flat, evenly lit disc read as glass.
+    iris *= 1.0 + IRIS_CAUSTIC * smoothstep(0.0, 0.9, -seen.y / IRIS_RADIUS) * smoothstep(0.25, 0.75, t);
     // The pupil is not ink: the lens behind it returns a little light (and the cornea in
     // front reflects the room, below).
     vec3 pupil = max(u_pupil, vec3(0.006, 0.0055, 0.0055)) * mix(1.3, 0.8, smoothstep(0.0, 0.8, ri / PUPIL_RADIUS));
