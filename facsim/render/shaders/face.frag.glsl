@@ -347,7 +347,7 @@ void main() {
     // colour with an even edge read as a rubber mask).
     lip_col = mix(mix(albedo, u_lips, 0.6), lip_col, lip_core);
     albedo = mix(albedo, lip_col, smoothstep(0.0, 1.0, lips));
-    albedo *= 1.0 + 0.07 * border * (1.0 - u_age);
+    albedo *= 1.0 + 0.03 * border * (1.0 - u_age);   // (faint: a bright rim outlined the lips)
 #ifdef USE_BROWS
     vec2 brow = brow_hair(v_uv, paint.r);
 #else
