@@ -39,7 +39,7 @@ EYE_CENTRE = (0.308, 7.284, 1.245)
 
 FOLD_SIZE = (1024, 512)  # rows (v), columns (u) over assets.PAINT_UV_BOX: a texel is ~0.8 mm on the face
 #: Bump when the fold recipe changes, so cached fold maps are redone.
-FOLD_VERSION = 1
+FOLD_VERSION = 2  # 2: forehead lines unevenly spaced, wavy and broken
 
 
 @lru_cache(maxsize=2)
@@ -202,19 +202,28 @@ def _groove(distance, width):
 
 
 def forehead_line_density(positions: np.ndarray) -> np.ndarray:
-    """Four gently arched forehead lines, each its own depth and extent, fading at their ends."""
+    """Five gently arched forehead lines, as on a real forehead: unevenly spaced, wavy (a few
+    millimetres up and down along their length), each its own depth, deepest in the middle
+    rows, and broken into two or three stretches that fade out and restart. Evenly spaced,
+    straight, unbroken lines of one depth read as drawn on (issue: "painted forehead lines")."""
     x, y, z = positions[..., 0], positions[..., 1], positions[..., 2]
     ax = np.abs(x)
     rng = np.random.default_rng(13)   # fixed: the lines are part of the head model
     out = np.zeros(np.shape(x))
-    for k in range(4):
-        height = 7.57 + 0.075 * k + rng.uniform(-0.01, 0.01)
-        sway = rng.uniform(0.004, 0.01) * np.sin(rng.uniform(3, 6) * x + rng.uniform(0, 2 * np.pi))
+    for k in range(5):
+        height = 7.56 + 0.065 * k + rng.uniform(-0.008, 0.008)
+        # Two swaying waves, one slow and one quicker; each line's own.
+        sway = (rng.uniform(0.006, 0.012) * np.sin(rng.uniform(3, 5) * x + rng.uniform(0, 2 * np.pi))
+                + rng.uniform(0.002, 0.005) * np.sin(rng.uniform(9, 14) * x + rng.uniform(0, 2 * np.pi)))
         across = y - 0.12 * ax ** 2 - sway - height
-        reach = rng.uniform(0.25, 0.42)
-        along = (0.7 + 0.3 * np.sin(rng.uniform(5, 9) * x + rng.uniform(0, 2 * np.pi))) \
+        reach = rng.uniform(0.22, 0.4)
+        # Depth along the line: two slow waves, so it fades out and restarts in places.
+        along = np.clip(0.75 + 0.35 * np.sin(rng.uniform(5, 8) * x + rng.uniform(0, 2 * np.pi))
+                        + 0.15 * np.sin(rng.uniform(12, 16) * x + rng.uniform(0, 2 * np.pi)), 0, 1) \
             * smoothstep(reach, reach - 0.18, ax)
-        out = np.maximum(out, rng.uniform(0.55, 0.9) * _groove(across, 0.026) * along)
+        depth = rng.uniform(0.55, 0.9) * (1.0 - 0.35 * abs(k - 2) / 2)
+        width = 0.03 * rng.uniform(0.85, 1.2)
+        out = np.maximum(out, depth * _groove(across, width) * along)
     return np.clip(out * smoothstep(1.1, 1.3, z), 0, 1).astype(np.float32)
 
 

@@ -202,7 +202,8 @@ const float ANTERIOR_CHAMBER = 0.15;
 const float CORNEA_INDEX = 1.376;
 const int IRIS_FIBRES = 96;        // radial noise cells around the iris
 const float COLLARETTE = 0.33;     // where the collarette lies across the iris annulus (0 pupil, 1 rim)
-const vec2 CARUNCLE = vec2(0.5, 0.58);   // nasal e.x where the caruncle begins and is full
+const vec2 CARUNCLE = vec2(0.5, 0.58);
+const float IRIS_CAUSTIC = 0.5;    // how much brighter the iris's lower rim is (the key is above)   // nasal e.x where the caruncle begins and is full
 // The key's reflection in the cornea: the softbox's half-size (radians, across and up) and
 // strength; the room's faint reflection over the whole cornea. (Issue 13: at 0.22 x 0.19
 // with the fill's at 0.6, two large bright patches read as glossy doll's eyes.)
@@ -346,7 +347,7 @@ void main() {
     // colour with an even edge read as a rubber mask).
     lip_col = mix(mix(albedo, u_lips, 0.6), lip_col, lip_core);
     albedo = mix(albedo, lip_col, smoothstep(0.0, 1.0, lips));
-    albedo *= 1.0 + 0.07 * border * (1.0 - u_age);
+    albedo *= 1.0 + 0.03 * border * (1.0 - u_age);   // (faint: a bright rim outlined the lips)
 #ifdef USE_BROWS
     vec2 brow = brow_hair(v_uv, paint.r);
 #else
@@ -376,14 +377,14 @@ void main() {
     vec3 r1 = cross(dpdy, n), r2 = cross(n, dpdx);
     float det = dot(dpdx, r1);
     vec3 n_smooth = n;
-    // The grooves' slopes (up to ~3 mm deep, dm) come from the map alone, their depth held
+    // The grooves' slopes (up to ~2.5 mm deep, dm) come from the map alone, their depth held
     // constant across them: the wrinkle amount is interpolated per triangle, and its slope
     // broke the grooves into facets where 6 squeezes the outer eye corner. They fade out where
     // they would be narrower than about two pixels (a pre-filter: the slope is constant over
     // each 2x2 pixel quad, so narrower grooves would break into light and dark blocks).
     vec2 texel = v_uv * vec2(textureSize(u_folds, 0));
     float groove_px = FOLD_TEXELS / max(max(length(dFdx(texel)), length(dFdy(texel))), 1e-6);
-    vec2 depth = vec2(-0.024 * line_depth, -0.006 * u_age) * clamp(groove_px - 1.5, 0.0, 1.0);
+    vec2 depth = vec2(-0.018 * line_depth, -0.006 * u_age) * clamp(groove_px - 1.5, 0.0, 1.0);
     float dh_dx = dot(dFdx(folds.rg), depth), dh_dy = dot(dFdy(folds.rg), depth);
     n = normalize(abs(det) * n - sign(det) * (dh_dx * r1 + dh_dy * r2));
 #ifdef USE_WRINKLE
@@ -415,16 +416,17 @@ void main() {
     // the 2x2-quad derivative is smooth) tilts the normal a little, which breaks the sheen
     // into the irregular highlights of real skin instead of a plastic glaze.
     // Pores show at this size too where they are largest (nose, the cheeks beside it: tone.b),
-    // as a speckle of small pits about a millimetre apart that darken a little and break
-    // the sheen; faded to nothing where they would be finer than a pixel.
+    // as a faint speckle of small pits about a millimetre apart that darken a little and break
+    // the sheen; faded to nothing where they would be finer than a pixel. (Shallow: pixel-sized
+    // pits as deep as a pore read as red dots, blotchy skin.)
     // (The grain's own peaks, so no further noise is evaluated; it is already faded to its
     // flat mean where it would be finer than a pixel.)
     float pit = smoothstep(0.64, 0.9, grain) * smoothstep(0.3, 0.9, tone.b) * (1.0 - paint.g) * (1.0 - hair);
-    float relief_h = mottle - 1.0 * pit;
+    float relief_h = mottle - 0.6 * pit;
     vec3 grad = sign(det) * (dFdx(relief_h) * r1 + dFdy(relief_h) * r2);
     float relief = (0.0012 + 0.0008 * u_age) * (0.5 + tone.b) * (1.0 - paint.g) * (1.0 - hair);
     vec3 bumped = normalize(abs(det) * n - relief * grad);
-    cavity *= 1.0 - 0.07 * pit;
+    cavity *= 1.0 - 0.04 * pit;
     float spec_break = 1.0 - 0.7 * pit;   // pores hold no oil film facing the light
 #endif
     // The lips' furrows are grooves (~0.1 mm deep), not only darker lines: their slopes catch
@@ -532,8 +534,10 @@ void main() {
     // Stroma: fine radial fibres (long along the radius, narrow around it), coarser bundles,
     // faded to their mean where they would be finer than a pixel (small images stay calm).
     float fibre_detail = clamp(1.6 - 0.6 * fwidth(turns), 0.0, 1.0);
-    float fibre = 0.55 * value_noise(vec2(turns, t * 3.0), IRIS_FIBRES)
-                + 0.3 * value_noise(vec2(turns * 2.0, t * 1.5 + 3.0), IRIS_FIBRES * 2)
+    // (The fibres wander: evenly spaced straight spokes read as a wheel of glass.)
+    float wander = 1.6 * (value_noise(vec2(turns * 0.125, t * 4.0 + 21.0), IRIS_FIBRES / 8) - 0.5);
+    float fibre = 0.55 * value_noise(vec2(turns + wander, t * 3.0), IRIS_FIBRES)
+                + 0.3 * value_noise(vec2(turns * 2.0 + 2.0 * wander, t * 1.5 + 3.0), IRIS_FIBRES * 2)
                 + 0.15 * value_noise(vec2(turns * 0.25, t * 6.0 + 11.0), IRIS_FIBRES / 4);
     fibre = mix(0.5, fibre, fibre_detail);
     // The collarette, a third of the way out, is a wavy ridge (it zigzags around the iris):
@@ -558,6 +562,10 @@ void main() {
     iris *= 1.0 - 0.3 * crypt;
     iris *= mix(0.45, 1.0, smoothstep(0.0, 0.08, t));                 // pupillary ruff
     iris *= mix(1.0, 0.2, smoothstep(1.0 - LIMBUS_WIDTH, 1.0, t));    // limbal ring
+    // The cornea gathers the key's light from above onto the iris's lower part (the limbal
+    // caustic): in photographs the iris glows below its pupil and darkens under the upper lid,
+    // where a flat, evenly lit disc read as glass.
+    iris *= 1.0 + IRIS_CAUSTIC * smoothstep(0.0, 0.9, -seen.y / IRIS_RADIUS) * smoothstep(0.25, 0.75, t);
     // The pupil is not ink: the lens behind it returns a little light (and the cornea in
     // front reflects the room, below).
     vec3 pupil = max(u_pupil, vec3(0.006, 0.0055, 0.0055)) * mix(1.3, 0.8, smoothstep(0.0, 0.8, ri / PUPIL_RADIUS));
