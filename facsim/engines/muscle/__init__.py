@@ -35,9 +35,11 @@ from facsim.engines.muscle.wrinkles import build_wrinkles, wrinkle_field
 
 __all__ = ["MuscleEngine", "simulated_codes", "coverage"]
 
-#: Increments of a static solve (Platt & Badler's n) and iterations per increment.
+#: Increments of a static solve (Platt & Badler's n) and iterations per increment at most ...
 STATIC_STEPS = 2
-STATIC_ITERATIONS = 20
+STATIC_ITERATIONS = 30
+#: ... an increment ends when the net force left on the points is below this share of what it added.
+STATIC_RESIDUAL = 0.02
 #: A static solve takes one more increment per this many degrees of jaw opening.
 JAW_DEGREES_PER_STEP = 10.0
 #: At most this many extra rounds of iterations for a static solve that ends with folded skin.
@@ -45,7 +47,7 @@ POLISH_ROUNDS = 5
 #: Expressions solved together by :meth:`MuscleEngine.solve_many`.
 BATCH = 4
 #: Iterations per animation frame (the state carries over, so frames converge over time).
-FRAME_ITERATIONS = 1
+FRAME_ITERATIONS = 2
 
 
 def simulated_codes() -> set[int]:
@@ -300,12 +302,12 @@ def solve_static(model, target, *, steps: int, iterations: int) -> solver.State:
     """An expression from rest in ``steps`` increments; where the skin is still folded through
     itself at the end (a big change not yet relaxed), keep relaxing, a few rounds at most."""
     state = solver.solve(model, solver.rest_state(model, target.muscle.shape[0]), target, steps=steps,
-                         iterations=iterations)
+                         iterations=iterations, residual=STATIC_RESIDUAL)
     for _ in range(POLISH_ROUNDS):
         folded = solver.folded(model, state.x) > 0
         if not folded.any():
             break
-        more = solver.solve(model, state, target, steps=1, iterations=iterations)
+        more = solver.solve(model, state, target, steps=1, iterations=iterations, residual=STATIC_RESIDUAL)
         # Only the folded ones take the extra round (so a batch solves each alike to alone).
         state = solver.State(np.where(folded[None, :, None], more.x, state.x), target,
                              np.where(folded[:, None], more.jaw, state.jaw))
