@@ -147,6 +147,14 @@ def test_bilateral_aus_are_symmetric(single, head, code):
     assert np.abs(p[head.mirror[skin]] * [-1, 1, 1] - p[skin]).max() < 1e-3  # 0.1 mm
 
 
+#: The other side moves less than this share of the acting side's most ...
+SPILL = 0.25
+#: ... except where a unilateral action stretches the lips, one band from corner to corner: its other
+#: half is drawn toward the acting corner (L20 on noah, settled: the corner 10.5 mm, the other
+#: half of the lips 3.0 mm, the other corner 1.4 mm).
+LIP_SPILL = {20: 0.3}
+
+
 @pytest.mark.parametrize("code", [1, 2, 4, 6, 12, 15, 20, 46])
 def test_unilateral_aus_move_only_their_side(engine, code):
     left, right = engine.solve_many([activations(parse(f"L{code}")), activations(parse(f"R{code}"))])
@@ -154,7 +162,7 @@ def test_unilateral_aus_move_only_their_side(engine, code):
     for moved, own, other in ((left, x > 0.05, x < -0.15), (right, x < -0.05, x > 0.15)):
         delta = np.linalg.norm(moved - engine.neutral, axis=1)
         assert delta[own].max() > 0.01
-        assert delta[other].max() < 0.25 * delta[own].max()
+        assert delta[other].max() < LIP_SPILL.get(code, SPILL) * delta[own].max()
 
 
 def test_masking_cheek_raiser_after_smile_lifts_the_corner_less(engine, marks):

@@ -221,3 +221,104 @@ def test_raised_brows_lift_the_forehead_level_across_the_midline(engine, head):
         x, rise = np.abs(rest[band, 0]), moved[band, 1] - rest[band, 1]
         midline, beside = rise[x < 0.05].mean(), rise[(x > 0.1) & (x < 0.22)].mean()
         assert midline > 0.65 * beside, (low, midline, beside)
+
+
+def test_force_length_relation_is_full_above_its_range_and_none_below():
+    from facsim.engines.muscle.solver import force_length
+
+    ratio = np.linspace(0.2, 1.3, 221)
+    f, phi = force_length(ratio, (0.45, 0.8))
+    assert np.all(f[ratio <= 0.45] == 0.0) and np.all(f[ratio >= 0.8] == 1.0)
+    assert np.all(np.diff(f) >= 0.0)
+    # Φ is the integral of f (the fiber's energy is T L₀ Φ, its force T f).
+    h = 1e-6
+    numeric = (force_length(ratio + h, (0.45, 0.8))[1] - force_length(ratio - h, (0.45, 0.8))[1]) / (2 * h)
+    assert np.allclose(numeric, f, atol=1e-6)
+
+
+def _segment_ratios(model, state, drive):
+    from facsim.engines.muscle import solver
+
+    ld = solver.loads(model, drive)
+    x = state.x
+    pa, pb = solver._apply(model.seg_a, x), solver._apply(model.seg_b, x)
+    ba, bb = model.seg_bone_a >= 0, model.seg_bone_b >= 0
+    pa[:, :, ba] = ld.bone[:, :, model.seg_bone_a[ba]]
+    pb[:, :, bb] = ld.bone[:, :, model.seg_bone_b[bb]]
+    length = np.sqrt(solver._dot(pb - pa, pb - pa))
+    return length / model.seg_rest, solver._per_row(model.fiber_sum, length) / model.fiber_rest
+
+
+@pytest.mark.parametrize("text", ["12", "6+12", "4", "9", "15"])
+def test_strong_contractions_settle_without_collapsing(engine, model, text):
+    """Each fiber settles inside its active range (its force falls off as it shortens) and no
+    segment of a muscle's path is shorter than the guard (issue 13: zygomaticus major's point
+    ran onto its pulley, its segment at 28 % of its rest length)."""
+    act = activations(parse(text))
+    (_, state, b), = engine.static_states([act])
+    drive = _drive(model, text)
+    segment, fiber = _segment_ratios(model, solver_state(state, b), drive)
+    assert segment.min() > model.segment_guard - 0.02
+    assert fiber.min() > model.active_range[0]
+
+
+def solver_state(state, b):
+    from facsim.engines.muscle import solver
+
+    return solver.State(state.x[:, b:b + 1], state.drive, state.jaw[b:b + 1])
+
+
+def test_gradient_matches_finite_differences_where_fibers_are_short(engine, model):
+    """The force-length relation's fall-off and the segment guard (active on a solved smile)."""
+    from facsim.engines.muscle import solver
+
+    (_, state, b), = engine.static_states([activations(parse("12"))])
+    ld = solver.loads(model, _drive(model, "12"))
+    x = state.x[:, b:b + 1]
+    segment, fiber = _segment_ratios(model, solver_state(state, b), _drive(model, "12"))
+    assert fiber.min() < model.active_range[1]  # some fiber is on the fall-off
+    # (The muscles' share of the energy: the whole energy has kinks at a solved face — arcs at
+    # their rest length, contacts — where a finite difference is not the derivative.)
+    rng = np.random.default_rng(3)
+    _, grad = solver.load_energy(model, x, ld)
+    v = rng.standard_normal(x.shape)
+    h = 1e-6
+    numeric = (solver.load_energy(model, x + h * v, ld)[0] - solver.load_energy(model, x - h * v, ld)[0]) / (2 * h)
+    assert numeric[0] == pytest.approx((grad * v).sum(), rel=1e-5)
+
+
+def test_skin_is_stiffer_where_muscles_insert(model):
+    """Skin arcs at the centre of a linear muscle's insertion are ``insertion_skin`` times stiffer."""
+    from facsim.engines.muscle.net import load_spec
+
+    factor = load_spec()["net"]["insertion_skin"]
+    net, layer = model.net, model.layer
+    centre = set(layer.head_ids[layer.head_weight == 1.0].tolist())
+    base = net.arcs.k
+    stiff = model.arc_k[: len(base)] / base
+    both = np.array([i in centre and j in centre for i, j in zip(net.arcs.i, net.arcs.j)])
+    neither = ~np.isin(net.arcs.i, layer.head_ids) & ~np.isin(net.arcs.j, layer.head_ids)
+    assert both.any() and np.allclose(stiff[both], factor)
+    assert np.allclose(stiff[neither], 1.0)
+
+
+def test_an_increment_stops_once_its_residual_is_small(model, monkeypatch):
+    """The minimiser stops a configuration when the force left on the points is below the
+    ``residual`` share of what the increment added (and iterates on without it)."""
+    from facsim.engines.muscle import solver
+
+    calls = []
+    real = solver.energy
+    monkeypatch.setattr(solver, "energy", lambda *a, **k: calls.append(1) or real(*a, **k))
+    drive = _drive(model, "12")
+    loose = solver.solve(model, solver.rest_state(model), drive, steps=1, iterations=60, residual=0.5, settle=False)
+    short = len(calls)
+    calls.clear()
+    solver.solve(model, solver.rest_state(model), drive, steps=1, iterations=60, residual=0.0, settle=False)
+    assert short < len(calls)
+    ld = solver.loads(model, drive)
+    floors = solver.select_sites(model, loose.x, ld)
+    _, g = real(model, loose.x, ld)
+    held = solver._hold_on_contacts(model, g.copy(), solver._gaps(model, loose.x, floors), floors, sign=1.0)
+    _, g0 = real(model, solver.rest_state(model).x, ld)
+    assert np.linalg.norm(held) <= 0.5 * np.linalg.norm(g0)

@@ -141,14 +141,27 @@ class RigidMotion:
 
         return Rotation.from_rotvec(head_motion(act.level)[0]).as_matrix()
 
-    def move_head(self, positions: np.ndarray, act) -> np.ndarray:
-        """Rigid head motion (51–58) blended smoothly into the neck; float32 positions."""
+    def weight_at(self, positions: np.ndarray) -> np.ndarray:
+        """The neck blend (N_geo, 1) read where the points of ``positions`` are now, not at rest.
+
+        Points that an expression brought together then follow the head alike: under a wide-open
+        jaw (27) the lower lip, 11 mm tall at rest, is pressed to 3 mm, and on faces whose lips sit
+        in the blend (george) their rest weights, 0.19 and 0.36, turned it inside out under 54.
+        """
+        return neck_weight(self.head, np.asarray(positions), self.base_positions)[:, None]
+
+    def move_head(self, positions: np.ndarray, act, weight: np.ndarray | None = None) -> np.ndarray:
+        """Rigid head motion (51–58) blended smoothly into the neck; float32 positions.
+
+        ``weight`` (N_geo, 1): how much each point follows the head; the rest blend by default
+        (:meth:`weight_at` reads it where the points are)."""
         from scipy.spatial.transform import Rotation
 
         rotvec, shift = head_motion(act.level)
         if not rotvec.any() and not shift.any():
             return positions
+        weight = self.weight if weight is None else weight
         # Interpolate the rotation angle per vertex (not the moved positions), so the neck twists smoothly.
         rel = positions - self.pivot
-        moved = Rotation.from_rotvec(self.weight * rotvec[None, :]).apply(rel) + self.pivot + self.weight * shift
+        moved = Rotation.from_rotvec(weight * rotvec[None, :]).apply(rel) + self.pivot + weight * shift
         return moved.astype(np.float32)

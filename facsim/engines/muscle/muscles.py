@@ -70,6 +70,11 @@ class MuscleLayer:
     arcs : Arcs
         Insertion arcs (muscle point ↔ skin heads), guide couplings, passive bellies.
     seg_a, seg_b, seg_muscle, seg_weight : (S,) chain segments and their muscle/fiber share.
+    seg_fiber : (S,) int
+        The fiber each segment belongs to (a linear muscle's fiber, or a sphincter's whole chain):
+        a fiber's force-length relation is read on its whole path's length.
+    head_ids, head_weight : (H,) skin heads of the linear muscles' insertions into the skin and their
+        weight in the insertion's patch (1 at its centre); the skin is stiffer there.
     bone_points, bone_on_jaw : (P, 3), (P,) bool.
     relax_node, relax_dir, relax_muscle, relax_weight : where a relaxing muscle's tone is released.
     jaw_action : (M, 3)
@@ -102,6 +107,9 @@ class MuscleLayer:
     bulge_vec: np.ndarray
     bulge_muscle: np.ndarray
     clench: np.ndarray = None    # (M,) bool: contracting it presses the teeth together
+    seg_fiber: np.ndarray = None
+    head_ids: np.ndarray = None
+    head_weight: np.ndarray = None
 
     def index(self, name: str, side: str) -> int:
         """Index of muscle ``name`` on ``side`` (midline muscles answer for both sides)."""
@@ -119,7 +127,9 @@ class _Builder:
         self.n_skin = net.count
         self.nodes, self.parent, self.floor = [], [], []
         self.arcs = {k: [] for k in ("i", "j", "rest", "k", "beta", "compress")}
-        self.seg = {k: [] for k in ("a", "b", "muscle", "weight")}
+        self.seg = {k: [] for k in ("a", "b", "muscle", "weight", "fiber")}
+        self.fibers = 0
+        self.heads, self.head_weight = [], []
         self.bones, self.bone_jaw = [], []
         self.relax = {k: [] for k in ("node", "dir", "muscle", "weight")}
         self._outer_tree = cKDTree(net.rest[anat.outer])
@@ -149,8 +159,12 @@ class _Builder:
             return self.net.rest[ref]
         return self.nodes[ref - self.n_skin]
 
-    def segment(self, a: int, b: int, muscle: int, weight: float):
-        for key, v in zip(("a", "b", "muscle", "weight"), (a, b, muscle, weight)):
+    def new_fiber(self) -> int:
+        self.fibers += 1
+        return self.fibers - 1
+
+    def segment(self, a: int, b: int, muscle: int, weight: float, fiber: int):
+        for key, v in zip(("a", "b", "muscle", "weight", "fiber"), (a, b, muscle, weight, fiber)):
             self.seg[key].append(v)
 
     # -- selectors on the character
@@ -184,8 +198,11 @@ class _Builder:
         ids = self.anat.outer[np.atleast_1d(j)]
         return [int(self.anat.mirror[v]) if side == "right" else int(v) for v in ids]
 
-    def insertion(self, sel: dict, side: str) -> tuple[int, np.ndarray, np.ndarray]:
-        """A muscle point beneath a patch of skin heads: (node, heads, weights)."""
+    def insertion(self, sel: dict, side: str, force: float = 0.0) -> tuple[int, np.ndarray, np.ndarray]:
+        """A muscle point beneath a patch of skin heads: (node, heads, weights).
+
+        A fiber of a muscle of maximal ``force`` ties it with ``tendon × force`` more (a
+        stronger muscle has a thicker tendon)."""
         vid, _ = self.skin_point({k: v for k, v in sel.items() if k != "depth"}, side)
         kinds = (LID, SOCKET) if self.anat.kind[vid] in (LID, SOCKET) else (OUTER, LID)
         radius = sel.get("radius", 0.04)
@@ -200,7 +217,7 @@ class _Builder:
         # `stiffness` (relative) ties a strong muscle's point more firmly to its skin: through the
         # default arcs a tension T stretches them T / insertion, and zygomaticus major reached its
         # pulley (the fiber fully shortened) with the lip corner only 10 mm up (issue 13).
-        k = self.c["insertion"] * float(sel.get("stiffness", 1.0))
+        k = self.c["insertion"] * float(sel.get("stiffness", 1.0)) + self.c.get("tendon", 0.0) * force
         for h, wh in zip(heads, w):
             self.arc(node, int(h), k * wh)
         return node, heads, w
@@ -284,6 +301,9 @@ def build_muscles(anat: Anatomy, net: TensionNet, spec: dict) -> MuscleLayer:
                   arr("k"), arr("beta"), arr("compress")),
         seg_a=np.asarray(b.seg["a"], np.int64), seg_b=np.asarray(b.seg["b"], np.int64),
         seg_muscle=np.asarray(b.seg["muscle"], np.int64), seg_weight=np.asarray(b.seg["weight"], float),
+        seg_fiber=np.asarray(b.seg["fiber"], np.int64),
+        head_ids=np.concatenate(b.heads) if b.heads else np.zeros(0, np.int64),
+        head_weight=np.concatenate(b.head_weight) if b.head_weight else np.zeros(0),
         bone_points=np.asarray(b.bones, float).reshape(-1, 3), bone_on_jaw=np.asarray(b.bone_jaw, bool),
         relax_node=np.asarray(b.relax["node"], np.int64),
         relax_dir=np.asarray(b.relax["dir"], float).reshape(-1, 3),
@@ -306,10 +326,18 @@ def _linear(b: _Builder, m: dict, index: int, side: str):
         _, origin_pos = b.point(fiber["origin"], side)
         chain = [b.bone(origin_pos, on_jaw)]
         chain += [b.guide(g, side, on_jaw) for g in fiber.get("path", [])]
-        node, _, _ = b.insertion(fiber["insertion"], side)
+        node, heads, w = b.insertion(fiber["insertion"], side, force=float(m["force"]))
+        # A fiber's insertion into the skin (not a lid's tarsus), on its own side of the midline (a
+        # patch reaching across it - procerus - stiffened there dragged the other brow along).
+        skin = b.anat.kind[heads] == OUTER
+        if not m.get("midline"):
+            skin &= b.net.rest[heads, 0] * (1.0 if side == "left" else -1.0) > 0.0
+        b.heads.append(np.asarray(heads, np.int64)[skin])
+        b.head_weight.append(np.asarray(w, float)[skin] / max(float(np.max(w)), 1e-12))
         chain.append(node)
+        fiber_id = b.new_fiber()
         for p, q in zip(chain[:-1], chain[1:]):
-            b.segment(p, q, index, weight)
+            b.segment(p, q, index, weight, fiber_id)
             if p >= 0 and q >= 0:  # passive belly between muscle points
                 b.arc(p, q, b.c["muscle_passive"], beta=0.0, compress=1.0)
         direction = b.position(chain[-2]) - b.position(node)
@@ -357,12 +385,13 @@ def _sphincter(b: _Builder, m: dict, index: int, side: str, midline: bool):
     pairs = list(zip(chain[:-1], chain[1:])) + ([(chain[-1], chain[0])] if closed else [])
     bias = m.get("bias")
     centre_y = np.mean([b.position(r)[1] for r in chain])
+    fiber_id = b.new_fiber()  # the chain shortens as one
     for p, q in pairs:
         weight = 1.0
         if bias:  # segments below the ring's centre pull with `below`, above with `above`
             t = np.clip((0.5 * (b.position(p)[1] + b.position(q)[1]) - centre_y) / (0.2 * b.net.scale), -1.0, 1.0)
             weight = bias["below"] + (bias["above"] - bias["below"]) * 0.5 * (1.0 + t)
-        b.segment(p, q, index, weight)
+        b.segment(p, q, index, weight, fiber_id)
         if p >= 0 and q >= 0:
             b.arc(p, q, b.c["muscle_passive"], beta=0.0, compress=0.2)
 

@@ -6,7 +6,9 @@ The face at rest under a set of muscle actions is the minimiser of
                                                  ½ c k δ² in compression (the skin buckles)
          + ½ Σ_points k_a |x − anchor(bone)|²      soft tissue tying skin to skull or jaw
          + ½ Σ_columns k_v (A h / A₀ − d)²          tissue columns keep their volume (bulges)
-         + Σ_segments T |p_a − p_b|                muscles: tension × path length
+         + Σ_fibers T L₀ Φ(λ)                      muscles: tension × path length (λ = l/L₀, the
+                                                 fiber's path), weakening as the fiber shortens
+         + ½ Σ_segments k_g (g L − l)₊²            no muscle segment shorter than g of its rest
          + ½ Σ penalties                           lips against each other, the tongue's tip
          − Σ f · x                                  released tone, air pressure, muscle bellies
 
@@ -14,7 +16,11 @@ over the skin and muscle points ``x``, subject to one-sided contacts: the
 flesh stays above the skull (it slides over bone, not through it) and the lids
 stay outside the eyeballs. Stretched arcs stiffen, so a force added where the
 tissue is already stretched moves it little — the masking Platt & Badler
-describe (F/k → 0 as k grows).
+describe (F/k → 0 as k grows). A muscle's active force follows a force-length
+relation: full while its fiber is longer than the top of its ``active_range``
+(of the rest length), falling smoothly to nothing at the bottom, so a strong
+contraction settles instead of collapsing; a segment guard keeps each segment
+of a muscle's path above ``segment_guard`` of its rest length.
 
 The minimiser is a projected L-BFGS whose initial inverse Hessian is the
 factorised rest stiffness (the projective-dynamics system matrix: arcs,
@@ -111,6 +117,14 @@ class Model:
     seg_scatter_b: sp.csr_matrix
     seg_bone_a: np.ndarray       # ... or names its bone point (-1 if none)
     seg_bone_b: np.ndarray
+    seg_rest: np.ndarray         # (S,) rest length of each segment
+    seg_guard_k: np.ndarray      # (S,) stiffness of its guard against shortening below segment_guard
+    fiber_sum: sp.csr_matrix     # (F, S) sums a fiber's segment lengths, weighted by their share of its tension
+    fiber_of: np.ndarray         # (S,) the fiber of each segment
+    fiber_first: np.ndarray      # (F,) one segment of each fiber ...
+    fiber_rest: np.ndarray       # (F,) ... and the fiber's weighted path length at rest
+    active_range: tuple          # (shortest, full): force-length relation, in rest lengths
+    segment_guard: float         # least length of a segment, in rest lengths
     force_matrix: sp.csr_matrix  # (3N, C): constant forces per unit of each control
     tongue: TongueModel
     node_mirror: np.ndarray | None   # (N,) each point's mirror image (None: no symmetry known)
@@ -183,7 +197,7 @@ def build_model(net: TensionNet, layer: MuscleLayer, spec: dict, tongue: TongueM
     ns, q = net.count, len(layer.node_rest)
     n = ns + q
     rest = np.concatenate([net.rest, layer.node_rest])
-    arcs = Arcs.concat([net.arcs, layer.arcs])
+    arcs = Arcs.concat([_stiff_insertions(net, layer), layer.arcs])
     na = len(arcs)
     arc_diff = sp.csr_matrix((np.r_[np.ones(na), -np.ones(na)],
                               (np.r_[np.arange(na), np.arange(na)], np.r_[arcs.j, arcs.i])), shape=(na, n))
@@ -304,6 +318,14 @@ def build_model(net: TensionNet, layer: MuscleLayer, spec: dict, tongue: TongueM
     everything = np.r_[rest, layer.bone_points]
     idx = lambda ref: np.where(ref >= 0, ref, n - 1 - ref)  # noqa: E731  (bone b is row n + b)
     seg_len = np.linalg.norm(everything[idx(layer.seg_a)] - everything[idx(layer.seg_b)], axis=1)
+    fibers = int(layer.seg_fiber.max()) + 1 if len(layer.seg_fiber) else 0
+    # (A sphincter's segments may pull unequally (`bias`): its length is weighted by their shares.)
+    fiber_sum = sp.csr_matrix((layer.seg_weight, (layer.seg_fiber, np.arange(len(seg_len)))),
+                              shape=(fibers, len(seg_len)))
+    fiber_first = np.zeros(fibers, np.int64)
+    fiber_first[layer.seg_fiber[::-1]] = np.arange(len(seg_len))[::-1]
+    seg_rest = np.maximum(seg_len, 1e-6)
+    const = net.constants
     k_seg = layer.force[layer.seg_muscle] * layer.seg_weight / np.maximum(seg_len, 0.02 * net.scale)
     both = (node_a >= 0) & (node_b >= 0)
     ia, ib, kb = node_a[both], node_b[both], k_seg[both]
@@ -335,7 +357,12 @@ def build_model(net: TensionNet, layer: MuscleLayer, spec: dict, tongue: TongueM
         site_blend=0.02 * net.scale,
         lip_pairs=rim, lip_floor=np.minimum(lip_sep, 0.0), lip_k=float(np.median(net.contact_k[net.contact_k > 0])),
         seg_a=seg_a, seg_b=seg_b, seg_scatter_a=seg_a.T.tocsr(), seg_scatter_b=seg_b.T.tocsr(),
-        seg_bone_a=bone_a, seg_bone_b=bone_b, force_matrix=force_matrix, tongue=tongue,
+        seg_bone_a=bone_a, seg_bone_b=bone_b, seg_rest=seg_rest,
+        seg_guard_k=const["guard_stiffness"] * layer.force[layer.seg_muscle] * layer.seg_weight / seg_rest,
+        fiber_sum=fiber_sum, fiber_of=layer.seg_fiber, fiber_first=fiber_first,
+        fiber_rest=np.maximum(fiber_sum @ seg_rest, 1e-6),
+        active_range=tuple(float(v) for v in const["active_range"]), segment_guard=float(const["segment_guard"]),
+        force_matrix=force_matrix, tongue=tongue,
         node_mirror=node_mirror, muscle_mirror=np.array([layer.index(mu, {"left": "right", "right": "left"}.get(sd, sd))
                                                          for mu, sd in zip(layer.muscle, layer.side)]),
         stiffness=system.tocsr(), stiffness_diagonal=system.diagonal(), solve_rest=lu.solve,
@@ -347,6 +374,20 @@ def build_model(net: TensionNet, layer: MuscleLayer, spec: dict, tongue: TongueM
     skull_gap, _, _ = _gaps(model, rest_state_.x, select_sites(model, rest_state_.x, loads(model, rest_state_.drive)))
     model.contact_floor[:] -= np.maximum(skull_gap[0], 0.0)[:, None] + 1e-9 * (skull_gap[0] > 0)[:, None]
     return model
+
+
+def _stiff_insertions(net: TensionNet, layer: MuscleLayer) -> Arcs:
+    """The skin's arcs, stiffer (``insertion_skin`` times at an insertion's centre) where a
+    linear muscle inserts: the fibres interlace with the dermis there, so the patch moves
+    as a piece and the pull reaches the lip corners and cheeks instead of stretching them."""
+    factor = float(net.constants.get("insertion_skin", 1.0))
+    arcs = net.arcs
+    if factor == 1.0 or not len(layer.head_ids):
+        return arcs
+    weight = np.zeros(net.count)
+    np.maximum.at(weight, layer.head_ids, layer.head_weight)
+    near = 0.5 * (weight[arcs.i] + weight[arcs.j])
+    return Arcs(arcs.i, arcs.j, arcs.rest, arcs.k * (1.0 + (factor - 1.0) * near), arcs.beta, arcs.compress)
 
 
 def _node_mirror(rest: np.ndarray, layer: MuscleLayer, skin: int, mirror: np.ndarray) -> np.ndarray:
@@ -454,6 +495,13 @@ def _apply(matrix: sp.csr_matrix, x: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(out.T).reshape(c, b, -1)
 
 
+def _per_row(matrix: sp.csr_matrix, rows: np.ndarray) -> np.ndarray:
+    """A sparse (K, N) operator applied to each row of (B, N) → (B, K), one mat-vec per row (a
+    product with all B at once sums in another order, and a batch's solves drifted from the
+    same solves alone)."""
+    return np.stack([matrix @ row for row in np.asarray(rows)])
+
+
 def _dot(a, b):
     """Dot product over the xyz axis: (3, B, K) · (3, B, K) → (B, K)."""
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
@@ -490,7 +538,7 @@ def loads(model: Model, d: Drive) -> Loads:
     released = np.maximum(-act, 0.0) * layer.force * layer.tone      # (B, M)
     tension = contraction[:, layer.seg_muscle] * layer.seg_weight    # (B, S)
     controls = np.concatenate([released, contraction, d.pressure, d.lip_pressure[:, None]], axis=1).T
-    force = (model.force_matrix @ controls).reshape(3, model.count, B).transpose(0, 2, 1).copy()
+    force = _per_row(model.force_matrix, controls.T).T.reshape(3, model.count, B).transpose(0, 2, 1).copy()
 
     jaw = jaw_pose(layer, act, model.jaw_spec)
     rot, shift = jaw_transform(jaw, net.hinge, model.jaw_spec["yaw_per_lateral"])
@@ -588,7 +636,7 @@ def energy(model: Model, x: np.ndarray, ld: Loads):
     e1, e2 = edges[:, :, :t], edges[:, :, t:]                            # b − a, c − a
     cross = _cross(e1, e2)
     twice = np.sqrt(_dot(cross, cross))                                  # (B, T)
-    area = (model.area_matrix @ (0.5 * twice).T).T                       # (B, V)
+    area = _per_row(model.area_matrix, 0.5 * twice)                      # (B, V)
     vid = model.vol_ids
     h = _dot(x[:, :, vid] - ld.vol_anchor, ld.vol_normal)
     excess = area * h / model.vol_area - model.vol_depth
@@ -596,7 +644,7 @@ def energy(model: Model, x: np.ndarray, ld: Loads):
     total += 0.5 * (g * excess).sum(-1)
     grad[:, :, vid] += (g * area / model.vol_area) * ld.vol_normal
     # Through the areas: ∂area/∂a = ½ (b − c) × n̂, ∂/∂b = ½ (c − a) × n̂, ∂/∂c = ½ (a − b) × n̂.
-    per_tri = (model.area_scatter @ (g * h / model.vol_area).T).T       # dE/d(triangle area) (B, T)
+    per_tri = _per_row(model.area_scatter, g * h / model.vol_area)      # dE/d(triangle area) (B, T)
     unit = cross * (0.5 * per_tri / np.maximum(twice, 1e-12))
     c1, c2 = _cross(e1, unit), _cross(e2, unit)
     corners = np.concatenate([c1 - c2, c2, -c1], axis=-1)
@@ -640,19 +688,47 @@ def energy(model: Model, x: np.ndarray, ld: Loads):
     return total, grad
 
 
+def force_length(ratio: np.ndarray, active_range: tuple) -> tuple[np.ndarray, np.ndarray]:
+    """A muscle's active force-length relation f(λ) and its integral Φ(λ), λ = length / rest.
+
+    f is 1 from the top of ``active_range`` up and falls smoothly (a smoothstep) to 0 at its
+    bottom; Φ(λ) = ∫ f with Φ = 0 below the range, so a fiber of rest length L₀ under
+    tension T stores T L₀ Φ(λ) (T × its length, up to a constant, while at full force).
+
+    >>> f, phi = force_length(np.array([0.3, 0.625, 1.0]), (0.45, 0.8))
+    >>> f.round(3).tolist(), phi.round(4).tolist()
+    ([0.0, 0.5, 1.0], [0.0, 0.0328, 0.375])
+    """
+    lo, hi = active_range
+    width = hi - lo
+    t = np.clip((ratio - lo) / width, 0.0, 1.0)
+    f = t * t * (3.0 - 2.0 * t)
+    phi = width * (t ** 3 - 0.5 * t ** 4) + np.maximum(ratio - hi, 0.0)
+    return f, phi
+
+
 def load_energy(model: Model, x: np.ndarray, ld: Loads):
-    """The drive's share of the energy and gradient: muscle tension × path length, minus the
-    work of the constant forces. When only the drive changes (not the jaw), a new frame's energy
-    is the last one's with this part swapped — no full evaluation needed."""
+    """The drive's share of the energy and gradient: the muscles' work (tension × path length,
+    through the force-length relation) and their segments' guard, minus the work of the
+    constant forces. When only the drive changes (not the jaw), a new frame's energy is the
+    last one's with this part swapped — no full evaluation needed."""
     pa = _apply(model.seg_a, x)
     pb = _apply(model.seg_b, x)
     ba, bb = model.seg_bone_a >= 0, model.seg_bone_b >= 0
     pa[:, :, ba] = ld.bone[:, :, model.seg_bone_a[ba]]
     pb[:, :, bb] = ld.bone[:, :, model.seg_bone_b[bb]]
     seg = pb - pa
-    seg_len = np.sqrt(_dot(seg, seg))
-    u = seg * (ld.tension / np.maximum(seg_len, 1e-12))
-    total = (ld.tension * seg_len).sum(-1) - (ld.force * x).sum((0, 2))
+    seg_len = np.sqrt(_dot(seg, seg))                                    # (B, S)
+    ratio = _per_row(model.fiber_sum, seg_len) / model.fiber_rest        # (B, F)
+    f, phi = force_length(ratio, model.active_range)
+    # Per fiber: its muscle's tension (a segment's tension over its share), × its weighted length.
+    first = model.fiber_first
+    fiber_tension = ld.tension[:, first] / model.layer.seg_weight[first]
+    short = np.maximum(model.segment_guard * model.seg_rest - seg_len, 0.0)
+    pull = ld.tension * f[:, model.fiber_of] - model.seg_guard_k * short
+    u = seg * (pull / np.maximum(seg_len, 1e-12))
+    total = ((fiber_tension * model.fiber_rest * phi).sum(-1) + 0.5 * (model.seg_guard_k * short * short).sum(-1)
+             - (ld.force * x).sum((0, 2)))
     return total, _apply(model.seg_scatter_b, u) - _apply(model.seg_scatter_a, u) - ld.force
 
 
@@ -673,11 +749,19 @@ def select_sites(model: Model, x: np.ndarray, ld: Loads) -> Floors:
     The nearby bone sites are blended with weights falling off with distance
     (a smooth skull between the samples, and no arbitrary choice between two
     sites equally near — which would break the face's symmetry). Distances are
-    measured in the bone's own frame, where the sites are fixed.
+    measured in the bone's own frame, where the sites are fixed. Each configuration is
+    blended on its own (einsum sums in an order that depends on the batch's width).
     """
+    parts = [_select_sites(model, x[:, b:b + 1], ld.jaw_rot[b:b + 1], ld.jaw_shift[b:b + 1])
+             for b in range(x.shape[1])]
+    return Floors(*(np.concatenate([getattr(f, name) for f in parts], axis=axis)
+                    for name, axis in (("site", 1), ("normal", 1), ("floor", 0))))
+
+
+def _select_sites(model: Model, x: np.ndarray, rot: np.ndarray, shift: np.ndarray) -> Floors:
     p = x[:, :, model.contact_ids].transpose(2, 1, 0)          # (K, B, 3)
     jaw = model.contact_jaw
-    rot, shift, hinge = ld.jaw_rot, ld.jaw_shift, model.net.hinge
+    hinge = model.net.hinge
     if jaw.any():  # into the jaw's frame: Rᵀ (p − hinge − t) + hinge
         p = p.copy()
         p[jaw] = np.einsum("bji,kbj->kbi", rot, p[jaw] - hinge - shift) + hinge
@@ -749,18 +833,26 @@ def clearances(model: Model, x: np.ndarray, ld: Loads) -> tuple[np.ndarray, np.n
 # -------------------------------------------------------------- minimiser ---
 
 def _precondition(model: Model, r: np.ndarray) -> np.ndarray:
-    """Apply the inverse rest stiffness to (3, B, N)."""
-    c, b, n = r.shape
-    return np.ascontiguousarray(model.solve_rest(np.ascontiguousarray(r.reshape(c * b, n).T)).T).reshape(r.shape)
+    """Apply the inverse rest stiffness to (3, B, N).
+
+    One back-substitution per configuration: with all of them at once the batch's width
+    changed the last bits of each (SuperLU's blocked solves), and the solves of a batch then
+    drifted from the same solves alone.
+    """
+    out = np.empty_like(r)
+    for b in range(r.shape[1]):
+        out[:, b] = model.solve_rest(np.ascontiguousarray(r[:, b].T)).T
+    return out
 
 
 def _per_config(a, b) -> np.ndarray:
-    """Inner product of two fields per configuration: (3, B, N) × (3, B, N) → (B,)."""
-    return np.einsum("cbn,cbn->b", a, b)
+    """Inner product of two fields per configuration: (3, B, N) × (3, B, N) → (B,), each summed
+    alike whatever the batch's width."""
+    return np.array([np.dot(a[:, k].ravel(), b[:, k].ravel()) for k in range(a.shape[1])])
 
 
 def minimise(model: Model, x: np.ndarray, ld: Loads, iterations: int, *, tolerance: float = 1e-7,
-             memory: tuple = (), floors: "Floors | None" = None, start=None):
+             residual: float = 0.0, memory: tuple = (), floors: "Floors | None" = None, start=None):
     """Projected L-BFGS from ``x`` (3, B, N), H₀⁻¹ = the factorised rest stiffness.
 
     A point on its contact floor may not step further in (that part of the
@@ -776,6 +868,12 @@ def minimise(model: Model, x: np.ndarray, ld: Loads, iterations: int, *, toleran
     ``floors`` (the skull under each point) may be passed in to reuse a
     previous frame's choice, ``start = (energy, gradient)`` at ``x`` to skip
     evaluating them.
+
+    Each configuration stops when its residual — the norm of the gradient that the
+    contacts do not take up, i.e. the net force left on the points — falls below
+    ``residual`` times its norm at the start of the call (or every entry below the
+    absolute ``tolerance``); the others go on. A configuration stops where it would
+    have stopped solved alone.
     """
     if floors is None:
         floors = select_sites(model, x, ld)
@@ -801,8 +899,11 @@ def minimise(model: Model, x: np.ndarray, ld: Loads, iterations: int, *, toleran
     # The step that worked last time, but never below a quarter: a converged frame's failed steps
     # must not leave the next frame (a new drive) crawling.
     trust = np.maximum(memory[3], 0.25) if len(memory) > 3 else np.ones(x.shape[1])
+    start_norm = np.sqrt(_per_config(g, g))
     for _ in range(iterations):
-        if np.abs(g).max() < tolerance:
+        norm = np.sqrt(_per_config(g, g))
+        active = (norm > residual * start_norm) & (np.abs(g).max(axis=(0, 2)) >= tolerance)
+        if not active.any():
             break
         q = g.copy()
         alphas = []
@@ -814,8 +915,9 @@ def minimise(model: Model, x: np.ndarray, ld: Loads, iterations: int, *, toleran
         for (s, y, rho), alpha in zip(zip(s_hist, y_hist, rho_hist), reversed(alphas)):
             z += (alpha - rho * _per_config(y, z))[:, None] * s
         direction = hold(-z, gaps, floors)
+        direction[:, ~active] = 0.0  # converged: stays where it is
         slope = _per_config(g, direction)
-        bad = slope >= 0  # not a descent direction: fall back to the preconditioned gradient
+        bad = (slope >= 0) & active  # not a descent direction: fall back to the preconditioned gradient
         if bad.any():
             fallback = hold(-_precondition(model, g), gaps, floors)
             direction[:, bad] = fallback[:, bad]
@@ -827,7 +929,7 @@ def minimise(model: Model, x: np.ndarray, ld: Loads, iterations: int, *, toleran
         for _attempt in range(8):
             x_new, gaps_new = project(x + step[:, None] * direction)
             e_new, g_new = energy_at(x_new)
-            ok = e_new <= e + 1e-4 * step * np.minimum(slope, 0.0)
+            ok = (e_new <= e + 1e-4 * step * np.minimum(slope, 0.0)) | ~active
             if ok.all():
                 break
             # Backtrack to the minimum of the quadratic through e, the slope and e_new.
@@ -835,23 +937,24 @@ def minimise(model: Model, x: np.ndarray, ld: Loads, iterations: int, *, toleran
             guess = -slope * step * step / np.maximum(2.0 * curve, 1e-300)
             step = np.where(ok, step, np.clip(guess, 0.1 * step, 0.5 * step))
         # Next time start from about what worked (grow it back while steps succeed).
-        trust = np.where(ok, np.minimum(1.0, 2.0 * step), step)
+        trust = np.where(active, np.where(ok, np.minimum(1.0, 2.0 * step), step), trust)
         raw_new = (e_new, g_new)
         g_new = hold(g_new.copy(), gaps_new, floors, sign=1.0)
-        if not ok.all():  # a configuration whose step still failed stays where it was; start afresh
-            rho_hist = [np.where(ok, rho, 0.0) for rho in rho_hist]
-            x_new[:, ~ok], e_new[~ok], g_new[:, ~ok] = x[:, ~ok], e[~ok], g[:, ~ok]
-            raw_new = (np.where(ok, raw_new[0], raw[0]), np.where(ok[None, :, None], raw_new[1], raw[1]))
+        rho_hist = [np.where(ok, rho, 0.0) for rho in rho_hist] if not ok.all() else rho_hist  # failed: afresh
+        moved = ok & active  # a configuration whose step failed, or that has converged, stays where it was
+        if not moved.all():
+            x_new[:, ~moved], e_new[~moved], g_new[:, ~moved] = x[:, ~moved], e[~moved], g[:, ~moved]
+            raw_new = (np.where(moved, raw_new[0], raw[0]), np.where(moved[None, :, None], raw_new[1], raw[1]))
             if gaps is not None:
-                gaps_new = tuple(np.where(ok[:, None], gn, go) for gn, go in zip(gaps_new[:2], gaps[:2])) + (
-                    np.where(ok[None, :, None], gaps_new[2], gaps[2]),)
+                gaps_new = tuple(np.where(moved[:, None], gn, go) for gn, go in zip(gaps_new[:2], gaps[:2])) + (
+                    np.where(moved[None, :, None], gaps_new[2], gaps[2]),)
         s, y = x_new - x, g_new - g
         sy = _per_config(s, y)
         x, e, g, gaps, raw = x_new, e_new, g_new, gaps_new, raw_new
         # Keep the pair only if the energy curved up along the step at least a little, compared
         # with the rest stiffness (projections onto contacts and kinks can break the secant pair).
         # (Per configuration: a rejected pair gets rho = 0, which makes it a no-op in the recursion.)
-        shs = np.einsum("cbn,n,cbn->b", s, model.stiffness_diagonal, s)
+        shs = _per_config(s, model.stiffness_diagonal * s)
         keep = (sy > 1e-3 * shs) & (shs > 0)
         if keep.any():
             s_hist.append(s)
@@ -899,13 +1002,15 @@ def _lerp_drive(a: Drive, b: Drive, t: float) -> Drive:
 
 
 def solve(model: Model, state: State, target: Drive, *, steps: int = 3, iterations: int = 12,
-          settle: bool = True) -> State:
+          residual: float = 0.0, settle: bool = True) -> State:
     """Apply the change from ``state.drive`` to ``target`` in ``steps`` increments.
 
     Each increment adds 1/steps of the change and relaxes the net toward
     equilibrium from the previous one (Platt & Badler's n-step contraction);
     every intermediate state is a valid expression (an animation steps with
-    ``steps=1`` per frame).
+    ``steps=1`` per frame). Each increment iterates until the net force left on
+    the points falls below ``residual`` of what the increment added (see
+    :func:`minimise`), ``iterations`` at most.
 
     ``settle`` re-chooses, at the end, the bone each point lies over after
     sliding and projects onto it (a static solve's last word). Without it (the
@@ -927,7 +1032,8 @@ def solve(model: Model, state: State, target: Drive, *, steps: int = 3, iteratio
             old_e, old_g = load_energy(model, x, known[0])
             new_e, new_g = load_energy(model, x, ld)
             start = (known[1] - old_e + new_e, known[2] - old_g + new_g)
-        x, memory, (e, g) = minimise(model, x, ld, iterations, memory=memory, floors=floors, start=start)
+        x, memory, (e, g) = minimise(model, x, ld, iterations, residual=residual, memory=memory,
+                                   floors=floors, start=start)
         known = (ld, e, g)
         mirrored = symmetric_drive(model, d) if settle else np.zeros(0, bool)
         if mirrored.any():  # a symmetric drive moves the face symmetrically: drop the round-off that breaks it
@@ -941,8 +1047,10 @@ def solve(model: Model, state: State, target: Drive, *, steps: int = 3, iteratio
             for _ in range(SETTLE_PASSES):
                 floors, age = select_sites(model, x, ld), 0
                 skull_gap, eye_gap, _ = _gaps(model, x, floors)
-                if max(skull_gap.max(initial=0.0), eye_gap.max(initial=0.0)) < 1e-9:
+                through = np.maximum(skull_gap.max(axis=-1, initial=0.0), eye_gap.max(axis=-1, initial=0.0)) >= 1e-9
+                if not through.any():
                     break
-                x, _ = project_contacts(model, x, floors)
+                # (Only the configurations still through a floor: each settles as it would alone.)
+                x = np.where(through[None, :, None], project_contacts(model, x, floors)[0], x)
             known = None
     return State(x, target, ld.jaw, memory, floors, age, known)
