@@ -353,9 +353,10 @@ def test_anger_glares_under_knitted_brows(engine, marks, level):
 
 @pytest.mark.parametrize("level", [1.0, 0.5])
 def test_surprise_is_not_fear(engine, marks, level):
-    """Session 12 (surprise named fear 5 times in 12): surprise's brows rise in an even arch, outer
-    ends highest, barely drawn together; fear's are drawn together and straightened, inner ends as
-    high as the outer. Surprise's relaxed jaw hangs open in a tall oval narrower than at rest;
+    """Session 12 (surprise named fear 5 times in 12): surprise's brows rise high in an even arch,
+    barely drawn together; fear's are drawn together, lower and straightened, inner ends as
+    high as the outer (session 15: surprise's outer ends no longer rise above its inner ends -
+    the slanted brow read as anger). Surprise's relaxed jaw hangs open in a tall oval narrower than at rest;
     fear's lips are stretched wider than at rest."""
     surprise, fear = (_emotion_moved(engine, name, level) for name in ("surprise", "fear"))
 
@@ -365,11 +366,14 @@ def test_surprise_is_not_fear(engine, marks, level):
     def tilt(delta):   # inner end of the brow over its outer end, from rest
         return delta[marks["inner_brow_left"], 1] - delta[marks["outer_brow_left"], 1]
 
+    def lift(delta):   # both ends of the brow, from rest
+        return (delta[marks["inner_brow_left"], 1] + delta[marks["outer_brow_left"], 1]) / 2
+
     def widening(delta):
         return delta[marks["lip_corner_left"], 0] - delta[marks["lip_corner_right"], 0]
 
     assert knit(fear) < knit(surprise) - 0.02 * level
-    assert tilt(surprise) < -0.01 * level and tilt(fear) > -0.005
+    assert lift(surprise) > lift(fear) + 0.02 * level and tilt(fear) > -0.005
     assert widening(surprise) < 0.0 < 0.05 * level < widening(fear)
     opening = surprise[marks["upper_lip"], 1] - surprise[marks["lower_lip"], 1]
     assert opening > 0.12 * level
@@ -422,3 +426,22 @@ def test_14_sinks_a_dimple_beyond_the_corner(engine, marks):
 
     assert pit("14") > 0.035
     assert pit("20") < 0.03
+
+
+@pytest.mark.parametrize("name", ["amara", "mei", "noah", "ava", "george", "margaret", "kwame"])
+def test_surprise_raises_the_whole_brow_in_an_arch(face_of, name):
+    """Session 15 (amara's surprise read as anger): in 1+2 the whole brow rises, curved and
+    high, its inner end about as much as its outer, its middle highest - not a low, heavy
+    head under a raised tail. Measured on the drawn brow (one preset per brow style and
+    ethnicity), in thirds along it."""
+    from facsim.head.proxies import along_brow
+
+    face = face_of(name)
+    brow = next(b for b in face.proxies if b.proxy.kind == "eyebrows")
+    rest = brow.binding.positions(face.neutral)
+    rise = brow.binding.positions(face.engine.deform(activations(parse("1+2"))).positions)[:, 1] - rest[:, 1]
+    along, left = along_brow(rest), rest[:, 0] > 0
+    inner, middle, outer = (rise[left & (along >= lo) & (along <= hi)].mean()
+                            for lo, hi in ((0.0, 1 / 3), (1 / 3, 2 / 3), (2 / 3, 1.0)))
+    assert inner > 0.04 and inner >= 0.7 * outer, (name, inner, middle, outer)
+    assert middle >= 0.9 * max(inner, outer), (name, inner, middle, outer)
