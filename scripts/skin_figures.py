@@ -9,12 +9,19 @@ pixel, so each pixel's linear radiance L = D + S splits into diffuse D = 2 (L1 -
 specular S = L1 - D (luminance). Regions are small boxes at landmarks (both sides pooled):
 
 - ``cheek``: mean S / L on the cheeks (a photograph of skin: a few per cent);
+- ``cheek S/D``: the same boxes' specular over their diffuse light (how far the sheen
+  stands out of the skin's own colour: dark skin's is larger for the same sheen);
 - ``forehead``, ``nose``, ``lower lip``: the same over the forehead's centre, the nose tip, the
   lower lip;
 - ``hl area``: the share of the face's skin pixels (between the brows' outer ends and the
   chin) where S is over 30 % of L: how much of the face reads as highlight;
 - ``speckle``: over the forehead box, the mean absolute difference of S between neighbouring
   pixels over the mean S: a broad soft sheen is near 0, a glittering film of specks high.
+- ``tone cv`` and ``hue sd``: the skin's own unevenness on the cheeks (larger boxes): the
+  diffuse light D over D blurred by 8 px (the shading's slow change removed), its standard
+  deviation (per cent); and the standard deviation of the diffuse light's hue,
+  (R - G) / (R + G), over the same pixels, times 100 (blood and pigment vary the hue; a
+  grey noise does not).
 
 Eyes: the iris's pixels (found by rendering again with the iris in a loud colour, as
 ``scripts/eyes_mouth_figures.py`` does): mean HSV saturation and value; the sclera's
@@ -121,6 +128,16 @@ def figures(name, expression=""):
             "lower lip": _box(camera, [pt("lower_lip") + [0.0, 0.012, 0.0]], 4),
         }
         out = {k: float(np.sum(specular[m]) / np.maximum(np.sum(l1[m]), 1e-6)) for k, m in regions.items()}
+        out["cheek S/D"] = float(np.sum(specular[regions["cheek"]]) / max(np.sum(diffuse[regions["cheek"]]), 1e-6))
+        # The skin's unevenness: per-channel diffuse light, the slow shading divided out.
+        from scipy.ndimage import gaussian_filter
+
+        diffuse_rgb = np.clip(2 * (radiance(image) - radiance(half)), 1e-4, None)
+        cheeks = _box(camera, [pt("cheek_left") + [-0.1, 0.02, 0.1], pt("cheek_right") + [0.1, 0.02, 0.1]], 14)
+        d = diffuse_rgb @ LUMINANCE
+        out["tone cv"] = float(100 * np.std((d / np.maximum(gaussian_filter(d, 8), 1e-6))[cheeks]))
+        r, g = diffuse_rgb[..., 0][cheeks], diffuse_rgb[..., 1][cheeks]
+        out["hue sd"] = float(100 * np.std((r - g) / (r + g)))
         (x0, _), (x1, _) = project(camera, [pt("outer_brow_left"), pt("outer_brow_right")], SIZE)[0]
         (_, y0), = project(camera, [pt("outer_brow_left")], SIZE)[0]
         (_, y1), = project(camera, [pt("chin")], SIZE)[0]

@@ -4,8 +4,10 @@ A second small texture beside :func:`facsim.head.appearance.detail_texture`, in 
 UV box and row order (v upward, GL order), placed by anatomy on the base mesh so every
 character's maps sit on the same features. Channels (0 … 1):
 
-- R, **periorbital darkening**: the thin skin around the eyes shows the vessels and
-  muscle beneath it (under-eye hollows, the inner corner, the upper lid's sulcus).
+- R, **darker skin**: the thin skin around the eyes shows the vessels and muscle beneath
+  it (under-eye hollows, the inner corner, the upper lid's sulcus), and pigment lies
+  unevenly (more around the mouth, at the temples and hairline, along the jaw's sides):
+  no face is one even tone, and in dark skin this unevenness is what a photograph shows most.
 - G, **translucency**: thin tissue that light passes through, so it glows red when lit
   from behind or the side (ear rims, nose wings and tip).
 - B, **pore strength**: pores are largest on the nose and the cheeks beside it, finer on
@@ -32,7 +34,7 @@ from facsim.head.surface import smoothstep
 
 TONE_SIZE = (512, 256)  # rows (v), columns (u) over assets.PAINT_UV_BOX; the maps are smooth
 #: Bump when the recipe changes, so cached tone maps are redone.
-TONE_VERSION = 1
+TONE_VERSION = 2  # 2: uneven pigment in R
 #: hm08's left eye centre (joint-l-eye), decimetres.
 EYE_CENTRE = (0.308, 7.284, 1.245)
 
@@ -44,7 +46,7 @@ FOLD_VERSION = 2  # 2: forehead lines unevenly spaced, wavy and broken
 
 @lru_cache(maxsize=2)
 def tone_texture(head, position_map: Callable) -> np.ndarray:
-    """(rows, cols, 4) uint8: periorbital darkening, translucency, pore strength, sun exposure.
+    """(rows, cols, 4) uint8: darker skin, translucency, pore strength, sun exposure.
 
     ``position_map(head)`` gives the base-mesh position (rows, cols, 3) at each texel of
     the paint box, NaN or far away off the mesh (:func:`facsim.head.appearance.position_map`).
@@ -67,7 +69,7 @@ def _resampled(positions: np.ndarray, size: tuple[int, int], order: int) -> np.n
 def build_tone(positions: np.ndarray) -> np.ndarray:
     """The tone maps at base-mesh ``positions`` (rows, cols, 3), resampled to :data:`TONE_SIZE`."""
     positions = _resampled(positions, TONE_SIZE, order=1)
-    channels = (periorbital_density(positions), translucency_density(positions),
+    channels = (np.maximum(periorbital_density(positions), pigment_density(positions)), translucency_density(positions),
                 pore_density(positions), sun_density(positions))
     tone = np.empty((*TONE_SIZE, 4), np.uint8)
     for k, mask in enumerate(channels):
@@ -95,6 +97,16 @@ def periorbital_density(positions: np.ndarray) -> np.ndarray:
             + 0.6 * blob(positions, (x - 0.17, y - 0.02, z + 0.14), (0.055, 0.08, 0.1))    # inner corner
             + 0.35 * blob(positions, (x + 0.02, y + 0.09, z + 0.1), (0.16, 0.045, 0.12)))  # upper lid sulcus
     return np.clip(dark * _front(positions), 0, 1).astype(np.float32)
+
+
+def pigment_density(positions: np.ndarray) -> np.ndarray:
+    """More pigment: around the mouth, at the temples and hairline, along the jaw's sides (the
+    cheeks' middle, the nose and the forehead's centre are the face's lightest skin)."""
+    pigment = (0.6 * blob(positions, (0.0, 6.6, 1.5), (0.24, 0.2, 0.3))          # around the mouth
+               + 0.35 * blob(positions, (0.5, 7.8, 1.0), (0.22, 0.35, 0.3))       # temples
+               + 0.3 * blob(positions, (0.0, 8.25, 1.3), (0.5, 0.15, 0.4))        # hairline
+               + 0.3 * blob(positions, (0.6, 6.5, 0.9), (0.15, 0.35, 0.3)))       # the jaw's sides
+    return np.clip(pigment, 0, 1).astype(np.float32)
 
 
 def translucency_density(positions: np.ndarray) -> np.ndarray:

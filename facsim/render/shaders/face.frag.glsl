@@ -58,11 +58,11 @@ vec3 specular_light(vec3 n, vec3 v, float shininess) {
 
 #ifdef REGION_SKIN
 uniform sampler2D u_paint;   // R brow hair density, G lips, B eyelids, A cheek blush
-uniform sampler2D u_detail;  // R redness, G beard area, B oiliness
+uniform sampler2D u_detail;  // R redness, G beard area, B oiliness, A uneven pigment
 const float FOLD_TEXELS = 3.0;   // a groove's half-width in fold-map texels (~0.8 mm each on the face)
 uniform sampler2D u_folds;   // R forehead lines + crow's feet, G under-eye lines, B fold shade,
                              // A where R and G replace the engine's furrows (facsim.head.skin)
-uniform sampler2D u_tone;    // R periorbital darkening, G translucency, B pores, A sun (facsim.head.skin)
+uniform sampler2D u_tone;    // R darker skin (eyes, mouth, temples), G translucency, B pores, A sun (facsim.head.skin)
 uniform float u_beard;       // 0..1 stubble shadow
 uniform float u_age;         // 0..1 how much the age lines show
 uniform vec3 u_skin;
@@ -288,7 +288,7 @@ void main() {
 #ifdef REGION_SKIN
     vec4 paint = texture(u_paint, v_uv);
     vec4 detail = texture(u_detail, v_uv);
-    vec4 tone = texture(u_tone, v_uv);   // periorbital, translucency, pores, sun
+    vec4 tone = texture(u_tone, v_uv);   // darker skin, translucency, pores, sun
     // Albedo varies at three scales, as photographed skin does, so no area is a flat plastic
     // colour: tone patches a couple of centimetres across (blood and melanin are never even),
     // blotches of a few millimetres, and grain about a millimetre across (pores and fine
@@ -305,6 +305,16 @@ void main() {
     float mottle = 0.6 * blotch + 0.4 * grain;
     vec3 albedo = u_skin * (1.0 + vec3(0.10, 0.12, 0.13) * (1.0 + 1.2 * u_age) * (mottle - 0.5));
     albedo *= mix(vec3(1.04, 0.97, 0.96), vec3(0.975, 1.0, 1.02), patches);
+    // The variation is in the skin's two pigments, not a grey noise: blood (haemoglobin takes
+    // green and blue) gathers in irregular flushed patches about a centimetre across, broken
+    // up by the blotches, and melanin lies unevenly in larger, softer patches (darker, a
+    // little warmer). Melanin veils the blood in dark skin, whose unevenness is mostly its
+    // pigment's.
+    float lum_skin = dot(u_skin, vec3(0.2126, 0.7152, 0.0722));
+    float melanin_rich = 1.0 - smoothstep(0.05, 0.3, lum_skin);
+    float haem = 0.55 * value_noise(skin_uv * vec2(55.0, 110.0) + 5.0, 0) + 0.45 * blotch;
+    albedo *= mix(vec3(1.0), vec3(1.01, 0.86, 0.87), (0.9 - 0.5 * melanin_rich) * smoothstep(0.4, 0.85, haem));
+    albedo *= 1.0 - (0.05 + 0.07 * melanin_rich) * (patches - 0.5) * vec3(0.85, 1.0, 1.15);
     // Regional colour: redder nose, cheeks and ears (blood close to the surface), in broken
     // capillary patches rather than an airbrushed blob; darker, cooler skin around the eyes
     // (thin skin over vessels and muscle), more so with age; a shaved beard's blue-grey shadow.
@@ -314,6 +324,10 @@ void main() {
     float red = u_redness * detail.r * veil * mix(0.6, 1.25, smoothstep(0.2, 0.8, 0.55 * blotch + 0.45 * patches));
     albedo *= mix(vec3(1.0), vec3(1.03, 0.84, 0.83), min((0.75 + 0.3 * u_age) * red, 1.0));   // older: broken veins
     albedo *= mix(vec3(1.0), vec3(0.78, 0.70, 0.75), tone.r * (0.6 + 0.5 * u_age));
+    // The same darker areas (tone.r: around the eyes and the mouth, temples, hairline, the
+    // jaw's sides) hold more pigment in melanin-rich skin: darker still, unevenly (a dark
+    // face of one even brown read as a plastic mask).
+    albedo *= 1.0 - tone.r * mix(0.6, 1.3, patches) * 0.3 * melanin_rich * vec3(0.85, 1.0, 1.15);
     albedo = mix(albedo, albedo * vec3(0.70, 0.72, 0.78), u_beard * detail.g * (1.0 - paint.g));
     // Age spots: sparse, soft tan patches where the sun reaches, growing with age.
     float spot = smoothstep(0.72, 0.9, blotch) * tone.a * u_age;
@@ -482,12 +496,12 @@ void main() {
     // furrows; brow hair has none.
     float ndv = max(dot(n, v), 1e-4);
     float oil = detail.b * (1.0 - 0.35 * u_age) * mix(0.8, 1.15, patches) * (1.0 - lips);
-    float film = smoothstep(0.6, 1.05, oil);
+    float film = smoothstep(0.75, 1.05, oil);
     // Moist, but the film is broken by the furrows and by the lips' fine mottle: a continuous
     // glossy band along the lip read as rubber.
     float wet = lips * (1.0 - 0.85 * lip_line) * (0.55 + 0.45 * blotch);
     // Lobe weights (broad, tight); the fill is too weak to show: key and rim only.
-    vec2 weight = vec2(0.6 - 0.3 * wet, 0.35 * film + 0.2 * wet);
+    vec2 weight = vec2(0.6 - 0.3 * wet, 0.22 * film + 0.2 * wet);
     vec3 spec = dot(skin_specular(bumped, u_key_dir, v, ndv), weight) * u_key_col
               + dot(skin_specular(bumped, u_rim_dir, v, ndv), weight) * u_rim_col;
     // (Times pi: the diffuse term here is albedo times N.L, without the Lambert 1/pi.)
