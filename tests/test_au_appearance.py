@@ -83,6 +83,8 @@ def test_4_lowers_the_brows_and_draws_them_together_with_glabellar_furrows(solve
     assert d[left, X] - d[right, X] < -0.02                                  # 2 mm closer together
     assert _creases(solved, "4", rest, GLABELLA) > 0.2
     assert _creases(solved, "4", rest, GLABELLA) > _creases(solved, "4", rest, FOREHEAD)  # not the brow
+    # Not the nose: 9 wrinkles it, 4 at most lines the root once (session 15: anger read as disgust).
+    assert _creases(solved, "4", rest, NOSE_ROOT) < 0.8 * _creases(solved, "9", rest, NOSE_ROOT)
 
 
 def test_6_raises_the_cheeks_narrows_the_eye_from_below_with_crows_feet(solved, marks, rest):

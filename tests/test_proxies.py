@@ -253,3 +253,34 @@ def test_long_hair_ends_above_the_shoulders_not_in_blocks_at_the_image_corners(f
     # the hair still frames the face down to the jaw
     sides = np.concatenate([(with_hair - without)[70:90, :30], (with_hair - without)[70:90, -30:]])
     assert (np.abs(sides[..., :3]).max(axis=-1) > 60).mean() > 0.2
+
+
+@pytest.mark.parametrize("name", ["ava", "amara", "kwame", "mei"])
+def test_brows_move_as_one_piece_and_keep_sadness_s_raised_inner_end(face_of, name):
+    """Each brow follows the skin along one line near its upper edge (BROW_BINDING_LINE): in 1+2
+    its head rises without stretching (session 15: tied to the skin under each hair, the head's
+    upper edge rose 5 mm more than its lower edge on ava, amara and mei, and the head grew tall),
+    and in sadness (1+4) the upper edge of its head rises and draws in as the skin there does."""
+    from facsim.facs.activations import activations
+    from facsim.facs.emotions import emotion
+    from facsim.facs.notation import parse
+
+    face = face_of(name)
+    brow = next(b for b in face.proxies if b.proxy.kind == "eyebrows")
+    rest = brow.binding.positions(face.neutral)
+    head = (proxies.along_brow(rest) < 0.2) & (rest[:, 0] > 0)
+    upper = head & (rest[:, 1] >= np.median(rest[head, 1]))
+    lower = head & ~upper
+    for expression in (parse("1+2"), emotion("sadness")):
+        moved = brow.binding.positions(face.engine.deform(activations(expression)).positions) - rest
+        stretch = moved[upper, 1].mean() - moved[lower, 1].mean()
+        assert abs(stretch) < 0.025, (name, str(expression), stretch)
+    # Sadness: the skin's rise and pull at the brow head's upper edge is the drawn brow's.
+    skin_rest = face.neutral[: face.head.skin_vertex_count]
+    skin_sad = face.engine.deform(activations(emotion("sadness"))).positions[: face.head.skin_vertex_count]
+    from scipy.spatial import cKDTree
+
+    under = cKDTree(skin_rest).query(rest[upper])[1]
+    assert moved[upper, 1].mean() > 0.03                                    # the inner end raised >= 3 mm
+    assert moved[upper, 0].mean() < -0.015                                  # and drawn in >= 1.5 mm
+    assert abs(moved[upper, 1].mean() - (skin_sad - skin_rest)[under, 1].mean()) < 0.01

@@ -335,9 +335,39 @@ def place_brows(points: np.ndarray, skin: np.ndarray, triangles: np.ndarray, loo
     height = ((points - foot) * normal).sum(1)
     slid = foot + np.stack([spread, lift, np.zeros_like(lift)], axis=1)
     tri, bary, normal = closest_on_surface(slid, skin, near)
-    ref = near[tri]
-    moved = np.einsum("vk,vkd->vd", bary, np.asarray(skin, np.float64)[ref]) + height[:, None] * normal
-    return ref.astype(np.int64), bary.astype(np.float32), moved.astype(np.float32)
+    on_skin = np.einsum("vk,vkd->vd", bary, np.asarray(skin, np.float64)[near[tri]])
+    moved = on_skin + height[:, None] * normal
+    # Each vertex follows the skin on the brow's binding line above or below it (see
+    # BROW_BINDING_LINE), so the skin's stretch across the brow does not stretch the brow.
+    line = on_skin + np.stack([np.zeros_like(lift), brow_line_height(moved) - moved[:, 1], np.zeros_like(lift)], axis=1)
+    tri, bary, _ = closest_on_surface(line, skin, near)
+    return near[tri].astype(np.int64), bary.astype(np.float32), moved.astype(np.float32)
+
+
+#: Where across its height a brow is tied to the skin: 0 at its lower edge, 1 at its upper edge.
+#: Every vertex of the brow moves as the skin on this line at its own distance from the midline
+#: does. Tied each to the skin under it, a brow stretched with that skin: in 1+2 the skin at the
+#: brow's head rises 5 mm more at its upper edge than at its lower one (ava), so the head grew
+#: tall and thin. Tied to its middle line the brow kept its shape, but sadness's (1+4) inner end
+#: then rose less (the upper edge 3.3 mm instead of 5.4) and read less sad (face-api 6 -> 4 of 6).
+#: Tied near its upper edge the brow keeps the outline of its upper edge, the one that shows the
+#: raised inner end of 1 and the lowered, drawn-together brows of 4, and moves as one piece.
+BROW_BINDING_LINE = 0.85
+#: Half-width (dm) of the window along the brow in which its lower and upper edges are read.
+BROW_EDGE_WINDOW = 0.03
+
+
+def brow_line_height(points: np.ndarray) -> np.ndarray:
+    """(V,) the height (y) of the brow's binding line at each of its ``points`` (V, 3):
+    :data:`BROW_BINDING_LINE` of the way from the brow's lower edge to its upper edge, both read
+    (10th and 90th percentile of height) among the points of the same brow within
+    :data:`BROW_EDGE_WINDOW` of each point's distance from the midline."""
+    points = np.asarray(points, np.float64)
+    x, y = points[:, 0], points[:, 1]
+    near = (np.abs(x[:, None] - x[None, :]) < BROW_EDGE_WINDOW) & (np.sign(x)[:, None] == np.sign(x)[None, :])
+    column = np.where(near, y[None, :], np.nan)
+    low, high = np.nanpercentile(column, 10, axis=1), np.nanpercentile(column, 90, axis=1)
+    return low + BROW_BINDING_LINE * (high - low)
 
 
 def bind_to_frame(proxy: Proxy, head, base_positions: np.ndarray, neutral_geometry: np.ndarray,

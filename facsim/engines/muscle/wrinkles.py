@@ -41,6 +41,7 @@ class WrinkleModel:
     zone_gain: np.ndarray       # (N,) how readily the skin creases there (deep forehead lines, fine crow's feet)
     across_gain: np.ndarray     # (N,) the same for vertical furrows (skin squeezed sideways) where zones differ
     straight: np.ndarray        # (N,) 1 where lines run straight across the face (forehead, glabella)
+    upright: np.ndarray         # (N,) 1 where the lines run straight up whatever squeezes the skin (the glabella)
     on_face: np.ndarray         # (N,) 1 on the outer skin, 0 inside the lips and lids
     crease: np.ndarray          # (N,) extra depth along anatomical folds (0 = none, 1 = twice as deep)
     gain: float
@@ -84,14 +85,19 @@ def build_wrinkles(anat: Anatomy, net: TensionNet, spec: dict) -> WrinkleModel:
     zone_gain = np.ones(n)
     across_gain = np.ones(n)
     straight = np.zeros(n)
+    upright = np.zeros(n)
     base = anat.base[: anat.skin_count]
     for zone in w.get("zones", []):
         weight = _blob(zone, base)
-        wavelength = wavelength * (1 - weight) + zone["wavelength"] * weight
-        zone_gain = zone_gain * (1 - weight) + zone.get("gain", 1.0) * weight
-        across_gain = across_gain * (1 - weight) + zone.get("across_gain", zone.get("gain", 1.0)) * weight
+        if "wavelength" in zone:
+            wavelength = wavelength * (1 - weight) + zone["wavelength"] * weight
+        if "gain" in zone or "across_gain" in zone:
+            zone_gain = zone_gain * (1 - weight) + zone.get("gain", 1.0) * weight
+            across_gain = across_gain * (1 - weight) + zone.get("across_gain", zone.get("gain", 1.0)) * weight
         if zone.get("straight"):
             straight = np.maximum(straight, weight)
+        if zone.get("upright"):
+            upright = np.maximum(upright, weight)
     wavelength = wavelength * net.scale
 
     crease = np.zeros(n)
@@ -112,7 +118,8 @@ def build_wrinkles(anat: Anatomy, net: TensionNet, spec: dict) -> WrinkleModel:
     integrate = spla.factorized((incidence.T @ incidence + 1e-4 * sp.identity(n)).tocsc())
     return WrinkleModel(
         triangles=tri, rest_inverse=inv, rest_frame=frame, to_vertex=to_vertex.tocsr(), rest=rest,
-        wavelength=wavelength, zone_gain=zone_gain, across_gain=across_gain, straight=np.clip(straight * 4.0, 0.0, 1.0), crease=crease,
+        wavelength=wavelength, zone_gain=zone_gain, across_gain=across_gain, straight=np.clip(straight * 4.0, 0.0, 1.0),
+        upright=np.clip(upright * 4.0, 0.0, 1.0), crease=crease,
         on_face=on_face,
         gain=float(w["gain"]), threshold=float(w["threshold"]), exponent=float(w["exponent"]),
         smooth=smooth.tocsr(), passes=int(w.get("smoothing", 2)),
@@ -195,6 +202,11 @@ def wrinkle_field(model: WrinkleModel, positions: np.ndarray) -> tuple[np.ndarra
     # held flat by the bone beneath): the direction snaps to the nearer of height and width.
     snapped = np.where(np.abs(v_dir[:, 1:2]) >= np.abs(v_dir[:, 0:1]), [[0.0, 1.0, 0.0]], [[1.0, 0.0, 0.0]])
     along = (1 - model.straight)[:, None] * v_dir + model.straight[:, None] * snapped
+    # Between the brows the furrows run straight up (corrugator, FACS 4): brows lowered and
+    # drawn together shear this skin diagonally as well as squeezing it sideways, and the
+    # shear's vertical part must not draw horizontal lines across the glabella - those read
+    # as the wrinkled nose root of 9 (issue 13: anger read as disgust for a "nose wrinkle").
+    along = (1 - model.upright)[:, None] * along + model.upright[:, None] * np.array([[1.0, 0.0, 0.0]])
     phase = _furrow_phase(model, along, positions)
     # Squeezed sideways the skin makes vertical furrows; zones may crease less that way (the
     # forehead's deep lines are horizontal: drawn together, brows furrow the glabella, not the brow).
