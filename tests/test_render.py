@@ -499,6 +499,31 @@ def test_seam_vertices_share_their_normal():
     assert np.allclose(normals[seam], normals[twin])
 
 
+def test_scattered_normals_soften_a_fold_and_leave_a_plane_alone():
+    """The normal subsurface light sees (facsim.render.geometry.scattered_normals) is averaged over
+    neighbours: across a sharp crease it tilts far less than the surface's own; on a plane it is
+    the plane's."""
+    from facsim.render.geometry import scattered_normals, smoothing_operator
+
+    n = 9
+    x, y = np.meshgrid(np.arange(n, dtype=float), np.arange(n, dtype=float))
+    index = np.arange(n * n).reshape(n, n)
+    a, b, c, d = index[:-1, :-1].ravel(), index[:-1, 1:].ravel(), index[1:, :-1].ravel(), index[1:, 1:].ravel()
+    faces = np.concatenate([np.c_[a, b, d], np.c_[a, d, c]])
+    op = smoothing_operator(faces, n * n)
+    flat = np.c_[x.ravel(), y.ravel(), np.zeros(n * n)]
+    normals = vertex_normals(flat, faces)
+    assert np.allclose(scattered_normals(normals, op), normals, atol=1e-6)
+    crease = flat.copy()
+    crease[:, 2] = -np.abs(x.ravel() - 4)   # a ridge along x = 4, flanks at 45 degrees
+    normals = vertex_normals(crease, faces)
+    scattered = scattered_normals(normals, op)
+    assert np.allclose(np.linalg.norm(scattered, axis=1), 1, atol=1e-5)
+    beside = (np.abs(x.ravel() - 4) == 1) & (y.ravel() > 1) & (y.ravel() < n - 2)
+    assert (normals[beside, 2] < 0.75).all()            # the flanks face 45 degrees away ...
+    assert (scattered[beside, 2] > normals[beside, 2] + 0.05).all()   # ... scattered light sees them flatter
+
+
 def test_unused_vertices_get_a_valid_normal():
     normals = vertex_normals(np.zeros((4, 3)), np.array([[0, 1, 2]]))
     assert np.allclose(np.linalg.norm(normals, axis=1), 1)

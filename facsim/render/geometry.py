@@ -77,6 +77,35 @@ def lash_coordinates(positions: np.ndarray, eyes: list[np.ndarray],
     return np.concatenate(out).astype(np.float32)
 
 
+def smoothing_operator(faces: np.ndarray, n_vertices: int) -> sp.csr_matrix:
+    """Sparse (n_vertices, n_vertices) float32 matrix averaging each vertex with its one-ring
+    neighbours (rows sum to one; a vertex on no face keeps its own value).
+
+    >>> op = smoothing_operator(np.array([[0, 1, 2]]), 4)
+    >>> np.round(op @ np.array([3.0, 0, 0, 5]), 6).tolist()
+    [1.0, 1.0, 1.0, 5.0]
+    """
+    faces = np.asarray(faces, dtype=np.int64)
+    edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    rows = np.concatenate([edges[:, 0], edges[:, 1], np.arange(n_vertices)])
+    cols = np.concatenate([edges[:, 1], edges[:, 0], np.arange(n_vertices)])
+    adjacency = sp.csr_matrix((np.ones(len(rows), np.float32), (rows, cols)), shape=(n_vertices, n_vertices))
+    adjacency.data[:] = 1.0   # (an edge shared by two faces counts once)
+    return sp.diags(1.0 / np.asarray(adjacency.sum(axis=1)).ravel()).astype(np.float32) @ adjacency
+
+
+def scattered_normals(normals: np.ndarray, operator: sp.csr_matrix, passes: int = 2) -> np.ndarray:
+    """Unit normals averaged over ``passes`` rings of neighbours (``operator``:
+    :func:`smoothing_operator`): the surface as light that travels a few millimetres under the
+    skin before it leaves sees it, without the folds and creases finer than that (subsurface
+    scattering softens their shading, red most)."""
+    n = np.asarray(normals, np.float32)
+    for _ in range(passes):
+        n = operator @ n
+    length = np.linalg.norm(n, axis=1, keepdims=True)
+    return np.where(length > 1e-8, n / np.maximum(length, 1e-8), normals).astype(np.float32)
+
+
 CREASES_PER_DM = 11.0  # spacing of the creases drawn along a wrinkle field's contours: about 9 mm
 
 

@@ -47,8 +47,8 @@ import numpy as np
 from facsim.render.camera import Camera, projection_matrix, view_matrix, _size_pair
 from facsim.media.images import write_png
 from facsim.render.geometry import (CREASES_PER_DM, _faces_touching, _orientation, crease_phase, eye_rotation, lash_coordinates,
-                              normal_operator, region_components, sphere_centre, sphere_directions,
-                              vertex_normals)
+                              normal_operator, region_components, scattered_normals, smoothing_operator,
+                              sphere_centre, sphere_directions, vertex_normals)
 from facsim.render.gl import RenderError, _set_uniform, _shader_source, gl_context
 from facsim.render.inputs import (COLOR_NAMES, DEFAULT_BROW_UV_FRAME, DEFAULT_COLORS, HM08_BROW_UV_FRAME, REGIONS,
                             Appearance, Lighting, RenderTopology, brow_uv_frame, srgb_to_linear)
@@ -211,15 +211,17 @@ class Renderer:
         self._faces = topology.faces.copy()
         self._geo_faces = np.ascontiguousarray(topology.geo_faces)
         self._normal_op = normal_operator(self._geo_faces, self._n_geo)
+        self._smoothing_op = smoothing_operator(self._geo_faces, self._n_geo)
         self._render_op = None  # face -> render vertex sums, built when wrinkles first come
         self._face_region = topology.face_regions()
         self._face_uv = topology.uv[topology.faces]             # (M, 3, 2) for brow coverage
         self._brow_faces = np.zeros(len(self._faces), dtype=bool)
         self._winding_checked = False
         self._draws: list[tuple[str, int, int]] = []
-        # Per-frame vertex data: position (3), normal (3), wrinkle, occlusion, crease phase.
-        self._geo_buffer = np.zeros((self._n_geo, 9), dtype=np.float32)
-        self._render_buffer = np.zeros((topology.n_render, 9), dtype=np.float32)
+        # Per-frame vertex data: position (3), normal (3), wrinkle, occlusion, crease phase,
+        # the normal as light scattered under the skin sees it (3).
+        self._geo_buffer = np.zeros((self._n_geo, 12), dtype=np.float32)
+        self._render_buffer = np.zeros((topology.n_render, 12), dtype=np.float32)
         self._appearance = None
         self._proxy_layers: dict = {}  # ProxyMesh -> ProxyLayer, created on first use
         self._proxy_draws: tuple = ()
@@ -261,8 +263,8 @@ class Renderer:
             vertex_shader=_shader_source("face.vert.glsl", defines),
             fragment_shader=_shader_source("face.frag.glsl", defines)))
         vao = self._track(ctx.vertex_array(
-            prog, [(self._vbo_dynamic, "3f 3f 1f 1f 1f", "in_pos", "in_normal", "in_wrinkle",
-                    "in_occlusion", "in_crease"),
+            prog, [(self._vbo_dynamic, "3f 3f 1f 1f 1f 3f", "in_pos", "in_normal", "in_wrinkle",
+                    "in_occlusion", "in_crease", "in_scatter_normal"),
                    (self._vbo_static, "2f 3f", "in_uv", "in_eye")],
             index_buffer=self._ibo, index_element_size=4, skip_errors=True))
         _set_uniform(prog, "u_paint", 0)
@@ -682,7 +684,7 @@ class Renderer:
             prog = self._track(ctx.program(vertex_shader=_DEPTH_VERTEX, fragment_shader=_DEPTH_FRAGMENT))
             self._depth_prog = prog
             self._depth_vao = self._track(ctx.vertex_array(
-                prog, [(self._vbo_dynamic, "3f 24x", "in_pos")], index_buffer=self._ibo, index_element_size=4))
+                prog, [(self._vbo_dynamic, "3f 36x", "in_pos")], index_buffer=self._ibo, index_element_size=4))
         self._depth_prog["u_view_proj"].write(self._vp_bytes)
         fbo.color_mask = (False, False, False, False)
         if self.cull_backfaces:
@@ -751,6 +753,7 @@ class Renderer:
         geo[:, 7] = 1.0 if occlusion is None else occlusion
         geo[:, 0:3] = p
         geo[:, 3:6] = normals
+        geo[:, 9:12] = scattered_normals(normals, self._smoothing_op)
         out = self._render_buffer
         np.take(geo, self.topology.render_to_geo, axis=0, out=out)
         if wrinkle is not None and wrinkle.any() and phase is not None:

@@ -14,6 +14,9 @@ in float v_occlusion;
 #ifdef USE_UV
 in vec2 v_uv;
 #endif
+#ifdef REGION_SKIN
+in vec3 v_scatter_normal;   // the normal averaged over a few millimetres (Renderer: scattered_normals)
+#endif
 #ifdef USE_EYE
 in vec3 v_eye;
 #endif
@@ -91,17 +94,24 @@ vec2 spots(vec2 p, float prob, float radius, int salt) {
     return vec2(cover * step(h, prob), fract(h * 13.7));
 }
 
+// How much of each channel's diffuse light sees the scattered normal (v_scatter_normal) rather
+// than the surface's own: red travels furthest under the skin, blue least.
+const vec3 SCATTER_SOFTNESS = vec3(0.6, 0.3, 0.12);
+// The lips' wet film is smoother than the skin's oil: their tight lobe's roughness.
+const float LIP_ROUGHNESS = 0.38;
+
 // Skin's specular (Fresnel F0 = SKIN_F0) from one light, in its two lobes (broad, tight):
-// GGX distributions of roughness SKIN_ROUGHNESS (alpha = roughness²) with Hammon's
+// GGX distributions of the given roughness (SKIN_ROUGHNESS, the tight lobe LIP_ROUGHNESS on
+// the wet lips; alpha = roughness²) with Hammon's
 // approximation of the height-correlated Smith visibility, times N.L.
 const float SKIN_F0 = 0.028;
-const vec2 SKIN_ROUGHNESS = vec2(0.6, 0.38);
+const vec2 SKIN_ROUGHNESS = vec2(0.6, 0.45);   // (a tighter film, 0.38, read as plastic on the nose)
 const float PEACH_FUZZ = 0.05;   // grazing sheen of the vellus hair, of the light reaching it
-vec2 skin_specular(vec3 n, vec3 l, vec3 v, float ndv) {
+vec2 skin_specular(vec3 n, vec3 l, vec3 v, float ndv, vec2 roughness) {
     vec3 h = normalize(l + v);
     float ndl = max(dot(n, l), 0.0);
     float ndh = max(dot(n, h), 0.0);
-    vec2 alpha = SKIN_ROUGHNESS * SKIN_ROUGHNESS;
+    vec2 alpha = roughness * roughness;
     vec2 a2 = alpha * alpha;
     vec2 d = ndh * ndh * (a2 - 1.0) + 1.0;
     vec2 distribution = a2 / (PI * d * d);
@@ -202,7 +212,7 @@ const float ANTERIOR_CHAMBER = 0.15;
 const float CORNEA_INDEX = 1.376;
 const int IRIS_FIBRES = 96;        // radial noise cells around the iris
 const float COLLARETTE = 0.33;     // where the collarette lies across the iris annulus (0 pupil, 1 rim)
-const vec2 CARUNCLE = vec2(0.5, 0.58);
+const vec2 CARUNCLE = vec2(0.46, 0.56);
 const float IRIS_CAUSTIC = 0.5;    // how much brighter the iris's lower rim is (the key is above)   // nasal e.x where the caruncle begins and is full
 // The key's reflection in the cornea: the softbox's half-size (radians, across and up) and
 // strength; the room's faint reflection over the whole cornea. (Issue 13: at 0.22 x 0.19
@@ -212,7 +222,7 @@ const vec2 SOFTBOX = vec2(0.17, 0.14);
 // rather than the key's ~30 (its middle's reflection lies under the upper lid of most eyes,
 // which then showed no catch-light at all: liam's did not).
 const float SOFTBOX_DROP = 0.22;
-const float KEY_REFLECTION = 0.6;
+const float KEY_REFLECTION = 0.65;   // (0.6 before dark irises kept their brown: the glint over them dimmed)
 // The fill is a broad bounce card to the side: a larger, dimmer reflection (it shows where
 // a lowered lid hides the key's, as in photographs).
 const vec2 FILL_BOX = vec2(0.2, 0.3);
@@ -244,9 +254,10 @@ const vec2 UPPER_SHADOW = vec2(0.6, 2.5);
 const vec2 UPPER_LID_SHADE = vec2(0.6, 8.0);
 const vec2 LOWER_LID_SHADE = vec2(0.2, 3.0);
 // The upper lid's soft cast shadow from the key above (depth at the margin, reach in degrees),
-// on the eyeball's diffuse light only: an evenly lit eyeball to the lid's edge read as glass.
+// on the eyeball's diffuse light only: an evenly lit eyeball to the lid's edge read as glass
+// (0.3 deep left the iris's top as bright as its middle: still glassy).
 // (The cornea's reflection of the key is the key seen past the lid: not shaded by it.)
-const vec2 UPPER_LID_CAST = vec2(0.3, 8.0);
+const vec2 UPPER_LID_CAST = vec2(0.45, 8.0);
 #endif
 
 #if defined(REGION_TEETH) || defined(REGION_TONGUE)
@@ -438,7 +449,7 @@ void main() {
     float pit = smoothstep(0.64, 0.9, grain) * smoothstep(0.3, 0.9, tone.b) * (1.0 - paint.g) * (1.0 - hair);
     float relief_h = mottle - 0.6 * pit;
     vec3 grad = sign(det) * (dFdx(relief_h) * r1 + dFdy(relief_h) * r2);
-    float relief = (0.0012 + 0.0008 * u_age) * (0.5 + tone.b) * (1.0 - paint.g) * (1.0 - hair);
+    float relief = (0.0016 + 0.0008 * u_age) * (0.5 + tone.b) * (1.0 - paint.g) * (1.0 - hair);
     vec3 bumped = normalize(abs(det) * n - relief * grad);
     cavity *= 1.0 - 0.04 * pit;
     float spec_break = 1.0 - 0.7 * pit;   // pores hold no oil film facing the light
@@ -457,12 +468,22 @@ void main() {
     // few millimetres and too much wrap is what looks waxy. Red scatters furthest under the
     // skin, so it sees the smooth normal; green and blue see the pores' relief.
     vec3 wrap = vec3(0.3, 0.13, 0.08) * (1.0 - hair) * (1.0 - 0.3 * u_age);
-    vec3 lit = diffuse_light(n, wrap, contact);
+    // Light entering a fold's shaded flank or a crease comes out a few millimetres away, so
+    // the surface's small relief (the mesh's folds and the drawn grooves) shades red least and
+    // blue most: folds look soft and warm, not carved in grey (v_scatter_normal is the normal
+    // averaged over two rings of neighbours, ~1 cm).
+    vec3 n_scatter = normalize(gl_FrontFacing ? v_scatter_normal : -v_scatter_normal);
+    vec3 softness = SCATTER_SOFTNESS * (1.0 - hair);
+    // (The key only: it alone draws the small relief's light and shade; the fill, rim and
+    // sky are broad and dim, and a second full evaluation cost ~10 % of a video frame.)
+    vec3 key_reach = u_key_col * mix(1.0, contact, KEY_OCCLUSION);
+    vec3 key_sharp = clamp((dot(n, u_key_dir) + wrap) / (1.0 + wrap), 0.0, 1.0) * key_reach;
+    vec3 key_part = mix(key_sharp, clamp((dot(n_scatter, u_key_dir) + wrap) / (1.0 + wrap), 0.0, 1.0) * key_reach,
+                        softness);
+    vec3 lit = diffuse_light(n, wrap, contact) + key_part - key_sharp;
     // Light in the shade reaches the eye after travelling through the skin: all but the
     // direct key (fill, sky, rim) comes out redder and more saturated, as in photographs,
     // where skin in shadow is a deeper red-brown and never the grey of a painted surface.
-    vec3 key_part = clamp((dot(n, u_key_dir) + wrap) / (1.0 + wrap), 0.0, 1.0) * u_key_col
-                  * mix(1.0, contact, KEY_OCCLUSION);
     // (Melanin absorbs much of the scattered light in dark skin: less reddening there.)
     float scatter = (1.0 - hair) * smoothstep(0.03, 0.3, dot(u_skin, vec3(0.2126, 0.7152, 0.0722)));
     lit = key_part + (lit - key_part) * mix(vec3(1.0), vec3(1.14, 0.92, 0.84), scatter);
@@ -476,7 +497,7 @@ void main() {
 #endif
     // Subsurface scattering reddens the terminator: where the key grazes the surface, light
     // that entered on the lit side comes out beyond it, its green and blue absorbed on the way.
-    float key_cos = dot(n_smooth, u_key_dir);
+    float key_cos = dot(n_scatter, u_key_dir);
     lit += u_key_col * vec3(0.075, 0.018, 0.006) * exp(-key_cos * key_cos * 16.0) * contact * scatter;
     // Light that scatters out of the skin's shadowed side is redder than the light going in.
     lit *= mix(vec3(1.0), vec3(1.06, 0.97, 0.95), (1.0 - contact) * (1.0 - hair));
@@ -502,8 +523,9 @@ void main() {
     float wet = lips * (1.0 - 0.85 * lip_line) * (0.55 + 0.45 * blotch);
     // Lobe weights (broad, tight); the fill is too weak to show: key and rim only.
     vec2 weight = vec2(0.6 - 0.3 * wet, 0.22 * film + 0.2 * wet);
-    vec3 spec = dot(skin_specular(bumped, u_key_dir, v, ndv), weight) * u_key_col
-              + dot(skin_specular(bumped, u_rim_dir, v, ndv), weight) * u_rim_col;
+    vec2 roughness = vec2(SKIN_ROUGHNESS.x, mix(SKIN_ROUGHNESS.y, LIP_ROUGHNESS, min(2.0 * wet, 1.0)));
+    vec3 spec = dot(skin_specular(bumped, u_key_dir, v, ndv, roughness), weight) * u_key_col
+              + dot(skin_specular(bumped, u_rim_dir, v, ndv, roughness), weight) * u_rim_col;
     // (Times pi: the diffuse term here is albedo times N.L, without the Lambert 1/pi.)
     spec *= PI * (1.0 - hair) * (0.85 + 0.3 * grain) * spec_break;
     // Peach fuzz: the fine vellus hair on the cheeks and forehead scatters a faint, soft sheen
@@ -568,7 +590,9 @@ void main() {
     // most of all blue ones). The stroma's radial fibres are paler and greyer than the
     // hollows between them, where the pigment shows.
     float iris_grey = dot(u_iris, vec3(0.3, 0.55, 0.15));
-    vec3 base_iris = mix(u_iris, vec3(iris_grey), 0.55);
+    // (Dark brown irises keep more of their hue: their melanin is in the stroma itself, and
+    // greyed they read as black discs, as a doll's eyes.)
+    vec3 base_iris = mix(u_iris, vec3(iris_grey), mix(0.3, 0.62, smoothstep(0.03, 0.12, iris_grey)));
     vec3 iris = base_iris * (0.42 + 1.05 * fibre);
     iris = mix(iris, vec3(iris_grey) * vec3(1.05, 1.0, 0.92) * (0.35 + 1.1 * fibre), 0.35 * smoothstep(0.45, 0.8, fibre) * fibre_detail);
     iris *= mix(vec3(1.0), vec3(0.72, 0.64, 0.52), 0.6 * inner);      // darker, warmer pupillary zone

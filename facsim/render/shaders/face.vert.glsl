@@ -20,6 +20,10 @@ out float v_crease;
 #ifdef USE_LASH
 out float v_lash;
 #endif
+#ifdef REGION_SKIN
+in vec3 in_scatter_normal;  // the normal averaged over a few millimetres (subsurface light sees it)
+out vec3 v_scatter_normal;
+#endif
 #ifdef USE_UV
 in vec2 in_uv;
 out vec2 v_uv;
@@ -39,6 +43,9 @@ void main() {
     v_pos = in_pos;
     v_normal = in_normal;
     v_occlusion = in_occlusion;
+#ifdef REGION_SKIN
+    v_scatter_normal = in_scatter_normal;
+#endif
 #ifdef USE_WRINKLE
     v_wrinkle = in_wrinkle;
     v_crease = in_crease;
