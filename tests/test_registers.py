@@ -330,6 +330,14 @@ def test_pressed_lips_keep_their_corners(engine, marks):
     assert delta[marks["upper_lip"], 1] < -0.02 and delta[marks["lower_lip"], 1] > 0.02
 
 
+def test_tightened_lips_keep_their_corners(engine, marks):
+    """FACS 23 narrows the red of the lips without raising their corners: with mouthPress alone
+    the corners rose 4 mm and EMFACS anger (4+5+7+23) wore a faint smile (session 16)."""
+    delta = _moved(engine, "23")
+    assert abs(delta[marks["lip_corner_left"], 1]) < 0.02
+    assert delta[marks["upper_lip"], 1] - delta[marks["lower_lip"], 1] < -0.04     # red narrowed >= 4 mm
+
+
 def _emotion_moved(engine, name, level=1.0):
     from facsim.facs.emotions import emotion
 
