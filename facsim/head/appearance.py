@@ -140,7 +140,7 @@ class Appearance:
 ETHNIC_COLORS = {
     "caucasian": {"skin": "#e6b8a2", "brows": "#5c4332", "iris": "#5b7088", "sclera": "#ede6df"},
     "asian": {"skin": "#dfb698", "brows": "#211b17", "iris": "#4a321f", "sclera": "#ebe3d8"},
-    "african": {"skin": "#774a36", "brows": "#161210", "iris": "#3d2617", "sclera": "#e6dccc"},
+    "african": {"skin": "#774a36", "brows": "#161210", "iris": "#3d2617", "sclera": "#dacdba"},
 }
 FIXED_COLORS = {
     "lashes": "#1b1511",
