@@ -219,6 +219,40 @@ def mouth_depth_visibility(head, neutral: np.ndarray, *, falloff: float = 0.12):
     return interior, np.exp(-depth / falloff).astype(np.float32)
 
 
+#: The lips' mucosa (the smooth, wet, redder lining the lips turn toward each other) covers
+#: the skin within the first geodesic distance (dm) of the lips' inner rim and fades out by
+#: the second. Where the closed lips touch (2.5-5 mm of surface in from the rim on hm08,
+#: then they turn out into the vermilion), the wet-dry line runs: an open mouth shows the
+#: mucosa as a darker red band between the lips' red and the dark inside. Without it the
+#: vermilion's dry, lined red ran to the opening's edge, "a cut-out hole".
+MUCOSA_REACH = (0.025, 0.05)
+
+
+def lip_mucosa(head) -> np.ndarray:
+    """(N_geo,) float32 per vertex: how much of the lips' mucosa it carries (1 at the lips'
+    inner rim, the skin bordering the mouth's lining, fading to 0 at
+    :data:`MUCOSA_REACH`'s far end, measured along the skin of the base mesh)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import dijkstra
+
+    from facsim.head.mesh import REGIONS
+    from facsim.head.surface import smoothstep
+
+    skin = head.region == REGIONS.index("skin")
+    lining = head.region == REGIONS.index("mouth_interior")
+    triangles = head.triangles
+    rim = np.unique(triangles[lining[triangles].any(axis=1)])
+    rim = rim[skin[rim]]
+    edges = np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]])
+    edges = edges[skin[edges].all(axis=1)]
+    p = head.positions(head.base_vertices)
+    length = np.linalg.norm(p[edges[:, 0]] - p[edges[:, 1]], axis=1)
+    graph = coo_matrix((length, (edges[:, 0], edges[:, 1])), shape=(len(p), len(p))).tocsr()
+    near, far = MUCOSA_REACH
+    distance = dijkstra(graph, directed=False, indices=rim, min_only=True, limit=2 * far)
+    return np.asarray(smoothstep(far, near, distance), np.float32)
+
+
 #: Ambient visibility the lips' inner surface reaches once the lips part, per ring of skin
 #: vertices from the rim (the wet mucosa the lips turn toward each other): the bake is
 #: taken on the closed mouth, where the rim is buried (visibility ~0), so an open mouth

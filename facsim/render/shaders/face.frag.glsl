@@ -97,6 +97,8 @@ vec2 spots(vec2 p, float prob, float radius, int salt) {
 const float SKIN_F0 = 0.028;
 const vec2 SKIN_ROUGHNESS = vec2(0.6, 0.38);
 const float PEACH_FUZZ = 0.05;   // grazing sheen of the vellus hair, of the light reaching it
+const vec3 MUCOSA = vec3(0.40, 0.075, 0.09);   // the lips' mucosa (linear; sRGB ~ #aa4d54)
+const float MUCOSA_SHINE = 0.5;                // its wet film's glint, of the light reaching it
 vec2 skin_specular(vec3 n, vec3 l, vec3 v, float ndv) {
     vec3 h = normalize(l + v);
     float ndl = max(dot(n, l), 0.0);
@@ -340,6 +342,12 @@ void main() {
                    * (0.25 + 0.75 * hash2(ivec2(int(floor(lip_s + 0.5)), 7)))    // uneven furrows,
                    * (0.3 + 0.7 * grain);                                         // broken along their length
     lip_line = mix(0.1, lip_line, clamp(1.6 - 3.0 * fwidth(lip_s), 0.0, 1.0));
+    // Inside the wet-dry line the lips roll into their mucosa (detail.a, facsim.head.mouth.
+    // lip_mucosa): smooth (no furrows), wet, a deeper and more bluish red than the vermilion
+    // (unpigmented: pink-red on dark lips too). Hidden where the closed lips touch, it is the
+    // band an open mouth shows between the lips' red and the dark inside.
+    float mucosa = detail.a;
+    lip_line *= 1.0 - mucosa;
     float lip_core = smoothstep(0.45, 0.95, lips);
     float border = lips * (1.0 - lips) * 4.0;
     vec3 lip_col = u_lips * (0.92 + 0.16 * blotch) * (1.0 - (0.16 + 0.16 * u_age) * lip_line * lip_core);
@@ -348,6 +356,7 @@ void main() {
     lip_col = mix(mix(albedo, u_lips, 0.6), lip_col, lip_core);
     albedo = mix(albedo, lip_col, smoothstep(0.0, 1.0, lips));
     albedo *= 1.0 + 0.03 * border * (1.0 - u_age);   // (faint: a bright rim outlined the lips)
+    albedo = mix(albedo, mix(u_lips, MUCOSA, 0.8) * (0.9 + 0.2 * blotch), mucosa);
 #ifdef USE_BROWS
     vec2 brow = brow_hair(v_uv, paint.r);
 #else
@@ -389,7 +398,7 @@ void main() {
     n = normalize(abs(det) * n - sign(det) * (dh_dx * r1 + dh_dy * r2));
 #ifdef USE_WRINKLE
     // The engine's furrows, except where the fold map draws the lines itself (folds.a).
-    Fold fold = crease_fold(v_wrinkle * (1.0 - folds.a), v_crease, v_uv);
+    Fold fold = crease_fold(v_wrinkle * (1.0 - folds.a) * (1.0 - mucosa), v_crease, v_uv);
     // Compressed skin is a little darker overall (blood pushed together, less light between
     // the rolls), and the crevices' bottoms darker still.
     cavity *= (1.0 - u_wrinkle_darken * clamp(v_wrinkle, 0.0, 1.0)) * (1.0 - 0.5 * fold.crevice);
@@ -485,13 +494,16 @@ void main() {
     float film = smoothstep(0.6, 1.05, oil);
     // Moist, but the film is broken by the furrows and by the lips' fine mottle: a continuous
     // glossy band along the lip read as rubber.
-    float wet = lips * (1.0 - 0.85 * lip_line) * (0.55 + 0.45 * blotch);
+    float wet = max(lips * (1.0 - 0.85 * lip_line) * (0.55 + 0.45 * blotch), mucosa);
     // Lobe weights (broad, tight); the fill is too weak to show: key and rim only.
     vec2 weight = vec2(0.6 - 0.3 * wet, 0.35 * film + 0.2 * wet);
     vec3 spec = dot(skin_specular(bumped, u_key_dir, v, ndv), weight) * u_key_col
               + dot(skin_specular(bumped, u_rim_dir, v, ndv), weight) * u_rim_col;
     // (Times pi: the diffuse term here is albedo times N.L, without the Lambert 1/pi.)
     spec *= PI * (1.0 - hair) * (0.85 + 0.3 * grain) * spec_break;
+    // The mucosa's film of saliva mirrors the lights in a thin bright line where the lip's
+    // inner edge turns toward them.
+    spec += mucosa * MUCOSA_SHINE * (blinn(n, u_key_dir, v, 160.0) * u_key_col + blinn(n, u_rim_dir, v, 160.0) * u_rim_col);
     // Peach fuzz: the fine vellus hair on the cheeks and forehead scatters a faint, soft sheen
     // where the skin turns away from the eye (toward the face's outline), never a highlight.
     float graze = 1.0 - ndv;
