@@ -263,6 +263,13 @@ LIP_PARTING = (0.005, 0.04)
 #: The tongue lies in the dark behind the teeth until the lips part this far (dm) at the
 #: midline, and takes the light the mouth lets in when they have parted this far.
 TONGUE_LIT_GAP = (0.003, 0.025)
+#: Near the mouth's corners the teeth lie in the shade of the lips and cheeks wrapped
+#: around them (the buccal corridor): a tooth vertex's height below the upper lip's edge
+#: is taken as at most (slope × its distance across the mouth from the nearer corner −
+#: offset, dm), so the lip's shadow deepens toward the corners, darkest at them and gone
+#: ~10 mm in. Lit evenly to the corners, the back teeth of a wide mouth (20+26) showed as
+#: pale slabs filling the commissures.
+COMMISSURE_SHADE = (0.3, 0.008)
 #: How many rings of skin around the rim count as the upper lip's free margin.
 UPPER_LIP_RINGS = 5
 @dataclass(frozen=True)
@@ -417,6 +424,8 @@ def mouth_light(rim: MouthRim, positions: np.ndarray, occlusion: np.ndarray) -> 
       edge is close to straight between the teeth's columns), so the teeth's shader draws
       the lip's soft contact shadow right under its edge, millimetres wide, where the
       band's vertices lie 8 mm apart. (The bake under closed lips means nothing for them.)
+      Toward the mouth's corners the height is capped (:data:`COMMISSURE_SHADE`): the
+      teeth there sit in the lips' and cheeks' shade.
     - the tongue takes the light the parted lips let in (:data:`TONGUE_LIT_GAP`): seen
       through the gaps between barely parted teeth it is dark, not a pink dot.
 
@@ -435,9 +444,12 @@ def mouth_light(rim: MouthRim, positions: np.ndarray, occlusion: np.ndarray) -> 
     lit = np.clip((upper_edge(middle) - lower_edge(middle) - rim.rest_gap_middle - lo) / (hi - lo), 0.0, 1.0)
     occlusion[rim.tongue] = lit * lit * (3.0 - 2.0 * lit)
     lip_x, lip_y = plane(rim.upper_lip)
+    corners = plane(rim.upper)[0][[0, -1]]
     for teeth in (rim.upper_teeth, rim.lower_teeth):
         x, y = plane(teeth)
         # The upper lip's lowest point within a tooth column's reach of x.
         over = np.abs(x[:, None] - lip_x[None]) < COLUMN_REACH
         edge = np.where(over.any(axis=1), np.where(over, lip_y[None], np.inf).min(axis=1), upper_edge(x))
-        occlusion[teeth] = edge - y
+        from_corner = np.minimum(x - corners.min(), corners.max() - x)
+        slope, offset = COMMISSURE_SHADE
+        occlusion[teeth] = np.minimum(edge - y, slope * from_corner - offset)

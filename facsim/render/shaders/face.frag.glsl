@@ -502,8 +502,11 @@ void main() {
     // (Times pi: the diffuse term here is albedo times N.L, without the Lambert 1/pi.)
     spec *= PI * (1.0 - hair) * (0.85 + 0.3 * grain) * spec_break;
     // The mucosa's film of saliva mirrors the lights in a thin bright line where the lip's
-    // inner edge turns toward them.
-    spec += mucosa * MUCOSA_SHINE * (blinn(n, u_key_dir, v, 160.0) * u_key_col + blinn(n, u_rim_dir, v, 160.0) * u_rim_col);
+    // inner edge turns toward them. (A branch: llvmpipe skips it for the blocks of pixels
+    // away from the lips, nearly all of them.)
+    if (mucosa > 0.0) {
+        spec += mucosa * MUCOSA_SHINE * (blinn(n, u_key_dir, v, 160.0) * u_key_col + blinn(n, u_rim_dir, v, 160.0) * u_rim_col);
+    }
     // Peach fuzz: the fine vellus hair on the cheeks and forehead scatters a faint, soft sheen
     // where the skin turns away from the eye (toward the face's outline), never a highlight.
     float graze = 1.0 - ndv;
@@ -766,10 +769,13 @@ void main() {
     // Light inside the mouth falls off with depth: the front teeth catch it, the back ones sit
     // in the shadow of the cheeks (the dark buccal corridor). The upper lip casts a soft
     // contact shadow just under its edge: v_occlusion is the fragment's height (dm) below
-    // that edge in this frame (facsim.head.mouth.mouth_light; 1 when nobody passes it). The
+    // that edge in this frame, less toward the mouth's corners, where the lips and cheeks
+    // shade the teeth (facsim.head.mouth.mouth_light; 1 when nobody passes it). The
     // lower row stands back under the upper teeth and lip and faces up into the mouth:
     // darker, and mostly hidden.
-    float depth_shade = mix(1.0, 0.09, smoothstep(0.12, 0.36, arc));
+    // (The lower row's back teeth sit lower in the cheeks' shade: its corridor starts nearer
+    // the front, or a stretched mouth (20+26) showed them as pale slabs in its corners.)
+    float depth_shade = mix(1.0, 0.09, smoothstep(mix(0.12, 0.08, lower), mix(0.36, 0.28, lower), arc));
     float lip_shadow = mix(0.5, 1.0, smoothstep(-0.002, 0.022, v_occlusion));
     float row_light = mix(1.0, 0.62, lower);
     // The inside of the arch faces the tongue and throat: it only catches light scattered in.
