@@ -338,3 +338,21 @@ def test_an_open_mouth_shows_a_wet_red_band_inside_the_lips(face_of):
     r0, g0, b0 = without[band].mean(axis=0)
     assert _luminance(image[band]).mean() < _luminance(without[band]).mean()
     assert r / (g + b) > r0 / (g0 + b0)   # redder than the dry lip it replaces
+
+
+def test_parted_lips_light_the_lining_just_inside_them(face_of):
+    # The lining's first rings inside the rim are the lips' mucosa going on: closed lips keep
+    # them as baked (in the cavity's dark), parted lips open them to the light.
+    from facsim.head.mouth import LINING_RING_VISIBILITY, mouth_rim
+
+    face = face_of("ava")
+    rim = mouth_rim(face.head, face.data, face.neutral)
+    assert len(rim.lining_rings) == len(LINING_RING_VISIBILITY)
+    first = rim.lining_rings[0]
+    assert (face.head.region[first] == REGIONS.index("mouth_interior")).all()
+    assert not np.intersect1d(first, np.concatenate(rim.rings)).size
+    rest = face.frame_occlusion(face.neutral)
+    np.testing.assert_allclose(rest[first], face.shading_occlusion[first])
+    opened = face.frame_occlusion(np.asarray(face.deform("1+2+5+26").positions))
+    assert (opened[first] >= LINING_RING_VISIBILITY[0] - 1e-6).mean() > 0.5
+    assert np.median(opened[first]) > np.median(rest[first]) + 0.2

@@ -258,6 +258,11 @@ def lip_mucosa(head) -> np.ndarray:
 #: taken on the closed mouth, where the rim is buried (visibility ~0), so an open mouth
 #: showed its lips' inner edge black, a hard outline.
 LIP_RING_VISIBILITY = (0.5, 0.65, 0.8)
+#: The same for the mouth's lining, ring by ring inward from the rim: just inside the lips
+#: it is their mucosa going on toward the gums, lit through the opening (and drawn in the
+#: mucosa's red) as the lips part, where the bake on the closed mouth left it in the
+#: cavity's dull dark: a dark seam along the lips' inner edge.
+LINING_RING_VISIBILITY = (0.9, 0.7)
 #: The lips have parted over this range of gap (dm) at a given x: 0.5 mm -> 4 mm.
 LIP_PARTING = (0.005, 0.04)
 #: The tongue lies in the dark behind the teeth until the lips part this far (dm) at the
@@ -296,6 +301,10 @@ class MouthRim:
         front of their inner rims, which sit apart; only a wider gap parts the lips.
     rest_gap_middle : float
         The same in the mouth's middle.
+    lining_rings : tuple of (K_i,) int
+        The mouth's lining just inside the rim, ring by ring inward (:data:`LINING_RING_VISIBILITY`).
+    lining_rest_gap : tuple of (K_i,) float
+        Their rest gaps, as ``rest_gap``.
     """
 
     upper: np.ndarray
@@ -307,6 +316,8 @@ class MouthRim:
     tongue: np.ndarray
     rest_gap: tuple = ()
     rest_gap_middle: float = 0.0
+    lining_rings: tuple = ()
+    lining_rest_gap: tuple = ()
 
 
 def mouth_rim(head, data, neutral: np.ndarray) -> MouthRim:
@@ -338,15 +349,25 @@ def mouth_rim(head, data, neutral: np.ndarray) -> MouthRim:
             up, down = (near == 1).any(), (near == 2).any()
             side[v] = 1 if up and not down else 2 if down and not up else 0
     upper_lip = np.flatnonzero(side == 1)
+    lining_rings, reached = [], np.zeros(len(region), bool)
+    reached[rings[0]] = True
+    for _ in LINING_RING_VISIBILITY:
+        ring = np.unique(triangles[reached[triangles].any(axis=1)])
+        ring = ring[lining[ring] & ~reached[ring]]
+        lining_rings.append(ring)
+        reached[ring] = True
     rings = rings[: len(LIP_RING_VISIBILITY)]
     by_x = lambda idx: idx[np.argsort(np.asarray(neutral)[idx, 0])]  # noqa: E731
     rim = MouthRim(upper=by_x(upper), lower=by_x(lower), rings=tuple(rings), upper_lip=upper_lip,
                    upper_teeth=head.group_geometry(data, UPPER_TEETH),
                    lower_teeth=head.group_geometry(data, LOWER_TEETH),
-                   tongue=head.group_geometry(data, TONGUE))
+                   tongue=head.group_geometry(data, TONGUE), lining_rings=tuple(lining_rings))
     plane, upper_edge, lower_edge, middle = _lips(rim, p)
-    gaps = tuple(np.maximum(upper_edge(x) - lower_edge(x), 0.0) for x in (plane(ring)[0] for ring in rings))
-    return replace(rim, rest_gap=gaps, rest_gap_middle=float(max(upper_edge(middle) - lower_edge(middle), 0.0)))
+
+    def gaps(ring_list):
+        return tuple(np.maximum(upper_edge(x) - lower_edge(x), 0.0) for x in (plane(ring)[0] for ring in ring_list))
+    return replace(rim, rest_gap=gaps(rings), lining_rest_gap=gaps(lining_rings),
+                   rest_gap_middle=float(max(upper_edge(middle) - lower_edge(middle), 0.0)))
 
 
 def _split_rim(rim: np.ndarray, triangles: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -417,8 +438,8 @@ def mouth_light(rim: MouthRim, positions: np.ndarray, occlusion: np.ndarray) -> 
     """Light the mouth by where the lips are in this frame (in place on ``occlusion``,
     (N_geo,), as baked on the closed mouth):
 
-    - the lips' inner surface opens to the light as the lips part at its x (the bake
-      buried it: an open mouth's lips had a black inner edge);
+    - the lips' inner surface, and the lining just inside it, open to the light as the
+      lips part at its x (the bake buried it: an open mouth's lips had a black inner edge);
     - each tooth vertex gets its height (dm) below the upper lip's edge at its x, not a
       visibility: interpolated across a triangle it is that height per fragment (the lip's
       edge is close to straight between the teeth's columns), so the teeth's shader draws
@@ -434,7 +455,8 @@ def mouth_light(rim: MouthRim, positions: np.ndarray, occlusion: np.ndarray) -> 
     """
     plane, upper_edge, lower_edge, middle = _lips(rim, positions)
     lo, hi = LIP_PARTING
-    for ring, visibility, rest_gap in zip(rim.rings, LIP_RING_VISIBILITY, rim.rest_gap):
+    for ring, visibility, rest_gap in zip(rim.rings + rim.lining_rings, LIP_RING_VISIBILITY + LINING_RING_VISIBILITY,
+                                          rim.rest_gap + rim.lining_rest_gap):
         x, _ = plane(ring)
         # Parted beyond where the lips' inner rims sit at rest (they touch in front of them).
         parted = np.clip((upper_edge(x) - lower_edge(x) - rest_gap - lo) / (hi - lo), 0.0, 1.0)

@@ -97,8 +97,8 @@ vec2 spots(vec2 p, float prob, float radius, int salt) {
 const float SKIN_F0 = 0.028;
 const vec2 SKIN_ROUGHNESS = vec2(0.6, 0.38);
 const float PEACH_FUZZ = 0.05;   // grazing sheen of the vellus hair, of the light reaching it
-const vec3 MUCOSA = vec3(0.40, 0.075, 0.09);   // the lips' mucosa (linear; sRGB ~ #aa4d54)
-const float MUCOSA_SHINE = 0.5;                // its wet film's glint, of the light reaching it
+const float MUCOSA_SHINE = 0.3;                // its wet film's glint, of the light reaching it
+                                               // (broad: a tight one broke into beads along the lip)
 vec2 skin_specular(vec3 n, vec3 l, vec3 v, float ndv) {
     vec3 h = normalize(l + v);
     float ndl = max(dot(n, l), 0.0);
@@ -251,6 +251,9 @@ const vec2 LOWER_LID_SHADE = vec2(0.2, 3.0);
 const vec2 UPPER_LID_CAST = vec2(0.3, 8.0);
 #endif
 
+#if defined(REGION_SKIN) || defined(REGION_MOUTH_INTERIOR)
+const vec3 MUCOSA = vec3(0.40, 0.075, 0.09);   // the lips' mucosa (linear; sRGB ~ #aa4d54)
+#endif
 #if defined(REGION_TEETH) || defined(REGION_TONGUE)
 #define ONE_ALBEDO
 #endif
@@ -505,7 +508,7 @@ void main() {
     // inner edge turns toward them. (A branch: llvmpipe skips it for the blocks of pixels
     // away from the lips, nearly all of them.)
     if (mucosa > 0.0) {
-        spec += mucosa * MUCOSA_SHINE * (blinn(n, u_key_dir, v, 160.0) * u_key_col + blinn(n, u_rim_dir, v, 160.0) * u_rim_col);
+        spec += mucosa * MUCOSA_SHINE * (blinn(n, u_key_dir, v, 50.0) * u_key_col + blinn(n, u_rim_dir, v, 50.0) * u_rim_col);
     }
     // Peach fuzz: the fine vellus hair on the cheeks and forehead scatters a faint, soft sheen
     // where the skin turns away from the eye (toward the face's outline), never a highlight.
@@ -817,10 +820,14 @@ void main() {
     // depth behind the lips (Face passes facsim.head.mouth.mouth_depth_visibility in occ) to
     // a warm, dull dark (light scattered through cheeks and lips), never black and never a
     // saturated red (seen through the gaps between the teeth, red read as braces' bands).
+    // Just inside the lips the lining is their mucosa going on, lit through the opening as
+    // the lips part (mouth_light lifts occ there): the lips' red and wet film, not the dark.
     float mouth_shade = occ * occ;
-    vec3 spec = specular_light(n, v, 30.0) * 0.04;
+    float lip_side = smoothstep(0.6, 0.9, occ);
+    vec3 spec = specular_light(n, v, 30.0) * mix(0.04, 0.3, lip_side);
     vec3 deep = 0.18 * mix(vec3(dot(u_albedo, vec3(0.33))), u_albedo, 0.5);
-    radiance = (diffuse_light(n, vec3(0.3, 0.1, 0.1), 1.0) * u_albedo * 0.45 + spec) * mouth_shade
+    vec3 albedo = mix(u_albedo * 0.45, MUCOSA * 0.8, lip_side);
+    radiance = (diffuse_light(n, vec3(0.3, 0.1, 0.1), 1.0) * albedo + spec) * mouth_shade
              + deep * (1.0 - mouth_shade);
 #endif
 
