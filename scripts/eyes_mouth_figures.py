@@ -21,10 +21,18 @@ down the midline (5 px wide) at 5, 15 … 95 % of the
 opening's height from the upper lip, and the mean luminance of the opening's outer sixth on each
 side (the corners of the mouth: the buccal corridor's shade).
 
+The lips' mucosa (``--mucosa``), 6+12+25 and 1+2+5+26 at 512², front: the pixels the mucosa
+changes (a render with the detail texture's mucosa channel cleared against the normal one),
+their count and median height per column over the lower and the upper lip (the band's width
+as seen), their mean sRGB colour (and the same pixels' without the mucosa) against the vermilion's (the lips' other pixels, found by
+recolouring the lips), the share of them darker than the vermilion's median, and their 99th
+percentile luminance (the wet glint).
+
 Usage::
 
     python3 scripts/eyes_mouth_figures.py [CHARACTER ...]      (default: amara liam mei george)
     python3 scripts/eyes_mouth_figures.py --cavity [--engine muscle] [--expression 27] [CHARACTER ...]
+    python3 scripts/eyes_mouth_figures.py --mucosa [--engine muscle] [CHARACTER ...]
 """
 from __future__ import annotations
 
@@ -118,6 +126,41 @@ def cavity_figures(character, expression="1+2+5+26", size=512, engine="registers
             "midline_luminance": profile, "corner_luminance": corners}
 
 
+def mucosa_figures(character, expression="6+12+25", size=512, engine="registers") -> dict:
+    import dataclasses
+
+    with Face(character, engine=engine) as face:
+        deformation = face.deform(expression)
+        image = face.render(deformation=deformation, size=size, background=WHITE)[..., :3].astype(float)
+        detail = face.appearance.detail.copy()
+        detail[..., 3] = 0
+        face.__dict__["appearance"] = dataclasses.replace(face.appearance, detail=detail)
+        dry = face.render(deformation=deformation, size=size, background=WHITE)[..., :3].astype(float)
+        positions = np.asarray(deformation.positions)
+        from facsim.render.camera import project
+
+        middle, _ = project(face.camera(size=(size, size)), positions[np.r_[face._mouth_rim.upper, face._mouth_rim.lower]],
+                            (size, size))
+    with Face(character.with_(colors={**character.colors, "lips": "#00ff00"}), engine=engine) as face:
+        marked = face.render(deformation=deformation, size=size, background=WHITE)[..., :3].astype(float)
+    band = np.abs(image - dry).max(-1) > 3
+    lips = (_changed(marked, image) | band) & ~band
+    centre_y = middle[:, 1].mean()
+    ys, xs = np.nonzero(band)
+    central = np.abs(xs - np.median(xs)) < (xs.max() - xs.min()) / 6
+    widths = {}
+    for name, side in (("lower", ys > centre_y), ("upper", ys <= centre_y)):
+        keep = central & side
+        counts = np.bincount(xs[keep], minlength=size)[np.unique(xs[keep])]
+        widths[name] = float(np.median(counts)) if len(counts) else 0.0
+    srgb = lambda pixels: [round(float(c), 1) for c in pixels.mean(axis=0)]  # noqa: E731
+    luminance = image @ LUMINANCE
+    return {"band_px": int(band.sum()), "width_lower_upper_px": [widths["lower"], widths["upper"]],
+            "band_rgb": srgb(image[band]), "band_rgb_without": srgb(dry[band]), "vermilion_rgb": srgb(image[lips]),
+            "darker_share": round(float((luminance[band] < np.median(luminance[lips])).mean()), 3),
+            "band_luminance_p99": round(float(np.percentile(luminance[band], 99)), 1)}
+
+
 def catch_light_figures(character, size=320) -> dict:
     image, marked = _renders(character, "", [{"iris": "#ff0000", "pupil": "#ff0000"}], size=size, antialias=1)
     bright = _changed(marked, image) & (image @ LUMINANCE > 120)
@@ -156,9 +199,15 @@ def main(argv=None) -> None:
     parser.add_argument("--cavity", action="store_true", help="the open mouth's figures only")
     parser.add_argument("--engine", default="registers", choices=["registers", "muscle"])
     parser.add_argument("--expression", default="1+2+5+26", help="the open mouth's expression (--cavity)")
+    parser.add_argument("--mucosa", action="store_true", help="the lips' mucosa figures only")
     args = parser.parse_args(argv)
     for name in args.characters:
         character = preset(name)
+        if args.mucosa:
+            for expression in ("6+12+25", "1+2+5+26"):
+                figures = mucosa_figures(character, expression, engine=args.engine)
+                print(name, args.engine, expression, "  ".join(f"{k} {v}" for k, v in figures.items()), flush=True)
+            continue
         if args.cavity:
             figures = cavity_figures(character, args.expression, engine=args.engine)
             print(name, args.engine, args.expression, "  ".join(f"{k} {v}" for k, v in figures.items()), flush=True)

@@ -292,3 +292,67 @@ def test_the_mouths_light_follows_the_lips(face_of):
     assert smile[rim.rings[0]].max() == pytest.approx(LIP_RING_VISIBILITY[0])
     assert smile[rim.tongue].min() > 0.9
     assert np.median(smile[edge]) > np.median(rest[edge]) + 0.03   # 3 mm more of the teeth below the lip
+
+
+def test_the_lips_mucosa_lines_their_inner_rim(face_of):
+    # The wet, redder lining the lips turn toward each other: on the skin bordering the
+    # mouth's lining, fading out within 5 mm along the lips, never on their outer red.
+    from facsim.head.mouth import MUCOSA_REACH, lip_mucosa, mouth_rim
+
+    face = face_of("ava")
+    mucosa = lip_mucosa(face.head)
+    rim = mouth_rim(face.head, face.data, face.neutral)
+    np.testing.assert_allclose(mucosa[np.r_[rim.upper, rim.lower]], 1.0)
+    skin = face.head.skin
+    p = face.neutral
+    # Each lip's most forward point at the midline is vermilion, more than 5 mm from the rim.
+    middle = skin[np.abs(p[skin, 0]) < 0.01]
+    for lip, sign in ((rim.upper, 1), (rim.lower, -1)):
+        height = sign * (p[middle, 1] - p[lip, 1].mean())
+        near = middle[(height > 0) & (height < 0.12)]
+        assert mucosa[near[np.argmax(p[near, 2])]] == 0.0
+    assert (mucosa[skin] > 0).sum() < 4 * (mucosa[skin] == 1).sum()   # a band, not a blur
+    assert mucosa[face.head.region != REGIONS.index("skin")].max() == 0.0
+    assert MUCOSA_REACH[0] < MUCOSA_REACH[1]
+
+
+def test_an_open_mouth_shows_a_wet_red_band_inside_the_lips(face_of):
+    # In a smile with parted lips the lower lip's inner surface shows between its red and the
+    # teeth: the mucosa, deeper red than the vermilion, its furrows gone and its film
+    # glinting. Without it the dry vermilion ran to the opening's edge (a "cut-out hole").
+    import dataclasses
+
+    from facsim import Face
+
+    face = face_of("ava")
+    deformation = face.deform("6+12+25")
+    image = face.render(deformation=deformation, size=256)[..., :3].astype(float)
+    with Face(face.character) as dry:
+        detail = dry.appearance.detail.copy()
+        detail[..., 3] = 0
+        dry.__dict__["appearance"] = dataclasses.replace(dry.appearance, detail=detail)
+        without = dry.render(deformation=deformation, size=256)[..., :3].astype(float)
+    band = np.abs(image - without).max(axis=-1) > 3
+    assert band.sum() > 100
+    r, g, b = image[band].mean(axis=0)
+    r0, g0, b0 = without[band].mean(axis=0)
+    assert _luminance(image[band]).mean() < _luminance(without[band]).mean()
+    assert r / (g + b) > r0 / (g0 + b0)   # redder than the dry lip it replaces
+
+
+def test_parted_lips_light_the_lining_just_inside_them(face_of):
+    # The lining's first rings inside the rim are the lips' mucosa going on: closed lips keep
+    # them as baked (in the cavity's dark), parted lips open them to the light.
+    from facsim.head.mouth import LINING_RING_VISIBILITY, mouth_rim
+
+    face = face_of("ava")
+    rim = mouth_rim(face.head, face.data, face.neutral)
+    assert len(rim.lining_rings) == len(LINING_RING_VISIBILITY)
+    first = rim.lining_rings[0]
+    assert (face.head.region[first] == REGIONS.index("mouth_interior")).all()
+    assert not np.intersect1d(first, np.concatenate(rim.rings)).size
+    rest = face.frame_occlusion(face.neutral)
+    np.testing.assert_allclose(rest[first], face.shading_occlusion[first])
+    opened = face.frame_occlusion(np.asarray(face.deform("1+2+5+26").positions))
+    assert (opened[first] >= LINING_RING_VISIBILITY[0] - 1e-6).mean() > 0.5
+    assert np.median(opened[first]) > np.median(rest[first]) + 0.2

@@ -103,6 +103,23 @@ def test_moving_the_au12_slider_changes_the_face(page):
     assert 850 <= slider_value(page, "#au-12") <= 950
 
 
+def test_the_3d_view_shows_the_garment_only_with_a_body(page):
+    # The preview's .glb always carries the neck, shoulders and garment; with Body "none" the
+    # render is the head alone, and the 3-D view showed the garment anyway.
+    shown = "() => studio.viewer.root.getObjectByName('body').visible"
+    assert page.eval_on_selector("#body", "e => e.value") == "crewneck" and page.evaluate(shown)
+    dressed = canvas(page)
+    page.select_option("#body", "none")
+    assert not page.evaluate(shown)
+    bare = canvas(page)
+    changed = np.abs(bare - dressed).sum(axis=2) > 24
+    assert changed.sum() > 300, "the garment did not go"
+    assert np.flatnonzero(changed.any(axis=1)).mean() > dressed.shape[0] * 0.5   # below the face
+    page.select_option("#body", "crewneck")
+    assert page.evaluate(shown)
+    assert (np.abs(canvas(page) - dressed).sum(axis=2) > 24).sum() < 50
+
+
 def test_typing_facs_moves_the_sliders_and_errors_point_at_the_token(page):
     page.fill("#facs", "R12C+14A")
     page.wait_for_function("document.querySelector('#au-12-right').value === '550'")

@@ -62,7 +62,7 @@ class Appearance:
     detail : (H, W, 4) uint8, optional
         Skin detail in the same UV space and row order: R = redness (nose, cheeks, ears,
         caruncle), G = beard area, B = oiliness (the T-zone's sheen, wet lid margins),
-        A unused (0; the age lines are in ``folds``).
+        A = the lips' mucosa (their wet inner surface, :func:`facsim.head.mouth.lip_mucosa`).
     beard : float
         0 … 1: how much the beard area shows a shaved stubble shadow.
     age : float
@@ -278,13 +278,13 @@ DETAIL_SIZE = (2048, 1024)  # rows (v), columns (u) over assets.PAINT_UV_BOX; fi
 
 
 #: Bump when the detail recipe changes, so cached detail textures are redone.
-DETAIL_VERSION = 7  # 7: the age lines moved to the fold map (facsim.head.skin.fold_texture); 6: wider grooves; 5: positions upsampled cubically; 4: 2048 rows; 3: sheen on the cheekbones; 2: irregular age lines, an asymmetric nasolabial fold
+DETAIL_VERSION = 8  # 8: the lips' mucosa in A; 7: the age lines moved to the fold map (facsim.head.skin.fold_texture); 6: wider grooves; 5: positions upsampled cubically; 4: 2048 rows; 3: sheen on the cheekbones; 2: irregular age lines, an asymmetric nasolabial fold
 
 
 @lru_cache(maxsize=2)
 def detail_texture(head) -> np.ndarray:
-    """(rows, cols, 4) uint8 skin detail: redness, beard area, oiliness, 0 (see
-    :class:`Appearance`), placed by anatomy on the base mesh.
+    """(rows, cols, 4) uint8 skin detail: redness, beard area, oiliness, the lips' mucosa
+    (:func:`facsim.head.mouth.lip_mucosa`), placed by anatomy on the base mesh.
     It depends on the base mesh only, so it is computed once and cached on disk."""
     return cached_array(cache_dir() / f"skin-detail-v{DETAIL_VERSION}.npy", lambda: _build_detail(head),
                         valid=lambda a: a.shape == (*DETAIL_SIZE, 4) and a.dtype == np.uint8)
@@ -295,6 +295,8 @@ def _build_detail(head) -> np.ndarray:
     # along the thin lid margins.
     from scipy.ndimage import zoom
 
+    from facsim.head.mouth import lip_mucosa
+
     source = position_map(head)
     positions = zoom(source, (DETAIL_SIZE[0] / source.shape[0], DETAIL_SIZE[1] / source.shape[1], 1), order=3)
     lips = _resize(head.masks["lips"].astype(np.float32) / 255, DETAIL_SIZE)
@@ -302,7 +304,7 @@ def _build_detail(head) -> np.ndarray:
     margin = lid_margin_density(positions, centre, radius)
     channels = (np.maximum(redness_density(positions), caruncle_density(positions, centre, radius)),
                 beard_density(positions) * (1 - np.clip(lips * 2, 0, 1)),
-                np.maximum(oil_density(positions), margin), np.zeros(DETAIL_SIZE, np.float32))
+                np.maximum(oil_density(positions), margin), _vertex_map(head, lip_mucosa(head), DETAIL_SIZE))
     detail = np.empty((*DETAIL_SIZE, 4), np.uint8)
     for k, mask in enumerate(channels):
         detail[..., k] = np.clip(mask * 255 + 0.5, 0, 255)
@@ -421,6 +423,30 @@ def _resize(image: np.ndarray, size: tuple[int, int]) -> np.ndarray:
 def position_map(head) -> np.ndarray:
     """Base-mesh 3-D position at each texel of the paint box (NaN off the mesh); cached on disk."""
     return cached_array(cache_dir() / _POSITION_MAP_FILE, lambda: _build_position_map(head))
+
+
+def _vertex_map(head, values: np.ndarray, size: tuple[int, int]) -> np.ndarray:
+    """(rows, cols) float32 texels of the paint box (``size``) with the skin's per-vertex
+    ``values`` ((N_geo,), zero beyond a small patch) interpolated linearly in UV; zero
+    outside the patch where they are not."""
+    from scipy.interpolate import LinearNDInterpolator
+
+    topo = head.topology
+    inside = (topo.uv >= 0).all(1) & (topo.uv <= 1).all(1) & (topo.region == 0)
+    uv, value = topo.uv[inside], np.asarray(values, np.float32)[topo.render_to_geo[inside]]
+    out = np.zeros(size, np.float32)
+    if not (value > 0).any():
+        return out
+    rows, cols = size
+    # Only the texels around the vertices that carry a value (plus a texel), not the whole box.
+    lo, hi = uv[value > 0].min(axis=0), uv[value > 0].max(axis=0)
+    c0, c1 = int(lo[0] * cols) - 1, int(np.ceil(hi[0] * cols)) + 1
+    r0, r1 = int(lo[1] * rows) - 1, int(np.ceil(hi[1] * rows)) + 1
+    c0, r0, c1, r1 = max(c0, 0), max(r0, 0), min(c1, cols), min(r1, rows)
+    v, u = np.meshgrid((np.arange(r0, r1) + 0.5) / rows, (np.arange(c0, c1) + 0.5) / cols, indexing="ij")
+    patch = LinearNDInterpolator(uv, value, fill_value=0.0)(np.stack([u.ravel(), v.ravel()], 1))
+    out[r0:r1, c0:c1] = patch.reshape(r1 - r0, c1 - c0)
+    return out
 
 
 def _build_position_map(head) -> np.ndarray:

@@ -219,16 +219,62 @@ def mouth_depth_visibility(head, neutral: np.ndarray, *, falloff: float = 0.12):
     return interior, np.exp(-depth / falloff).astype(np.float32)
 
 
+#: The lips' mucosa (the smooth, wet, redder lining the lips turn toward each other) covers
+#: the skin within the first geodesic distance (dm) of the lips' inner rim and fades out by
+#: the second. Where the closed lips touch (2.5-5 mm of surface in from the rim on hm08,
+#: then they turn out into the vermilion), the wet-dry line runs: an open mouth shows the
+#: mucosa as a darker red band between the lips' red and the dark inside. Without it the
+#: vermilion's dry, lined red ran to the opening's edge, "a cut-out hole".
+MUCOSA_REACH = (0.025, 0.05)
+
+
+def lip_mucosa(head) -> np.ndarray:
+    """(N_geo,) float32 per vertex: how much of the lips' mucosa it carries (1 at the lips'
+    inner rim, the skin bordering the mouth's lining, fading to 0 at
+    :data:`MUCOSA_REACH`'s far end, measured along the skin of the base mesh)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import dijkstra
+
+    from facsim.head.mesh import REGIONS
+    from facsim.head.surface import smoothstep
+
+    skin = head.region == REGIONS.index("skin")
+    lining = head.region == REGIONS.index("mouth_interior")
+    triangles = head.triangles
+    rim = np.unique(triangles[lining[triangles].any(axis=1)])
+    rim = rim[skin[rim]]
+    edges = np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]])
+    edges = edges[skin[edges].all(axis=1)]
+    p = head.positions(head.base_vertices)
+    length = np.linalg.norm(p[edges[:, 0]] - p[edges[:, 1]], axis=1)
+    graph = coo_matrix((length, (edges[:, 0], edges[:, 1])), shape=(len(p), len(p))).tocsr()
+    near, far = MUCOSA_REACH
+    distance = dijkstra(graph, directed=False, indices=rim, min_only=True, limit=2 * far)
+    return np.asarray(smoothstep(far, near, distance), np.float32)
+
+
 #: Ambient visibility the lips' inner surface reaches once the lips part, per ring of skin
 #: vertices from the rim (the wet mucosa the lips turn toward each other): the bake is
 #: taken on the closed mouth, where the rim is buried (visibility ~0), so an open mouth
 #: showed its lips' inner edge black, a hard outline.
 LIP_RING_VISIBILITY = (0.5, 0.65, 0.8)
+#: The same for the mouth's lining, ring by ring inward from the rim: just inside the lips
+#: it is their mucosa going on toward the gums, lit through the opening (and drawn in the
+#: mucosa's red) as the lips part, where the bake on the closed mouth left it in the
+#: cavity's dull dark: a dark seam along the lips' inner edge.
+LINING_RING_VISIBILITY = (0.9, 0.7)
 #: The lips have parted over this range of gap (dm) at a given x: 0.5 mm -> 4 mm.
 LIP_PARTING = (0.005, 0.04)
 #: The tongue lies in the dark behind the teeth until the lips part this far (dm) at the
 #: midline, and takes the light the mouth lets in when they have parted this far.
 TONGUE_LIT_GAP = (0.003, 0.025)
+#: Near the mouth's corners the teeth lie in the shade of the lips and cheeks wrapped
+#: around them (the buccal corridor): a tooth vertex's height below the upper lip's edge
+#: is taken as at most (slope × its distance across the mouth from the nearer corner −
+#: offset, dm), so the lip's shadow deepens toward the corners, darkest at them and gone
+#: ~10 mm in. Lit evenly to the corners, the back teeth of a wide mouth (20+26) showed as
+#: pale slabs filling the commissures.
+COMMISSURE_SHADE = (0.3, 0.008)
 #: How many rings of skin around the rim count as the upper lip's free margin.
 UPPER_LIP_RINGS = 5
 @dataclass(frozen=True)
@@ -255,6 +301,10 @@ class MouthRim:
         front of their inner rims, which sit apart; only a wider gap parts the lips.
     rest_gap_middle : float
         The same in the mouth's middle.
+    lining_rings : tuple of (K_i,) int
+        The mouth's lining just inside the rim, ring by ring inward (:data:`LINING_RING_VISIBILITY`).
+    lining_rest_gap : tuple of (K_i,) float
+        Their rest gaps, as ``rest_gap``.
     """
 
     upper: np.ndarray
@@ -266,6 +316,8 @@ class MouthRim:
     tongue: np.ndarray
     rest_gap: tuple = ()
     rest_gap_middle: float = 0.0
+    lining_rings: tuple = ()
+    lining_rest_gap: tuple = ()
 
 
 def mouth_rim(head, data, neutral: np.ndarray) -> MouthRim:
@@ -297,15 +349,25 @@ def mouth_rim(head, data, neutral: np.ndarray) -> MouthRim:
             up, down = (near == 1).any(), (near == 2).any()
             side[v] = 1 if up and not down else 2 if down and not up else 0
     upper_lip = np.flatnonzero(side == 1)
+    lining_rings, reached = [], np.zeros(len(region), bool)
+    reached[rings[0]] = True
+    for _ in LINING_RING_VISIBILITY:
+        ring = np.unique(triangles[reached[triangles].any(axis=1)])
+        ring = ring[lining[ring] & ~reached[ring]]
+        lining_rings.append(ring)
+        reached[ring] = True
     rings = rings[: len(LIP_RING_VISIBILITY)]
     by_x = lambda idx: idx[np.argsort(np.asarray(neutral)[idx, 0])]  # noqa: E731
     rim = MouthRim(upper=by_x(upper), lower=by_x(lower), rings=tuple(rings), upper_lip=upper_lip,
                    upper_teeth=head.group_geometry(data, UPPER_TEETH),
                    lower_teeth=head.group_geometry(data, LOWER_TEETH),
-                   tongue=head.group_geometry(data, TONGUE))
+                   tongue=head.group_geometry(data, TONGUE), lining_rings=tuple(lining_rings))
     plane, upper_edge, lower_edge, middle = _lips(rim, p)
-    gaps = tuple(np.maximum(upper_edge(x) - lower_edge(x), 0.0) for x in (plane(ring)[0] for ring in rings))
-    return replace(rim, rest_gap=gaps, rest_gap_middle=float(max(upper_edge(middle) - lower_edge(middle), 0.0)))
+
+    def gaps(ring_list):
+        return tuple(np.maximum(upper_edge(x) - lower_edge(x), 0.0) for x in (plane(ring)[0] for ring in ring_list))
+    return replace(rim, rest_gap=gaps(rings), lining_rest_gap=gaps(lining_rings),
+                   rest_gap_middle=float(max(upper_edge(middle) - lower_edge(middle), 0.0)))
 
 
 def _split_rim(rim: np.ndarray, triangles: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -376,13 +438,15 @@ def mouth_light(rim: MouthRim, positions: np.ndarray, occlusion: np.ndarray) -> 
     """Light the mouth by where the lips are in this frame (in place on ``occlusion``,
     (N_geo,), as baked on the closed mouth):
 
-    - the lips' inner surface opens to the light as the lips part at its x (the bake
-      buried it: an open mouth's lips had a black inner edge);
+    - the lips' inner surface, and the lining just inside it, open to the light as the
+      lips part at its x (the bake buried it: an open mouth's lips had a black inner edge);
     - each tooth vertex gets its height (dm) below the upper lip's edge at its x, not a
       visibility: interpolated across a triangle it is that height per fragment (the lip's
       edge is close to straight between the teeth's columns), so the teeth's shader draws
       the lip's soft contact shadow right under its edge, millimetres wide, where the
       band's vertices lie 8 mm apart. (The bake under closed lips means nothing for them.)
+      Toward the mouth's corners the height is capped (:data:`COMMISSURE_SHADE`): the
+      teeth there sit in the lips' and cheeks' shade.
     - the tongue takes the light the parted lips let in (:data:`TONGUE_LIT_GAP`): seen
       through the gaps between barely parted teeth it is dark, not a pink dot.
 
@@ -391,7 +455,8 @@ def mouth_light(rim: MouthRim, positions: np.ndarray, occlusion: np.ndarray) -> 
     """
     plane, upper_edge, lower_edge, middle = _lips(rim, positions)
     lo, hi = LIP_PARTING
-    for ring, visibility, rest_gap in zip(rim.rings, LIP_RING_VISIBILITY, rim.rest_gap):
+    for ring, visibility, rest_gap in zip(rim.rings + rim.lining_rings, LIP_RING_VISIBILITY + LINING_RING_VISIBILITY,
+                                          rim.rest_gap + rim.lining_rest_gap):
         x, _ = plane(ring)
         # Parted beyond where the lips' inner rims sit at rest (they touch in front of them).
         parted = np.clip((upper_edge(x) - lower_edge(x) - rest_gap - lo) / (hi - lo), 0.0, 1.0)
@@ -401,9 +466,12 @@ def mouth_light(rim: MouthRim, positions: np.ndarray, occlusion: np.ndarray) -> 
     lit = np.clip((upper_edge(middle) - lower_edge(middle) - rim.rest_gap_middle - lo) / (hi - lo), 0.0, 1.0)
     occlusion[rim.tongue] = lit * lit * (3.0 - 2.0 * lit)
     lip_x, lip_y = plane(rim.upper_lip)
+    corners = plane(rim.upper)[0][[0, -1]]
     for teeth in (rim.upper_teeth, rim.lower_teeth):
         x, y = plane(teeth)
         # The upper lip's lowest point within a tooth column's reach of x.
         over = np.abs(x[:, None] - lip_x[None]) < COLUMN_REACH
         edge = np.where(over.any(axis=1), np.where(over, lip_y[None], np.inf).min(axis=1), upper_edge(x))
-        occlusion[teeth] = edge - y
+        from_corner = np.minimum(x - corners.min(), corners.max() - x)
+        slope, offset = COMMISSURE_SHADE
+        occlusion[teeth] = np.minimum(edge - y, slope * from_corner - offset)

@@ -107,6 +107,8 @@ const float LIP_ROUGHNESS = 0.38;
 const float SKIN_F0 = 0.028;
 const vec2 SKIN_ROUGHNESS = vec2(0.6, 0.45);   // (a tighter film, 0.38, read as plastic on the nose)
 const float PEACH_FUZZ = 0.05;   // grazing sheen of the vellus hair, of the light reaching it
+const float MUCOSA_SHINE = 0.3;                // its wet film's glint, of the light reaching it
+                                               // (broad: a tight one broke into beads along the lip)
 vec2 skin_specular(vec3 n, vec3 l, vec3 v, float ndv, vec2 roughness) {
     vec3 h = normalize(l + v);
     float ndl = max(dot(n, l), 0.0);
@@ -260,6 +262,9 @@ const vec2 LOWER_LID_SHADE = vec2(0.2, 3.0);
 const vec2 UPPER_LID_CAST = vec2(0.45, 8.0);
 #endif
 
+#if defined(REGION_SKIN) || defined(REGION_MOUTH_INTERIOR)
+const vec3 MUCOSA = vec3(0.40, 0.075, 0.09);   // the lips' mucosa (linear; sRGB ~ #aa4d54)
+#endif
 #if defined(REGION_TEETH) || defined(REGION_TONGUE)
 #define ONE_ALBEDO
 #endif
@@ -365,6 +370,12 @@ void main() {
                    * (0.25 + 0.75 * hash2(ivec2(int(floor(lip_s + 0.5)), 7)))    // uneven furrows,
                    * (0.3 + 0.7 * grain);                                         // broken along their length
     lip_line = mix(0.1, lip_line, clamp(1.6 - 3.0 * fwidth(lip_s), 0.0, 1.0));
+    // Inside the wet-dry line the lips roll into their mucosa (detail.a, facsim.head.mouth.
+    // lip_mucosa): smooth (no furrows), wet, a deeper and more bluish red than the vermilion
+    // (unpigmented: pink-red on dark lips too). Hidden where the closed lips touch, it is the
+    // band an open mouth shows between the lips' red and the dark inside.
+    float mucosa = detail.a;
+    lip_line *= 1.0 - mucosa;
     float lip_core = smoothstep(0.45, 0.95, lips);
     float border = lips * (1.0 - lips) * 4.0;
     vec3 lip_col = u_lips * (0.92 + 0.16 * blotch) * (1.0 - (0.16 + 0.16 * u_age) * lip_line * lip_core);
@@ -373,6 +384,7 @@ void main() {
     lip_col = mix(mix(albedo, u_lips, 0.6), lip_col, lip_core);
     albedo = mix(albedo, lip_col, smoothstep(0.0, 1.0, lips));
     albedo *= 1.0 + 0.03 * border * (1.0 - u_age);   // (faint: a bright rim outlined the lips)
+    albedo = mix(albedo, mix(u_lips, MUCOSA, 0.8) * (0.9 + 0.2 * blotch), mucosa);
 #ifdef USE_BROWS
     vec2 brow = brow_hair(v_uv, paint.r);
 #else
@@ -414,7 +426,7 @@ void main() {
     n = normalize(abs(det) * n - sign(det) * (dh_dx * r1 + dh_dy * r2));
 #ifdef USE_WRINKLE
     // The engine's furrows, except where the fold map draws the lines itself (folds.a).
-    Fold fold = crease_fold(v_wrinkle * (1.0 - folds.a), v_crease, v_uv);
+    Fold fold = crease_fold(v_wrinkle * (1.0 - folds.a) * (1.0 - mucosa), v_crease, v_uv);
     // Compressed skin is a little darker overall (blood pushed together, less light between
     // the rolls), and the crevices' bottoms darker still.
     cavity *= (1.0 - u_wrinkle_darken * clamp(v_wrinkle, 0.0, 1.0)) * (1.0 - 0.5 * fold.crevice);
@@ -520,7 +532,7 @@ void main() {
     float film = smoothstep(0.75, 1.05, oil);
     // Moist, but the film is broken by the furrows and by the lips' fine mottle: a continuous
     // glossy band along the lip read as rubber.
-    float wet = lips * (1.0 - 0.85 * lip_line) * (0.55 + 0.45 * blotch);
+    float wet = max(lips * (1.0 - 0.85 * lip_line) * (0.55 + 0.45 * blotch), mucosa);
     // Lobe weights (broad, tight); the fill is too weak to show: key and rim only.
     vec2 weight = vec2(0.6 - 0.3 * wet, 0.22 * film + 0.2 * wet);
     vec2 roughness = vec2(SKIN_ROUGHNESS.x, mix(SKIN_ROUGHNESS.y, LIP_ROUGHNESS, min(2.0 * wet, 1.0)));
@@ -528,6 +540,12 @@ void main() {
               + dot(skin_specular(bumped, u_rim_dir, v, ndv, roughness), weight) * u_rim_col;
     // (Times pi: the diffuse term here is albedo times N.L, without the Lambert 1/pi.)
     spec *= PI * (1.0 - hair) * (0.85 + 0.3 * grain) * spec_break;
+    // The mucosa's film of saliva mirrors the lights in a thin bright line where the lip's
+    // inner edge turns toward them. (A branch: llvmpipe skips it for the blocks of pixels
+    // away from the lips, nearly all of them.)
+    if (mucosa > 0.0) {
+        spec += mucosa * MUCOSA_SHINE * (blinn(n, u_key_dir, v, 50.0) * u_key_col + blinn(n, u_rim_dir, v, 50.0) * u_rim_col);
+    }
     // Peach fuzz: the fine vellus hair on the cheeks and forehead scatters a faint, soft sheen
     // where the skin turns away from the eye (toward the face's outline), never a highlight.
     float graze = 1.0 - ndv;
@@ -792,10 +810,13 @@ void main() {
     // Light inside the mouth falls off with depth: the front teeth catch it, the back ones sit
     // in the shadow of the cheeks (the dark buccal corridor). The upper lip casts a soft
     // contact shadow just under its edge: v_occlusion is the fragment's height (dm) below
-    // that edge in this frame (facsim.head.mouth.mouth_light; 1 when nobody passes it). The
+    // that edge in this frame, less toward the mouth's corners, where the lips and cheeks
+    // shade the teeth (facsim.head.mouth.mouth_light; 1 when nobody passes it). The
     // lower row stands back under the upper teeth and lip and faces up into the mouth:
     // darker, and mostly hidden.
-    float depth_shade = mix(1.0, 0.09, smoothstep(0.12, 0.36, arc));
+    // (The lower row's back teeth sit lower in the cheeks' shade: its corridor starts nearer
+    // the front, or a stretched mouth (20+26) showed them as pale slabs in its corners.)
+    float depth_shade = mix(1.0, 0.09, smoothstep(mix(0.12, 0.08, lower), mix(0.36, 0.28, lower), arc));
     float lip_shadow = mix(0.5, 1.0, smoothstep(-0.002, 0.022, v_occlusion));
     float row_light = mix(1.0, 0.62, lower);
     // The inside of the arch faces the tongue and throat: it only catches light scattered in.
@@ -837,10 +858,14 @@ void main() {
     // depth behind the lips (Face passes facsim.head.mouth.mouth_depth_visibility in occ) to
     // a warm, dull dark (light scattered through cheeks and lips), never black and never a
     // saturated red (seen through the gaps between the teeth, red read as braces' bands).
+    // Just inside the lips the lining is their mucosa going on, lit through the opening as
+    // the lips part (mouth_light lifts occ there): the lips' red and wet film, not the dark.
     float mouth_shade = occ * occ;
-    vec3 spec = specular_light(n, v, 30.0) * 0.04;
+    float lip_side = smoothstep(0.6, 0.9, occ);
+    vec3 spec = specular_light(n, v, 30.0) * mix(0.04, 0.3, lip_side);
     vec3 deep = 0.18 * mix(vec3(dot(u_albedo, vec3(0.33))), u_albedo, 0.5);
-    radiance = (diffuse_light(n, vec3(0.3, 0.1, 0.1), 1.0) * u_albedo * 0.45 + spec) * mouth_shade
+    vec3 albedo = mix(u_albedo * 0.45, MUCOSA * 0.8, lip_side);
+    radiance = (diffuse_light(n, vec3(0.3, 0.1, 0.1), 1.0) * albedo + spec) * mouth_shade
              + deep * (1.0 - mouth_shade);
 #endif
 

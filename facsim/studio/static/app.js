@@ -104,6 +104,11 @@ class Viewer {
     return {yaw: THREE.MathUtils.radToDeg(Math.atan2(o.x, o.z)),
             pitch: THREE.MathUtils.radToDeg(Math.asin(o.y / o.length()))};
   }
+  /** Show or hide the neck, shoulders and garment (the .glb's ``body`` node), as the Body choice says. */
+  showBody(visible) {
+    const body = this.root && this.root.getObjectByName('body');
+    if (body) { body.visible = visible; this.render(); }
+  }
   /** Show per-side AU levels {code: {left, right}}: morph weights, head and eye joints. */
   apply(levels) {
     for (const mesh of this.morphMeshes) {
@@ -309,6 +314,7 @@ async function loadCharacter() {
     const buffer = await r.arrayBuffer();
     if (serial !== loadSerial) return;
     await viewer.load(buffer);
+    viewer.showBody($('#body').value !== 'none');
     viewer.apply(S.mode === 'timeline' && S.curves ? timelineLevels(editor.time) : S.levels);
     status(`${S.character.name || 'custom character'} · ready`);
   } catch (err) { showError($('#character-error'), err); status(err.message); }
@@ -555,6 +561,7 @@ async function main() {
   // what is under the head (facsim/data/body.yaml's garments, or none)
   for (const name of catalogue.bodies) $('#body').append(el('option', {value: name}, name));
   $('#body').value = catalogue.default_body;
+  $('#body').addEventListener('change', e => viewer.showBody(e.target.value !== 'none'));
   // emotions
   for (const [name, t] of Object.entries(emotions.tables)) $('#emotion-table').append(el('option', {value: name, title: t.source}, t.title.length > 28 ? name : t.title));
   for (const name of emotions.names) {
