@@ -252,6 +252,30 @@ def test_fear_and_closed_eye_smiles_stay_physical_on_amara(face_of, head):
     assert not problems, "\n".join(problems)
 
 
+#: The lid AUs and pairs that folded slivers at the outer eye corners of mei (and hiro, lin, kenji,
+#: whose character morphs draw the corner together to 0.13-0.3 mm) and george (6+7, 6+12, 9+7).
+EYE_CORNER = ("6E+7E", "6E+12E", "6E+64E", "7E+64E", "4E+7E", "9E+7E", "12E+7E")
+
+
+@pytest.mark.parametrize("character", ["mei", "george"])
+def test_singles_eye_pairs_and_emotions_stay_physical_on_mei_and_george(face_of, head, character):
+    """Every AU at E, the pairs around the eye corners and every emotion at 100 % keep every skin
+    triangle the right way out on an East Asian and an older preset (mei's 7E inverted 8
+    slivers at the outer corners, 6E+64E 21; george's 6E+12E 7 and happiness 6)."""
+    from facsim.engines.checks import GeometryCheck
+    from facsim.facs.emotions import emotion, emotion_names
+
+    engine = face_of(character).engine
+    check = GeometryCheck(head, engine.neutral)
+    texts = [f"L{c}E" if c == 46 else f"{c}E" for c in sorted(simulated_codes())] + list(EYE_CORNER)
+    problems = [q for text in texts for q in _geometry_problems(engine, check, text)]
+    for name in emotion_names():
+        report = check(engine.deform(activations(emotion(name))).positions)
+        if report.flipped or report.inside:
+            problems.append(f"{name}: {report.flipped} skin triangles turned inside out, {report.inside} skin points in an eye")
+    assert not problems, "\n".join(problems)
+
+
 def _eye_seen(head, positions, side, within=None) -> int:
     """How many of the eyeball's points (its front within 40 degrees of its gaze, or the local
     points ``within`` selects) are seen from straight ahead: no skin triangle between them and the

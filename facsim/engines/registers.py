@@ -288,6 +288,13 @@ class RegisterEngine:
     def deform(self, act: Activations) -> Deformation:
         """The expression ``act`` from the relaxed rest: targets weighted by Eq. 1, then the eyes
         and the head moved rigidly."""
+        positions = self.guard(self._morphed(act))
+        skin = positions[: self.head.skin_vertex_count]
+        return Deformation(self.rigid.move_head(positions, act), creases=lambda: self._creases(skin))
+
+    def _morphed(self, act: Activations) -> np.ndarray:
+        """Positions (N_geo, 3) of ``act``'s weighted targets, the upper lids stopped on the lower
+        ones and the eyes turned: the expression before the skin guard and the head motion."""
         base = self.base_positions[self.head.base_index]  # a copy (fancy indexing)
         closing = {}
         for col, weight in self.weights(act).items():
@@ -300,11 +307,8 @@ class RegisterEngine:
             self.lids[key].close_on_lower(base[:skin], share[:skin])
         morphed = np.array(self.base_positions, copy=True)
         morphed[self.head.base_index] = base
-        positions = self.head.positions(morphed, neutral_base=self.base_positions,
-                                        eye_rotations=self.rigid.eye_rotations(act))
-        positions = self.guard(positions)
-        skin = positions[: self.head.skin_vertex_count]
-        return Deformation(self.rigid.move_head(positions, act), creases=lambda: self._creases(skin))
+        return self.head.positions(morphed, neutral_base=self.base_positions,
+                                   eye_rotations=self.rigid.eye_rotations(act))
 
     def _creases(self, skin: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Skin compression (N_geo,) and furrow phase (N_geo,) of deformed skin positions.
@@ -333,9 +337,11 @@ class RegisterEngine:
 
     @cached_property
     def guard(self) -> SkinGuard:
-        """The physical last step: skin off the eyeballs, no skin turned inside out."""
+        """The physical last step: skin off the eyeballs, no skin turned inside out, against the
+        face at rest (the relaxed lids: a triangle of the upper lid that 5 turns nearly on edge
+        from the sculpted lid has turned through it from the relaxed one, mei's fear)."""
         centres = [self.head.eye_pivot(self.base_positions, side)[0] for side in ("left", "right")]
-        return SkinGuard(self.head, self.sculpted, centres, self.head.eye_pivot(self.base_positions, "left")[1],
+        return SkinGuard(self.head, self._morphed(Activations()), centres, self.head.eye_pivot(self.base_positions, "left")[1],
                          neck_below=float(self.head.joint(self.base_positions, "joint-jaw")[1]))
 
     def reset(self) -> None:
