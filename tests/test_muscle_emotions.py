@@ -66,6 +66,12 @@ def test_lid_tightener_with_upper_lid_raiser_glares(figures):
     assert f57["aperture"] > 1.0
 
 
+def test_anger_lowers_the_lip_corners_little(figures):
+    """HapFACS anger (…+15+17): the chin pushes the lower lip up under the corners, so they come
+    down less than a grimace's (3.9 mm on ava before the 15+17 rule; register engine 1.8)."""
+    assert figures["anger"]["corner"] > -3.2
+
+
 @pytest.mark.parametrize("name", ["anger_emfacs", "anger"])
 def test_anger_opens_the_eyes_over_tensed_lower_lids(figures, name):
     f = figures[name]
