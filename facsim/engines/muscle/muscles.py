@@ -472,18 +472,35 @@ def drive(layer: MuscleLayer, activations_list) -> Drive:
 def _combination_scales(act, code: int, side: str) -> dict[str, float]:
     """Muscle → factor on AU ``code``'s magnitudes on ``side`` (``combinations`` in muscle_aus.yaml).
 
-    A rule applies when every AU it names acts on that side, in proportion to the weakest.
+    A rule applies when every AU it names acts on that side, as the register engine's do
+    (:func:`facsim.engines.registers.combination_scales`): in full while the other AUs of the
+    rule act at least as strongly as ``code``, fading with their share of ``code``'s intensity.
+    So a whole emotion at half intensity keeps its combinations' look (session 16: scaled by the
+    weakest AU's intensity instead, anger at 50 % kept only half of the 5+7 rule and its eyes
+    squeezed as at rest the lower palpebral chain does).
+
+    >>> from facsim.facs.activations import Activations
+    >>> glare = Activations({(5, "left"): 0.5, (7, "left"): 0.5})
+    >>> round(_combination_scales(glare, 7, "left")["orbicularis_oculi_palpebral_lower"], 6)
+    0.1
+    >>> _combination_scales(Activations({(7, "left"): 1.0}), 7, "left")
+    {}
     """
     out: dict[str, float] = {}
+    level = act[code, side]
+    if level <= 0.0:
+        return out
     for rule in au_table().get("combinations") or []:
         scale = rule["scale"]
         if scale["au"] != code:
             continue
-        weakest = min(act[c, side] for c in rule["when"])
-        if weakest > 0.0:
-            factor = 1.0 - weakest * (1.0 - float(scale["by"]))
-            for name in scale["muscles"]:
-                out[name] = out.get(name, 1.0) * factor
+        partners = [act[c, side] for c in rule["when"] if c != code]
+        share = min(1.0, min(partners, default=level) / level)
+        if share <= 0.0:
+            continue
+        factor = 1.0 - share * (1.0 - float(scale["by"]))
+        for name in scale["muscles"]:
+            out[name] = out.get(name, 1.0) * factor
     return out
 
 
