@@ -131,8 +131,10 @@ def test_lips_show_vertical_furrows_not_a_flat_paint(face_of, marks):
         x, y = int(x), int(y)
         return np.abs(np.diff(image[y - 8:y + 1, x - 24:x + 25], axis=1)).mean()
 
-    # Crossing the lower lip's furrows varies the brightness far more than the chin's skin does.
-    assert across("lower_lip") > 2.0 * across("chin")
+    # Crossing the lower lip's furrows varies the brightness far more than the chin's skin does
+    # (1.8x: since session 16 the chin carries blood and melanin patches and more micro-relief,
+    # 0.71 -> 0.79 here, while the lip's furrows stayed at 1.6).
+    assert across("lower_lip") > 1.8 * across("chin")
 
 
 def test_hair_texture_keeps_its_strands_but_not_its_painted_light():
