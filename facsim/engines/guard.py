@@ -219,24 +219,25 @@ class SkinGuard:
             np.add.at(count, corners.ravel(), 1.0)
             moved = count > 0
             skin[moved] += 0.5 * (total[moved] / count[moved, None] - skin[moved])
-            # A fold that needs more than MAX_CORRECTION to undo is the target's own shape (a lid
-            # margin rolling under as the eye closes): leave it rather than reshape the lid.
-            shift = skin - start
-            length = np.linalg.norm(shift, axis=1)
-            far = length > most
-            skin[far] = start[far] + shift[far] * (most / length[far])[:, None]
-            if eyes:
-                self.off_eyes(skin)
+            self._within_reach(skin, start, most, eyes)
             bad = folded()
         if len(bad):
             self.open_slivers(skin, bad, folded, rest_normal=rest_normal, min_share=min_share)
-            shift = skin - start
-            length = np.linalg.norm(shift, axis=1)
-            far = length > most
-            skin[far] = start[far] + shift[far] * (most / length[far])[:, None]
-            if eyes:
-                self.off_eyes(skin)
+            self._within_reach(skin, start, most, eyes)
         return first
+
+    def _within_reach(self, skin: np.ndarray, start: np.ndarray, most: float, eyes: bool) -> None:
+        """Clip each vertex's correction to ``most`` (dm) from ``start`` and keep it off the eyes (in place).
+
+        A fold that needs more than that to undo is the target's own shape (a lid margin
+        rolling under as the eye closes): leave it rather than reshape the lid.
+        """
+        shift = skin - start
+        length = np.linalg.norm(shift, axis=1)
+        far = length > most
+        skin[far] = start[far] + shift[far] * (most / length[far])[:, None]
+        if eyes:
+            self.off_eyes(skin)
 
     def open_slivers(self, skin: np.ndarray, bad: np.ndarray, folded, *, rest_normal=None, min_share=None) -> None:
         """Open folded triangles ``bad`` by the least motion of their corners (in place).

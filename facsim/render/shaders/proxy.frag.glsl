@@ -39,8 +39,8 @@ vec3 hair_colour(vec2 clump) {
     return mix(c, u_color, clamp(0.5 * max(fwidth(clump.x), fwidth(clump.y)) - 0.25, 0.0, 1.0));
 }
 
-// Value noise in 3D, [0, 1], faded to its mean where its cells are finer than a pixel.
-float value_noise3(vec3 p) {
+// Value noise in 3D on the integer lattice, [0, 1] (callers pick or fade the octave).
+float lattice_noise3(vec3 p) {
     vec3 i = floor(p);
     vec3 f = p - i;
     vec3 u = f * f * (3.0 - 2.0 * f);
@@ -50,8 +50,12 @@ float value_noise3(vec3 p) {
                   mix(hash2(ivec2(c.x, c.y + 1 + z0)), hash2(ivec2(c.x + 1, c.y + 1 + z0)), u.x), u.y);
     float b = mix(mix(hash2(ivec2(c.x, c.y + z1)), hash2(ivec2(c.x + 1, c.y + z1)), u.x),
                   mix(hash2(ivec2(c.x, c.y + 1 + z1)), hash2(ivec2(c.x + 1, c.y + 1 + z1)), u.x), u.y);
-    float n = mix(a, b, u.z);
-    return mix(0.5, n, clamp(2.0 - 1.4 * length(fwidth(p)), 0.0, 1.0));
+    return mix(a, b, u.z);
+}
+
+// The same, faded to its mean where its cells are finer than a pixel.
+float value_noise3(vec3 p) {
+    return mix(0.5, lattice_noise3(p), clamp(2.0 - 1.4 * length(fwidth(p)), 0.0, 1.0));
 }
 
 // The same over a card's strand coordinates (``uv``, with ``base`` cells per texture unit across
@@ -77,19 +81,6 @@ float pixel_strands_uv(vec2 uv, vec2 base, vec2 offset) {
 // pixels across (at most 4x finer), blended with the next one so nothing pops as the hair
 // nears or leaves the camera. Noise of fixed frequency fades to its mean at stimulus sizes (a
 // flat, clay-like mass); this keeps strand-level variation in every image. [0, 1], mean 0.5.
-float lattice_noise3(vec3 p) {   // value_noise3 without its fade (the caller picks the octave)
-    vec3 i = floor(p);
-    vec3 f = p - i;
-    vec3 u = f * f * (3.0 - 2.0 * f);
-    ivec3 c = ivec3(i);
-    int z0 = 7919 * c.z, z1 = 7919 * (c.z + 1);
-    float a = mix(mix(hash2(ivec2(c.x, c.y + z0)), hash2(ivec2(c.x + 1, c.y + z0)), u.x),
-                  mix(hash2(ivec2(c.x, c.y + 1 + z0)), hash2(ivec2(c.x + 1, c.y + 1 + z0)), u.x), u.y);
-    float b = mix(mix(hash2(ivec2(c.x, c.y + z1)), hash2(ivec2(c.x + 1, c.y + z1)), u.x),
-                  mix(hash2(ivec2(c.x, c.y + 1 + z1)), hash2(ivec2(c.x + 1, c.y + 1 + z1)), u.x), u.y);
-    return mix(a, b, u.z);
-}
-
 float smeared_noise(vec3 p, vec3 step) {
     return (lattice_noise3(p - step) + lattice_noise3(p) + lattice_noise3(p + step)) * (1.0 / 3.0);
 }
