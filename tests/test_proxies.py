@@ -255,6 +255,24 @@ def test_long_hair_ends_above_the_shoulders_not_in_blocks_at_the_image_corners(f
     assert (np.abs(sides[..., :3]).max(axis=-1) > 60).mean() > 0.2
 
 
+def test_long_hair_ends_in_solid_strand_tips_not_a_translucent_film(face_of):
+    # long01's ends used to fade over 2 cm of translucent card, which against the background
+    # read as pale smears and streaks (blind review, session 16); strands now end solid, clump
+    # by clump, thinning only over their last millimetres. Below the jaw, where the hair hangs
+    # over the background, most of the pixels it touches are fully covered.
+    face = face_of("mei")  # long01, black hair: partial cover shows as grey
+    from facsim.face import Face
+
+    cover = face.render(None, size=128, background=None)[80:, :, 3].astype(float) / 255.0
+
+    with Face(face.character.with_(hair="none")) as bald:
+        bare = bald.render(None, size=128, background=None)[80:, :, 3] < 0.01
+    touched = bare & (cover > 0.08)
+    partial = touched & (cover < 0.92)
+    assert touched.sum() > 300
+    assert partial.sum() / touched.sum() < 0.22, partial.sum() / touched.sum()
+
+
 @pytest.mark.parametrize("name", ["ava", "amara", "kwame", "mei"])
 def test_brows_move_as_one_piece_and_keep_sadness_s_raised_inner_end(face_of, name):
     """Each brow follows the skin along one line near its upper edge (BROW_BINDING_LINE): in 1+2

@@ -278,15 +278,29 @@ void main() {
 #else
     float px = u_along_v > 0.5 ? pixel_strands_uv(v_uv, vec2(40.0, 1.5), vec2(5.0, 5.0) + 2.0 * phase)
                                : pixel_strands(v_rest, normalize(v_rest_tangent + vec3(0.0, 1e-4, 0.0)), 60.0);
-    // Long hair ends strand by strand above u_end_height (MakeHuman's long cards hang on
-    // through the shoulders): each strand at its own length, thinning to its tip, so the hair
-    // ends in tapered strands, not in blocks cut by the shoulders or the image's edge.
+    // Long hair ends above u_end_height (MakeHuman's long cards hang on through the shoulders)
+    // the way a cut bob does: clumps a few millimetres across end at a little different
+    // lengths, and within each the strands end one by one over the last few millimetres, so
+    // the ends thin out into fine tips. Each strand is solid to its tip (no translucent film:
+    // faded cards showed the background through them as pale smears and streaks); only where
+    // strands are finer than a pixel does the thinning show as partial cover. Placed on the
+    // neutral head across the strands (v_rest's x and z; hair hangs along y there), so
+    // neighbouring cards and layers end together instead of each in its own comb of teeth.
     float ends = (v_rest.y - u_end_height) / u_end_fade;
     if (ends < 1.0) {
-        // (inner layers end higher, behind the outer ones: their shaded ends showed through
-        // the outer layer's tips as dark blots)
-        float length_at = 0.05 + 0.9 * px + 0.5 * (1.0 - smoothstep(0.3, 0.9, v_depth));
-        alpha *= smoothstep(length_at - 0.05, length_at + 0.35, ends) * smoothstep(0.15, 0.5, ends);
+        vec3 across = v_rest * vec3(1.0, 0.02, 1.0);
+        float clump_end = lattice_noise3(across * 16.0 + 3.0);              // clumps ~6 mm across
+        vec3 sp = across * 140.0 + 9.0;                                     // strands < 1 mm across
+        float strand_detail = clamp(2.0 - 1.4 * length(fwidth(sp)), 0.0, 1.0);
+        float strand_end = mix(0.5, lattice_noise3(sp), strand_detail);
+        // (inner layers end a little higher, behind the outer ones, so they never show below them)
+        float end_at = 0.3 + 0.3 * clump_end + 0.06 * (strand_end - 0.5)
+                     + 0.08 * (1.0 - smoothstep(0.3, 0.9, v_depth));
+        float thinning = clamp((ends - end_at) / 0.12, 0.0, 1.0);           // over ~7 mm to the tips
+        float rank = lattice_noise3(sp * vec3(1.3, 1.0, 1.3) + 21.0);
+        // (value noise gathers about its mean: the ramp spans its range, and nothing is left past the ends)
+        float tips = mix(thinning, smoothstep(rank - 0.06, rank + 0.06, 1.2 * thinning - 0.1), strand_detail);
+        alpha *= tips * step(1e-4, thinning);
     }
     float px_full = px;
     if (u_along_v > 0.5) px = mix(0.5, px, 0.4);
