@@ -13,6 +13,11 @@ view at 512² the pupil's centre less the visible cornea's (px along x; positive
 the camera side: the refracted iris's parallax); the lower lashes' coverage (summed change,
 in pixels, when the lashes are recoloured, in a band 12 px deep under each eye's sclera).
 
+The lids (``--aperture``), at rest, 5E, surprise (1+2+5+26) and fear (1+2+4+5+20+26) at 512²,
+front, without anti-aliasing: the sclera bared above and below the iris down its middle column,
+in mm (the iris's width in pixels is 11.7 mm); the visible iris's top third's mean luminance
+over its bottom third's (the upper lid's shade); the sclera's mean luminance.
+
 Open mouth (``--cavity``), surprise (1+2+5+26) at 512², front: within the mouth's opening (the
 pixels of teeth, tongue and the mouth's lining), the share that is tongue and the share in deep
 shadow (luminance under 30), the share that is tongue in the light (over 30) and its median and
@@ -33,6 +38,7 @@ Usage::
     python3 scripts/eyes_mouth_figures.py [CHARACTER ...]      (default: amara liam mei george)
     python3 scripts/eyes_mouth_figures.py --cavity [--engine muscle] [--expression 27] [CHARACTER ...]
     python3 scripts/eyes_mouth_figures.py --mucosa [--engine muscle] [CHARACTER ...]
+    python3 scripts/eyes_mouth_figures.py --aperture [--engine muscle] [CHARACTER ...]
 """
 from __future__ import annotations
 
@@ -193,6 +199,39 @@ def three_quarter_figures(character, size=512) -> dict:
     return {"pupil_offset_px": offsets, "lower_lash_cover": round(float(lash[below].sum()), 1)}
 
 
+IRIS_DIAMETER_MM = 11.7  # facsim/render/shaders/face.frag.glsl IRIS_RADIUS on hm08's eyeball
+
+
+def aperture_figures(character, expression, size=512, engine="registers") -> dict:
+    """Sclera bared above and below the iris, per eye (mm, from the iris's width in pixels); the
+    mean luminance of the visible iris's top third over its bottom third (the upper lid's shade
+    and the cornea's caustic); the sclera's mean luminance (0-255)."""
+    image, iris_marked, sclera_marked = _renders(character, expression, [{"iris": "#ff0000", "pupil": "#ff0000"},
+                                                                         {"sclera": "#00ff00"}],
+                                                 size=size, antialias=1, engine=engine)
+    iris = _changed(iris_marked, image)
+    sclera = _changed(sclera_marked, image) & ~iris
+    eyes, count = ndimage.label(ndimage.binary_dilation(iris, iterations=2))
+    luminance = image @ LUMINANCE
+    above, below, shade = [], [], []
+    for k in sorted(range(1, count + 1), key=lambda k: np.nonzero(eyes == k)[1].mean()):
+        ys, xs = np.nonzero(iris & (eyes == k))
+        if len(ys) < 20:
+            continue
+        mm = IRIS_DIAMETER_MM / (xs.max() - xs.min() + 1)
+        middle = slice(int(round(xs.mean())) - 1, int(round(xs.mean())) + 2)
+        top, bottom = ys[np.abs(xs - xs.mean()) < 1.5].min(), ys[np.abs(xs - xs.mean()) < 1.5].max()
+        column = sclera[:, middle].any(axis=1)
+        above.append(round(float(column[max(top - 40, 0): top].sum() * mm), 1))
+        below.append(round(float(column[bottom + 1: bottom + 41].sum() * mm), 1))
+        visible = np.arange(ys.min(), ys.max() + 1)
+        thirds = np.array_split(visible, 3)
+        rows = [np.isin(ys, third) for third in (thirds[0], thirds[-1])]
+        shade.append(round(float(luminance[ys[rows[0]], xs[rows[0]]].mean() / luminance[ys[rows[1]], xs[rows[1]]].mean()), 2))
+    return {"sclera_above_mm": above, "sclera_below_mm": below, "iris_top_over_bottom": shade,
+            "sclera_luminance": round(float(luminance[sclera].mean()), 1)}
+
+
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("characters", nargs="*", default=["amara", "liam", "mei", "george"])
@@ -200,6 +239,8 @@ def main(argv=None) -> None:
     parser.add_argument("--engine", default="registers", choices=["registers", "muscle"])
     parser.add_argument("--expression", default="1+2+5+26", help="the open mouth's expression (--cavity)")
     parser.add_argument("--mucosa", action="store_true", help="the lips' mucosa figures only")
+    parser.add_argument("--aperture", action="store_true",
+                        help="sclera bared above and below the iris at rest, 5E, surprise and fear only")
     args = parser.parse_args(argv)
     for name in args.characters:
         character = preset(name)
@@ -207,6 +248,12 @@ def main(argv=None) -> None:
             for expression in ("6+12+25", "1+2+5+26"):
                 figures = mucosa_figures(character, expression, engine=args.engine)
                 print(name, args.engine, expression, "  ".join(f"{k} {v}" for k, v in figures.items()), flush=True)
+            continue
+        if args.aperture:
+            for expression in ("", "5E", "1+2+5+26", "1+2+4+5+20+26"):
+                figures = aperture_figures(character, expression, engine=args.engine)
+                print(name, args.engine, expression or "neutral", "  ".join(f"{k} {v}" for k, v in figures.items()),
+                      flush=True)
             continue
         if args.cavity:
             figures = cavity_figures(character, args.expression, engine=args.engine)

@@ -448,10 +448,12 @@ void main() {
     cavity *= 1.0 - 0.07 * pit * pore_amount;
     float spec_break = 1.0 - 0.6 * pit * pore_amount;   // pores hold no oil film facing the light
 #else
-    // Micro-relief at small sizes: the skin's millimetre-scale unevenness (the mottle as a
-    // height, surface gradient from screen derivatives: its cells span several pixels, so
-    // the 2x2-quad derivative is smooth) tilts the normal a little, which breaks the sheen
-    // into the irregular highlights of real skin instead of a plastic glaze.
+    // Micro-relief at small sizes: the skin's millimetre-scale grain as a height (surface
+    // gradient from screen derivatives) tilts the normal a little, which breaks the sheen
+    // into the irregular highlights of real skin instead of a plastic glaze. Only the grain:
+    // the blotches' few-millimetre cells as a height drew a network of lit and shaded cell
+    // walls over the cheek, a craquelure rather than skin (issue 13, ava's raised cheek in
+    // 6+12 most of all); the blotches stay in the colour.
     // Pores show at this size too where they are largest (nose, the cheeks beside it: tone.b),
     // as a faint speckle of small pits about a millimetre apart that darken a little and break
     // the sheen; faded to nothing where they would be finer than a pixel. (Shallow: pixel-sized
@@ -459,7 +461,7 @@ void main() {
     // (The grain's own peaks, so no further noise is evaluated; it is already faded to its
     // flat mean where it would be finer than a pixel.)
     float pit = smoothstep(0.64, 0.9, grain) * smoothstep(0.3, 0.9, tone.b) * (1.0 - paint.g) * (1.0 - hair);
-    float relief_h = mottle - 0.6 * pit;
+    float relief_h = 0.4 * grain - 0.6 * pit;
     vec3 grad = sign(det) * (dFdx(relief_h) * r1 + dFdy(relief_h) * r2);
     float relief = (0.0016 + 0.0008 * u_age) * (0.5 + tone.b) * (1.0 - paint.g) * (1.0 - hair);
     vec3 bumped = normalize(abs(det) * n - relief * grad);
