@@ -134,15 +134,17 @@ class Face:
         """Loose strands over the hair's cards (a ``"wisps"`` BoundProxy, facsim.head.wisps), or None."""
         from facsim.head.proxies import bind_wisps
 
-        hair = [b for b in self.proxies if b.proxy.kind == "hair"]
+        hair = [b for b in self.proxies if b.proxy.kind == "hair" and not b.crop]  # a crop has no strands to stray
         return bind_wisps(hair[0], self.head, self.neutral) if hair else None
 
     @property
     def _drawn_proxies(self) -> list:
         """What the renderer draws: the scalp layer first (under every card), then the hair,
-        its loose strands, brows and lashes."""
+        its loose strands, brows and lashes. A close crop is its scalp layer alone."""
         out = [self.scalp] if self.scalp is not None else []
         for bound in self.proxies:
+            if bound.crop:
+                continue
             out.append(bound)
             if bound.proxy.kind == "hair" and self.wisps is not None:
                 out.append(self.wisps)
@@ -154,10 +156,10 @@ class Face:
         from facsim.render.proxies import ProxyMesh
 
         return [ProxyMesh(b.proxy.name, b.proxy.kind, b.proxy.triangles, b.proxy.corner_vertex, b.proxy.uv,
-                          b.proxy.texture, b.depth, b.neutral if b.proxy.kind in ("hair", "wisps") else None,
+                          b.proxy.texture, b.depth, b.neutral if b.proxy.kind in ("hair", "wisps") or b.crop else None,
                           self._card_cover(b) if b.proxy.kind == "hair" else None, b.coil > 0.0,
                           b.strand_points, b.strand_width,
-                          self._hair_end_height if b.proxy.kind in ("hair", "wisps") else None)
+                          self._hair_end_height if b.proxy.kind in ("hair", "wisps") else None, bool(b.crop))
                 for b in self._drawn_proxies]
 
     @cached_property
@@ -300,7 +302,7 @@ class Face:
         occlusion[interior] = visibility
         cover = self._scalp_density
         for bound in self.proxies:
-            if bound.proxy.kind == "hair":
+            if bound.proxy.kind == "hair" and not bound.crop:  # a crop's cards are not there
                 hair = bound.binding.positions(self.neutral)
                 occlusion[skin] *= hair_shadow(self.neutral[skin], hair, cover=cover[skin],
                                                triangles=bound.proxy.corner_vertex[bound.proxy.triangles])

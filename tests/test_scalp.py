@@ -126,3 +126,43 @@ def test_hair_lying_on_the_skin_casts_no_shadow_down_the_cheeks(face_of):
     eyes = np.concatenate([np.asarray(v) for v in face.head.eye_vertices.values()])
     cheeks = skin[:, 1] < face.neutral[eyes, 1].mean() - 0.2
     assert (cast[cheeks] < 0.9).mean() < 0.01
+
+
+def test_a_close_crop_is_its_scalp_layer_alone_standing_off_the_skin(face_of):
+    """kwame's close crop (``crops:`` in hair.yaml): no cards or loose strands drawn, only the
+    scalp layer over short04's footprint, coily, its length off the skin where it grows full
+    and on the skin at the hairline; it covers the crown and leaves the forehead bare."""
+    from facsim.face import Face
+
+    face = face_of("kwame")
+    assert face.character.hair == "crop" and proxies.crop_footprint("crop") == "short04"
+    hair = next(b for b in face.proxies if b.proxy.kind == "hair")
+    assert hair.crop == "crop" and hair.proxy.name == "short04" and face.wisps is None
+    assert [m.kind for m in face.proxy_meshes] == ["scalp", "eyebrows", "eyelashes"]
+    layer = face.scalp
+    mesh = face.proxy_meshes[0]
+    assert mesh.crop and mesh.coily and layer.coil == 1.0 and layer.style == "crop"
+    geo = face.neutral
+    lift = np.linalg.norm(layer.binding.positions(geo) - geo[layer.binding.ref[:, 0]], axis=1)
+    full, edge = layer.shade > 0.99, (layer.shade > 0.05) & (layer.shade < 0.4)
+    assert np.allclose(lift[full], scalp.LIFT + 0.01 * proxies.crop_length("crop"), atol=1e-4)
+    assert lift[edge].max() < scalp.LIFT + 1e-4
+    # drawn: the crown dark with hair where the bald head shows skin, the forehead the same
+    with Face(face.character.with_(hair="none")) as bald:
+        bare = bald.render(None, size=96).astype(float)
+    cropped = face.render(None, size=96).astype(float)
+    rows = np.flatnonzero((np.abs(bare - 255) > 3).any(axis=(1, 2)))
+    crown = (slice(rows[0] + 2, rows[0] + 6), slice(40, 56))
+    assert cropped[crown][..., :3].mean() < bare[crown][..., :3].mean() - 30
+    forehead = (slice(rows[0] + 22, rows[0] + 26), slice(44, 52))
+    assert abs(cropped[forehead][..., :3].mean() - bare[forehead][..., :3].mean()) < 4
+
+
+def test_crops_are_worn_by_name_and_only_where_the_table_names_them():
+    from facsim.head.character import Character, CharacterError
+
+    assert "crop" in proxies.hair_names() and "crop" not in proxies.HAIR_STYLES
+    assert proxies.crop_footprint("short04") is None and proxies.crop_length("short04") == 0.0
+    assert Character(hair="crop").hair == "crop"
+    with pytest.raises(CharacterError, match="unknown hair 'buzz'"):
+        Character(hair="buzz")

@@ -158,7 +158,7 @@ def add_view_options(p: argparse.ArgumentParser) -> None:
     from facsim.render.options import DEFAULT_BODY, VIEWS
 
     p.add_argument("--character", "-c", default="ava", help="preset name (see `facsim characters`) or random:SEED")
-    p.add_argument("--hair", help="hair style (bob01, bob02, short01-04, long01, ponytail01, braid01, afro01) "
+    p.add_argument("--hair", help="hair style (bob01, bob02, short01-04, long01, ponytail01, braid01, afro01, crop) "
                                   "or none; default: the character's own")
     p.add_argument("--engine", choices=tuple(ENGINES), default=DEFAULT_ENGINE, help="how AUs move the face")
     p.add_argument("--view", choices=sorted(VIEWS), default="front")

@@ -425,7 +425,7 @@ def _proxy_meshes(b: GlbBuilder, face, keys, pivot, materials: dict) -> list[dic
     from facsim.render.proxies import shade_texture
 
     scalp = getattr(face, "scalp", None)
-    exported = ([scalp] if scalp is not None else []) + list(face.proxies)
+    exported = ([scalp] if scalp is not None else []) + [b for b in face.proxies if not b.crop]
     if not exported:
         return []
     engine = face.engine if face.engine_name == "registers" else RegisterEngine(

@@ -81,7 +81,8 @@ class Character:
     colors : mapping
         Colour overrides, ``{"iris": "#3b6ea5", ...}``; keys in :data:`COLOR_NAMES` or ``hair``.
     hair, brows, lashes : str
-        MakeHuman proxy names (``facsim.head.proxies.HAIR_STYLES``, ``EYEBROWS``, ``EYELASHES``),
+        MakeHuman proxy names (``facsim.head.proxies.HAIR_STYLES``, ``EYEBROWS``, ``EYELASHES``;
+        hair also a close crop, ``crops:`` in ``facsim/data/hair.yaml``),
         ``"none"``, or ``""`` for one chosen from gender, age and ethnicity
         (``facsim/data/hair.yaml``).
     name : str
@@ -122,9 +123,9 @@ class Character:
         for key in self.colors:
             if key not in COLOR_NAMES + EXTRA_COLOR_NAMES:
                 raise CharacterError(f"unknown colour {key!r}; choose from {', '.join(COLOR_NAMES + EXTRA_COLOR_NAMES)}")
-        from facsim.head.proxies import EYEBROWS, EYELASHES, HAIR_STYLES
+        from facsim.head.proxies import EYEBROWS, EYELASHES, hair_names
 
-        for key, names in (("hair", HAIR_STYLES), ("brows", EYEBROWS), ("lashes", EYELASHES)):
+        for key, names in (("hair", hair_names()), ("brows", EYEBROWS), ("lashes", EYELASHES)):
             value = getattr(self, key)
             if value not in ("", "none", *names):
                 raise CharacterError(f"unknown {key} {value!r}; choose from {', '.join(names)} or 'none'")

@@ -172,6 +172,24 @@ def hair_table() -> dict:
     return yaml.safe_load(resources.files("facsim").joinpath("data/hair.yaml").read_text())
 
 
+@lru_cache(maxsize=1)
+def hair_names() -> tuple[str, ...]:
+    """Every name ``hair:`` may take besides ``none``: the MakeHuman styles and the close crops
+    drawn over their footprints (``crops:`` in ``facsim/data/hair.yaml``)."""
+    return HAIR_STYLES + tuple(hair_table().get("crops", {}))
+
+
+def crop_footprint(name: str) -> str | None:
+    """The MakeHuman style whose footprint close crop ``name`` covers, or None if ``name`` is no crop."""
+    crop = hair_table().get("crops", {}).get(name)
+    return None if crop is None else crop["footprint"]
+
+
+def crop_length(name: str) -> float:
+    """Millimetres close crop ``name`` stands off the skin inside its hairline (0 for anything else)."""
+    return float(hair_table().get("crops", {}).get(name, {}).get("length_mm", 0.0))
+
+
 def character_proxies(character) -> dict[str, str | None]:
     """Proxy names ``{"hair": …, "eyebrows": …, "eyelashes": …}`` (None = none) for ``character``.
 
@@ -459,6 +477,9 @@ class BoundProxy:
     shade: np.ndarray | None = None  # (V,) the scalp layer's hair density (see :attr:`depth`)
     strand_points: int = 0  # wisps: points per strand (facsim.head.wisps)
     strand_width: float = 0.0  # wisps: a strand's width (dm) at its root
+    #: Hair worn as a close crop (``crops:`` in ``hair.yaml``): its name. The proxy is then the
+    #: style whose footprint the crop covers; its cards are never drawn, only the scalp layer.
+    crop: str = ""
 
     @cached_property
     def depth(self) -> np.ndarray:
@@ -499,8 +520,9 @@ class BoundProxy:
 
     @property
     def style(self) -> str:
-        """The proxy's name; a scalp layer's or loose strands' is their hairstyle's."""
-        return self.proxy.name.removesuffix(SCALP_SUFFIX).removesuffix(WISPS_SUFFIX)
+        """The proxy's name; a scalp layer's or loose strands' is their hairstyle's; a close
+        crop's is the crop's."""
+        return self.crop or self.proxy.name.removesuffix(SCALP_SUFFIX).removesuffix(WISPS_SUFFIX)
 
 
 COLOR_KEY = {"hair": "hair", "eyebrows": "brows", "eyelashes": "lashes"}
@@ -539,10 +561,11 @@ def bind_character_proxies(character, head, base_positions, neutral_geometry, *,
     for kind in ("hair", "eyebrows", "eyelashes"):
         name = chosen[kind]
         if name:
-            proxy = library[name]
+            crop = (crop_footprint(name) and name) if kind == "hair" else None
+            proxy = library[crop_footprint(name) if crop else name]
             binding = bind_to_frame(proxy, head, base_positions, neutral_geometry, look)
             out.append(BoundProxy(proxy, binding, COLOR_KEY[kind], density[kind],
-                                  binding.positions(neutral_geometry)))
+                                  binding.positions(neutral_geometry), crop=crop or ""))
     return out
 
 
@@ -569,16 +592,20 @@ def bind_scalp(hair: BoundProxy, head, neutral_geometry: np.ndarray, *, cache: P
         return None
     layer = ScalpLayer.from_array(array)
     vertices, normals = layer.vertices, layer.normals
+    # A close crop stands its length off the skin where it grows full, rising from the hairline.
+    from facsim.head.surface import smoothstep
+
+    lift = (LIFT + 0.01 * crop_length(hair.crop) * smoothstep(0.5, 1.0, layer.density))[:, None]
     k = len(vertices)
     weights = np.zeros((k, 3), np.float32)
     weights[:, 0] = 1.0
     ref = np.repeat(vertices[:, None], 3, axis=1).astype(np.int64)
     proxy = Proxy(name=hair.proxy.name + SCALP_SUFFIX, kind="scalp",
-                  ref=np.asarray(head.base_index)[ref], weights=weights, offsets=LIFT * normals,
+                  ref=np.asarray(head.base_index)[ref], weights=weights, offsets=lift * normals,
                   triangles=layer.triangles, corner_vertex=np.arange(k, dtype=np.int32), uv=layer.uv,
                   png=b"", author="facsim", license="CC0", image=strand_texture())
-    binding = FrameBinding(ref=ref, weights=weights, offsets=(LIFT * normals).astype(np.float32))
-    return BoundProxy(proxy, binding, "hair", 1.0, binding.positions(geo), shade=layer.density)
+    binding = FrameBinding(ref=ref, weights=weights, offsets=(lift * normals).astype(np.float32))
+    return BoundProxy(proxy, binding, "hair", 1.0, binding.positions(geo), shade=layer.density, crop=hair.crop)
 
 
 def bind_wisps(hair: BoundProxy, head, neutral_geometry: np.ndarray) -> BoundProxy | None:

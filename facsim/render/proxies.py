@@ -57,7 +57,8 @@ class ProxyMesh:
     rest : (V, 3) float, optional
         Hair: vertex positions at rest (the neutral face). Which cards neighbour which is
         read from them once, so a frame's shading never depends on the frames before it.
-        Without them strand directions are not averaged across cards.
+        Without them strand directions are not averaged across cards. A close crop's scalp
+        layer: where its coils lie (they move with the skin).
     cover : (V,) float, optional
         Hair: the scalp's hair density under each vertex (1 full … 0 bare; default 1).
         Cards over a thinning hairline break up into strands, so they fade into the scalp
@@ -71,6 +72,9 @@ class ProxyMesh:
         as ribbons ``strand_width`` dm wide at the root (at least a pixel, fainter where
         widened) turned toward the camera, tapering to the tip. ``depth``: 0 at the root …
         1 at the tip.
+    crop : bool
+        Scalp: the hair itself, a close crop with no cards over it (``crops:`` in
+        ``facsim/data/hair.yaml``): lit in the open and covering the skin fully inside its hairline.
     end_height : float, optional
         Hair and wisps: the height (y on the neutral face, dm) where the hair ends. MakeHuman's
         long styles hang on through where the shoulders are; below ``END_FADE`` over this
@@ -91,6 +95,7 @@ class ProxyMesh:
     strand_points: int = 0
     strand_width: float = 0.0
     end_height: float | None = None
+    crop: bool = False
 
     def __post_init__(self):
         if self.kind not in PROXY_KINDS:
@@ -455,7 +460,7 @@ class ProxyLayer:
         self._ibo["SUBSET"] = track(ctx.buffer(reserve=max(self._triangles.nbytes, 12), dynamic=True))
         for stage in ("OPAQUE", "BLEND"):
             defines = {f"PASS_{stage}": "", f"KIND_{mesh.kind.upper()}": "", "ALPHA_CUTOFF": f"{ALPHA_CUTOFF:.3f}",
-                       **({"COILY": ""} if mesh.coily else {})}
+                       **({"COILY": ""} if mesh.coily else {}), **({"CROP": ""} if mesh.crop else {})}
             prog = track(ctx.program(vertex_shader=_shader_source("proxy.vert.glsl", defines),
                                      fragment_shader=_shader_source("proxy.frag.glsl", defines)))
             _set_uniform(prog, "u_texture", 1)

@@ -143,25 +143,56 @@ void main() {
     // Where the cover thins, the hairs that are left are finer and fewer: the tuft's own
     // strands (tex.a) show more of the skin between them, so the hairline ends in wisps.
     float alpha = mix(tex.a * tex.a * tex.a, tex.a, smoothstep(0.2, 0.9, dens)) * keep * 0.92;
+#ifdef CROP
+    // A close crop (no cards over it) is all the hair there is: inside its hairline the short
+    // hairs hide the skin but for a glimpse between them.
+    alpha = mix(tex.a * tex.a * tex.a, 1.0, smoothstep(0.3, 0.9, dens)) * keep * 0.95;
+    // Seen at a slant the eye crosses more of the layer's hairs (transmittance to the power
+    // 1 / cos): edge-on, at the head's outline, they hide what is behind them.
+    float facing = abs(dot(normalize(v_normal), normalize(u_cam_pos - v_pos)));
+    alpha = 1.0 - pow(1.0 - min(alpha, 0.999), 1.0 / max(facing, 0.08));
+#endif
     if (alpha < 0.01) discard;
     vec3 n = normalize(v_normal);
     vec3 t = normalize(v_tangent);
     float kl = clamp(dot(n, u_key_dir) * 0.5 + 0.5, 0.0, 1.0);
+#ifdef CROP
+    float dk = mix(strand_diffuse(t, u_key_dir), 1.0, 0.7) * kl * kl * 1.25;   // coils face every way
+#else
     float dk = mix(strand_diffuse(t, u_key_dir), 1.0, 0.3) * kl * kl * 1.25;
+#endif
     float df = clamp(dot(n, u_fill_dir) * 0.5 + 0.5, 0.0, 1.0);
     vec3 lit = dk * u_key_col + df * u_fill_col + hemisphere(n) * 0.8;
     // The roots under full cover lie in the cards' shadow; the hairline's fine hairs in the open.
     float light_hair = sqrt(clamp(dot(u_color, vec3(0.2126, 0.7152, 0.0722)), 0.0, 1.0));
+#ifdef CROP
+    float shade = 0.85;   // a crop's coils shade only each other
+#else
     float shade = mix(0.9, mix(0.35, 0.7, light_hair), smoothstep(0.3, 1.0, v_depth));
+#endif
     float curl = 1.0;
 #ifdef COILY
     {  // and each curl shows its own light and shade
         vec2 kp = suv * 600.0;
         curl = 0.55 + 0.9 * mix(0.5, value_noise(kp, 0), clamp(1.8 - 1.4 * fwidth(kp.x), 0.0, 1.0));
+#ifdef CROP
+        alpha = min(alpha * mix(1.0, curl, 0.4), 1.0);
+#else
         alpha *= curl * 0.9;
+#endif
     }
 #endif
     vec3 albedo = hair_colour(suv * vec2(8.0, 2.0)) * (0.55 + 0.9 * tex.r) * shade * curl;
+#ifdef CROP
+    {   // Coils a millimetre and a few millimetres across, placed on the neutral head (v_rest) so
+        // they are round, not streaked along the tile's strands, with dark crevices between them.
+        // (lattices turned against the head's axes: an axis-aligned one drew a grid of dots)
+        const mat3 turn = mat3(0.788, 0.418, -0.452, -0.360, 0.908, 0.214, 0.500, -0.017, 0.866);
+        float kink = value_noise3(turn * v_rest * 110.0);
+        float coils = value_noise3(transpose(turn) * v_rest * 35.0 + 5.0);
+        albedo = hair_colour(v_rest.xy * 40.0) * (0.8 + 0.4 * tex.r) * (0.6 + 0.8 * kink) * (0.65 + 0.7 * coils) * shade;
+    }
+#endif
     f_color = vec4(finish(albedo * lit).rgb, alpha);
 }
 #elif defined(KIND_WISPS)
