@@ -147,6 +147,9 @@ void main() {
     // A close crop (no cards over it) is all the hair there is: inside its hairline the short
     // hairs hide the skin but for a glimpse between them.
     alpha = mix(tex.a * tex.a * tex.a, 1.0, smoothstep(0.3, 0.9, dens)) * keep * 0.95;
+    // Where it stands off the skin (bind_scalp lifts it from half cover up) it is solid: no
+    // background shows through it past the head's outline.
+    alpha = max(alpha, smoothstep(0.5, 0.9, v_depth));
     // Seen at a slant the eye crosses more of the layer's hairs (transmittance to the power
     // 1 / cos): edge-on, at the head's outline, they hide what is behind them.
     float facing = abs(dot(normalize(v_normal), normalize(u_cam_pos - v_pos)));
