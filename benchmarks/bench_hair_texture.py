@@ -10,7 +10,11 @@ count. On their luminance (Rec. 709 weights on the sRGB values) it prints
   a flat, clay-like mass gives a figure near 0;
 - ``mass``: the standard deviation of the blurred luminance over its mean: the volume's shading
   and large locks;
-- ``pixels``: how many pixels were measured.
+- ``pixels``: how many pixels were measured;
+- ``ends``: below the jaw (the image's lowest 3/8), of the pixels where the hair covers the
+  background at all (alpha over 0.08 with hair, under 0.01 without), the share it covers only
+  partly (alpha under 0.92): long hair ending in a translucent film (pale smears and streaks
+  against a light background) gives a high figure, strands ending solid a low one.
 
     PYTHONPATH=. python3 benchmarks/bench_hair_texture.py [--character liam] [--view front] [--size 512]
 """
@@ -48,6 +52,17 @@ def luminance_variation(image: np.ndarray, mask: np.ndarray, *, sigma: float = 2
     return float((lum - blurred)[mask].std() / mean), float(blurred[mask].std() / mean)
 
 
+def partial_cover_below_jaw(with_hair: np.ndarray, without_hair: np.ndarray) -> tuple[float, int]:
+    """(share, pixels): of the pixels in the lowest 3/8 of two (H, W, 4) uint8 RGBA renders on a
+    transparent background where the hair covers the background (see the module docstring),
+    the share it covers only partly, and how many there are."""
+    below = slice(int(0.625 * with_hair.shape[0]), None)
+    cover = with_hair[below, :, 3].astype(np.float32) / 255.0
+    touched = (without_hair[below, :, 3] < 3) & (cover > 0.08)
+    partial = touched & (cover < 0.92)
+    return float(partial.sum() / max(touched.sum(), 1)), int(touched.sum())
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--character", default="liam")
@@ -65,6 +80,8 @@ def main(argv=None) -> int:
     fine, mass = luminance_variation(images[0], mask)
     print(f"{args.character} {args.view}: fine {fine:.3f}, mass {mass:.3f} over {int(mask.sum())} hair pixels "
           f"({args.size}²)")
+    share, pixels = partial_cover_below_jaw(*images)
+    print(f"ends: {share:.3f} of {pixels} hair pixels over the background below the jaw only partly covered")
     return 0
 
 

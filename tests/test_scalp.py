@@ -67,7 +67,7 @@ def test_card_cover_thins_cards_only_over_a_thinning_hairline():
 
 
 def test_presets_grow_scalp_hair_on_the_scalp_only(face_of):
-    face = face_of("george")
+    face = face_of("hiro")  # short04: lies close over the whole scalp
     layer = face.scalp
     assert layer is not None and layer.proxy.kind == "scalp" and layer.style == face.character.hair
     geo = face.neutral
@@ -118,7 +118,7 @@ def test_greying_hair_is_drawn_as_pigmented_and_white_strands(face_of):
 
 
 def test_hair_lying_on_the_skin_casts_no_shadow_down_the_cheeks(face_of):
-    face = face_of("george")  # short04: its side cards lie on the temples, down to the cheeks
+    face = face_of("hiro")  # short04: its side cards lie on the temples, down to the cheeks
     hair = next(b for b in face.proxies if b.proxy.kind == "hair")
     skin = face.neutral[: face.head.skin_vertex_count]
     cards = hair.binding.positions(face.neutral)

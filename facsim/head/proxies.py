@@ -575,6 +575,7 @@ def bind_scalp(hair: BoundProxy, head, neutral_geometry: np.ndarray, *, cache: P
     ``.npy`` file keeping the layer (building it takes a few tenths of a second)."""
     from facsim.head.assets import cached_array
     from facsim.head.scalp import LIFT, ScalpLayer, scalp_layer, strand_texture
+    from facsim.head.surface import smoothstep
 
     geo = np.asarray(neutral_geometry, np.float32)
 
@@ -592,10 +593,16 @@ def bind_scalp(hair: BoundProxy, head, neutral_geometry: np.ndarray, *, cache: P
         return None
     layer = ScalpLayer.from_array(array)
     vertices, normals = layer.vertices, layer.normals
+    density = layer.density
+    if hair.crop:
+        # A crop is the only hair drawn: none on the ears, whose skin (facing up and back, not
+        # out from the skull) lies under the cards' footprint and grew hair on their rims.
+        points = geo[vertices]
+        centre = points.mean(axis=0) - np.array([0.0, 0.3 * np.ptp(points[:, 1]), 0.0])
+        radial = (points - centre) / (np.linalg.norm(points - centre, axis=1, keepdims=True) + 1e-12)
+        density = density * smoothstep(0.45, 0.75, np.einsum("ij,ij->i", radial, normals)).astype(np.float32)
     # A close crop stands its length off the skin where it grows full, rising from the hairline.
-    from facsim.head.surface import smoothstep
-
-    lift = (LIFT + 0.01 * crop_length(hair.crop) * smoothstep(0.5, 1.0, layer.density))[:, None]
+    lift = (LIFT + 0.01 * crop_length(hair.crop) * smoothstep(0.5, 1.0, density))[:, None]
     k = len(vertices)
     weights = np.zeros((k, 3), np.float32)
     weights[:, 0] = 1.0
@@ -605,7 +612,7 @@ def bind_scalp(hair: BoundProxy, head, neutral_geometry: np.ndarray, *, cache: P
                   triangles=layer.triangles, corner_vertex=np.arange(k, dtype=np.int32), uv=layer.uv,
                   png=b"", author="facsim", license="CC0", image=strand_texture())
     binding = FrameBinding(ref=ref, weights=weights, offsets=(lift * normals).astype(np.float32))
-    return BoundProxy(proxy, binding, "hair", 1.0, binding.positions(geo), shade=layer.density, crop=hair.crop)
+    return BoundProxy(proxy, binding, "hair", 1.0, binding.positions(geo), shade=density, crop=hair.crop)
 
 
 def bind_wisps(hair: BoundProxy, head, neutral_geometry: np.ndarray) -> BoundProxy | None:

@@ -147,6 +147,9 @@ void main() {
     // A close crop (no cards over it) is all the hair there is: inside its hairline the short
     // hairs hide the skin but for a glimpse between them.
     alpha = mix(tex.a * tex.a * tex.a, 1.0, smoothstep(0.3, 0.9, dens)) * keep * 0.95;
+    // Where it stands off the skin (bind_scalp lifts it from half cover up) it is solid: no
+    // background shows through it past the head's outline.
+    alpha = max(alpha, smoothstep(0.5, 0.9, v_depth));
     // Seen at a slant the eye crosses more of the layer's hairs (transmittance to the power
     // 1 / cos): edge-on, at the head's outline, they hide what is behind them.
     float facing = abs(dot(normalize(v_normal), normalize(u_cam_pos - v_pos)));
@@ -443,6 +446,12 @@ void main() {
     // clump-scale mix above fades to one flat grey at stimulus sizes).
     if (u_grey > 0.0)
         albedo = mix(albedo, mix(u_pigment, u_white, clamp(u_grey + 0.9 * (px_full - 0.5), 0.0, 1.0)) * strand, 0.7);
+    // Strands differ in pigment, not only in brightness: lighter ones warmer (less eumelanin:
+    // pheomelanin's red-gold shows), darker ones cooler, clump by clump and strand by strand
+    // (white strands have none to vary); and long hair's tips, older and weathered, are a
+    // little lighter than the lengths above them.
+    float pigment_shift = (0.6 * (mid - 0.5) + 0.5 * (px_full - 0.5)) * (1.0 - u_grey);
+    albedo *= (vec3(1.0) + pigment_shift * vec3(0.4, 0.1, -0.3)) * mix(1.18, 1.0, smoothstep(0.25, 1.0, ends));
 #endif
     // Depth in the volume: layers near the scalp lie under the outer ones and get little
     // light (roots and the under-layers darker), the gaps between clumps are darker still.
