@@ -9,7 +9,9 @@ is what the creases do, in 8-bit luma levels; per patch it prints
   difference blurred by ~2 mm): thin dark lines score high, soft shading low.
 
 Patches (about 8 x 5 mm, following the skin): under each eye, crow's feet beside each outer eye
-corner, the nasolabial folds, the forehead. Left/right figures are the character's left/right.
+corner, the nasolabial folds, the forehead, between the brows (glabella: 4's furrows), across the
+nose's root and along its sides (9's wrinkles). Left/right figures are the character's left/right
+(on the midline the same patch twice).
 
     python3 scripts/measure_creases.py --characters george,kofi "6E+12E" "1E+2E"
 
@@ -29,6 +31,9 @@ PATCHES = {
     "crows_feet": (0.58, 7.27, 1.21),
     "nasolabial": (0.215, 6.76, 1.46),
     "forehead": (0.15, 7.64, 1.5),
+    "glabella": (0.0, 7.38, 1.51),
+    "nose_root": (0.0, 7.17, 1.57),
+    "nose_side": (0.07, 7.04, 1.6),
 }
 #: Patch half-size (decimetres): across the face, up.
 HALF = (0.04, 0.025)
@@ -46,15 +51,22 @@ def creaseless(appearance):
 
 
 def render(face, deformation, appearance, size, creased):
-    positions = np.asarray(deformation.positions, np.float32)
-    camera = face.camera(size=(size, size))
-    image = face.renderer(size=size).render(
-        positions, appearance=appearance, camera=camera,
-        wrinkle=deformation.wrinkle if creased else None,
-        crease_phase=deformation.crease_phase if creased else None,
-        occlusion=face.frame_occlusion(positions), lids=face.frame_lids(positions),
-        proxies=face.proxy_draws(positions))
-    return image[..., :3].astype(float) @ LUMA, camera
+    """Luma of ``deformation`` drawn as ``facsim render`` draws it (body included), with ``appearance``
+    and with or without the wrinkle field."""
+    from facsim.engines.base import Deformation
+
+    if not creased:
+        deformation = Deformation(np.asarray(deformation.positions, np.float32))
+    own = face.__dict__.get("appearance")
+    face.__dict__["appearance"] = appearance
+    try:
+        image = face.render(deformation=deformation, size=size)
+    finally:
+        if own is None:
+            del face.__dict__["appearance"]
+        else:
+            face.__dict__["appearance"] = own
+    return image[..., :3].astype(float) @ LUMA, face.camera(size=(size, size))
 
 
 def patch_box(face, deformation, camera, size, centre):

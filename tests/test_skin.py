@@ -267,6 +267,58 @@ def test_fold_lines_deepen_where_their_au_acts_and_nowhere_else(face_of, head, e
     assert np.abs(around(rests)).max() < 1.0        # ... and the other lines' skin stays as it was
 
 
+#: Base-mesh points (decimetres, the character's left) where 4 and 9 crease the skin: between the
+#: brows, across the nose's root, along the side of the nose's bridge.
+CREASE_PLACES = {"glabella": (0.0, 7.38, 1.51), "nose_root": (0.0, 7.17, 1.57), "nose_side": (0.07, 7.04, 1.6)}
+
+
+def crease_darkening(face, head, expression, place, size=512, r=6):
+    """Mean luma the engine's creases take from a patch (~7 mm) around a base-mesh point and its
+    mirror image (both sides of the face): the same deformed face drawn with and without its
+    wrinkle field."""
+    deformation = face.deform(expression)
+    positions = np.asarray(deformation.positions, np.float32)
+    camera = face.camera(size=(size, size))
+    renderer = face.renderer(size=size, body="none")
+
+    def luma(creased):
+        image = renderer.render(positions, appearance=face.appearance, camera=camera,
+                                wrinkle=deformation.wrinkle if creased else None,
+                                crease_phase=deformation.crease_phase if creased else None,
+                                occlusion=face.frame_occlusion(positions))
+        return image[..., :3].astype(float) @ np.array([0.2126, 0.7152, 0.0722])
+
+    darkening = luma(False) - luma(True)
+    skin = head.base_vertices[head.base_index[: head.skin_vertex_count]]
+    means = []
+    for side in (1.0, -1.0):
+        point = np.asarray(CREASE_PLACES[place]) * (side, 1.0, 1.0)
+        vertex = int(np.argmin(((skin - point) ** 2).sum(1)))
+        (x, y), = project(camera, positions[[vertex]], size)[0].astype(int)
+        means.append(darkening[y - r:y + r + 1, x - r:x + r + 1].mean())
+    return float(np.mean(means))
+
+
+@pytest.mark.parametrize("au, place", [("9", "nose_root"), ("9", "nose_side"), ("4", "glabella")])
+def test_creases_of_an_au_at_c_show_most_of_what_they_show_at_e(face_of, head, au, place):
+    """FACS C is "marked or pronounced": 9's lines across the root and along the sides of the nose
+    and 4's furrows between the brows are plain at C and deepen towards E, not switched on near E.
+    (Until session 17 the furrows began only at a wrinkle strength of 0.15 and 9's nose, 0.13 at C,
+    stayed smooth: 1.7 levels of darkening at its root on ava at C, 0.45 of E's; now 4.1 and 0.67.)
+    At E the folds keep deepening without setting into uniformly cut grooves."""
+    face = face_of("ava")
+    at_c, at_e = (crease_darkening(face, head, f"{au}{level}", place) for level in "CE")
+    assert at_c > 3.0, (at_c, at_e)
+    assert at_c > 0.55 * at_e, (at_c, at_e)
+
+
+def test_a_brow_lowerer_does_not_wrinkle_the_sides_of_the_nose(face_of, head):
+    """The nose's sidewalls buckle early (they are 9's), but 4 does not squeeze them: anger's
+    frown (4) must not take disgust's nose (9)."""
+    face = face_of("ava")
+    assert crease_darkening(face, head, "4E", "nose_side") < 0.2 * crease_darkening(face, head, "9C", "nose_side")
+
+
 def test_nasolabial_fold_is_a_broad_shade_on_the_cheeks_side_not_a_line():
     from facsim.head.skin import FOLD_LINES, fold_shade_density
 

@@ -39,13 +39,13 @@ class WrinkleModel:
     rest: np.ndarray            # (N, 3) rest positions (phase of the furrow pattern)
     wavelength: np.ndarray      # (N,) furrow spacing
     zone_gain: np.ndarray       # (N,) how readily the skin creases there (deep forehead lines, fine crow's feet)
+    threshold: np.ndarray       # (N,) compression at which the skin starts to buckle there
     across_gain: np.ndarray     # (N,) the same for vertical furrows (skin squeezed sideways) where zones differ
     straight: np.ndarray        # (N,) 1 where lines run straight across the face (forehead, glabella)
     upright: np.ndarray         # (N,) 1 where the lines run straight up whatever squeezes the skin (the glabella)
     on_face: np.ndarray         # (N,) 1 on the outer skin, 0 inside the lips and lids
     crease: np.ndarray          # (N,) extra depth along anatomical folds (0 = none, 1 = twice as deep)
     gain: float
-    threshold: float
     exponent: float
     smooth: sp.csr_matrix       # (N, N) one pass of neighbour averaging
     passes: int                 # how many, on the compression tensor (a steady direction field)
@@ -84,6 +84,7 @@ def build_wrinkles(anat: Anatomy, net: TensionNet, spec: dict) -> WrinkleModel:
     wavelength = np.full(n, float(w["wavelength"]))
     zone_gain = np.ones(n)
     across_gain = np.ones(n)
+    threshold = np.full(n, float(w["threshold"]))
     straight = np.zeros(n)
     upright = np.zeros(n)
     base = anat.base[: anat.skin_count]
@@ -91,6 +92,8 @@ def build_wrinkles(anat: Anatomy, net: TensionNet, spec: dict) -> WrinkleModel:
         weight = _blob(zone, base)
         if "wavelength" in zone:
             wavelength = wavelength * (1 - weight) + zone["wavelength"] * weight
+        if "threshold" in zone:
+            threshold = threshold * (1 - weight) + zone["threshold"] * weight
         if "gain" in zone or "across_gain" in zone:
             zone_gain = zone_gain * (1 - weight) + zone.get("gain", 1.0) * weight
             across_gain = across_gain * (1 - weight) + zone.get("across_gain", zone.get("gain", 1.0)) * weight
@@ -118,10 +121,10 @@ def build_wrinkles(anat: Anatomy, net: TensionNet, spec: dict) -> WrinkleModel:
     integrate = spla.factorized((incidence.T @ incidence + 1e-4 * sp.identity(n)).tocsc())
     return WrinkleModel(
         triangles=tri, rest_inverse=inv, rest_frame=frame, to_vertex=to_vertex.tocsr(), rest=rest,
-        wavelength=wavelength, zone_gain=zone_gain, across_gain=across_gain, straight=np.clip(straight * 4.0, 0.0, 1.0),
+        wavelength=wavelength, zone_gain=zone_gain, threshold=threshold, across_gain=across_gain, straight=np.clip(straight * 4.0, 0.0, 1.0),
         upright=np.clip(upright * 4.0, 0.0, 1.0), crease=crease,
         on_face=on_face,
-        gain=float(w["gain"]), threshold=float(w["threshold"]), exponent=float(w["exponent"]),
+        gain=float(w["gain"]), exponent=float(w["exponent"]),
         smooth=smooth.tocsr(), passes=int(w.get("smoothing", 2)),
         edges=edges, incidence=incidence, integrate=integrate,
     )

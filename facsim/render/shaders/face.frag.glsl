@@ -143,19 +143,30 @@ Fold crease_fold(float wrinkle, float phase, vec2 uv) {
     // Depth along the line: per-line (hash) times a slow variation along it.
     float along = value_noise(uv * vec2(22.0, 44.0) + 9.0 * hash2(ivec2(int(line), 3)), 0);
     float depth = (0.5 + 0.5 * hash2(ivec2(int(line), 11))) * smoothstep(0.1, 0.55, along);
-    // Older skin creases sooner (less elastic): the same compression shows more lines.
-    float amount = smoothstep(0.15 - 0.08 * u_age, 0.8 - 0.2 * u_age, wrinkle);
+    // How far the skin has folded: from the engine's buckling threshold on (the wrinkle field is 0
+    // below it), growing fastest at first and levelling off, as a buckled sheet's fold amplitude
+    // grows with the square root of its extra compression - so an AU at C (half of E's
+    // compression or more) already shows its lines, and at E the folds deepen without setting
+    // into uniformly cut grooves. (Until session 17 the lines started only at wrinkle 0.15 and
+    // were full at 0.8: 9's nose lines, 0.13 at C, did not show at all.) Older skin creases
+    // sooner (less elastic): the same compression shows more lines.
+    float amount = (1.0 - exp(-wrinkle / (0.3 - 0.1 * u_age))) * smoothstep(0.0, 0.08, wrinkle);
     // The crevice is widened where it would be finer than a pixel, keeping its area (a
     // pre-filter: no aliasing, no shimmer as the face moves); the roll fades to flat when
     // the furrows themselves are finer than a few pixels.
-    const float W = 0.085;
+    const float W = 0.12;
     float w = max(W, 0.8 * aa);
     float g = exp(-(t * t) / (w * w));
     float roll = clamp(2.0 - 4.0 * aa, 0.0, 1.0);
     Fold f;
-    // H(t) = A (-0.5 cos 2 pi t) - C exp(-t^2 / w^2): rolls 2.6 mm high, crevices 0.9 mm deep.
-    f.slope = amount * depth * (roll * 0.026 * PI * sin(2.0 * PI * t) + 0.009 * (W / w) * 2.0 * t / (w * w) * g);
-    f.crevice = amount * depth * (W / w) * exp(-(t * t) / (2.2 * w * w));
+    // H(t) = A (-0.5 cos 2 pi t) - C exp(-t^2 / w^2): rolls 2 mm high, crevices up to 0.6 mm
+    // deep and 0.12 of a furrow spacing wide. The crevice is where the rolls' flanks meet: it
+    // opens only once the skin has folded (amount squared), so a slight fold is a soft roll and a
+    // deep one a roll with a seam. (Until session 17: 2.6 mm rolls, 0.9 mm crevices 0.085 wide, at
+    // full depth as soon as the skin buckled - 4's folds at E looked like creased paper, "carved".)
+    float seam = amount * amount;
+    f.slope = depth * (amount * roll * 0.02 * PI * sin(2.0 * PI * t) + seam * 0.006 * (W / w) * 2.0 * t / (w * w) * g);
+    f.crevice = seam * depth * (W / w) * exp(-(t * t) / (2.2 * w * w));
     f.s = s;
     return f;
 }
