@@ -262,6 +262,18 @@ const vec2 LOWER_LID_SHADE = vec2(0.2, 3.0);
 const vec2 UPPER_LID_CAST = vec2(0.45, 8.0);
 #endif
 
+#ifdef REGION_EYEBALL
+// The eyeball's top, above the iris (hy: height above the eye's centre in eyeball radii),
+// lies under the lid at rest; bared by 5 it is still deep under the brow ridge and the
+// retracted lid fold, which hide most of the key above: in photographs of surprise and fear
+// the white above the iris is a shaded band, and lit as brightly as beside the iris it read
+// as an eyeball popping out (issue 13: "bulging eyes").
+const vec2 ORBIT_SHADE = vec2(0.4, 0.5);   // how much darker at hy = ORBIT_SHADE.y; from hy 0.3
+float orbit_shade(float hy) {
+    return 1.0 - ORBIT_SHADE.x * smoothstep(0.3, ORBIT_SHADE.y, hy);
+}
+#endif
+
 #if defined(REGION_SKIN) || defined(REGION_MOUTH_INTERIOR)
 const vec3 MUCOSA = vec3(0.40, 0.075, 0.09);   // the lips' mucosa (linear; sRGB ~ #aa4d54)
 #endif
@@ -700,7 +712,7 @@ void main() {
     // lids). The socket around it hides much of the sky: the whole eyeball
     // takes less ambient than the skin.
     float lid_shade = 0.7 * (1.0 - 0.15 * smoothstep(-0.05, 0.3, hy)) * (1.0 - 0.5 * smoothstep(0.32, 0.68, abs(hx)))
-                    * lash_shadow;
+                    * lash_shadow * orbit_shade(hy);
     vec3 diffuse = diffuse_light(n, vec3(0.15), occ) * albedo * lid_shade * lid_cast;
     // Wet surface. The cornea bulges over the iris as a sphere of 1.33 iris radii (7.8 mm
     // over an 11.7-mm iris), so its normal tilts faster than the eyeball's: the catch-light
