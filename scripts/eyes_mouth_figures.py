@@ -15,7 +15,8 @@ in pixels, when the lashes are recoloured, in a band 12 px deep under each eye's
 
 The lids (``--aperture``), at rest, 5E, surprise (1+2+5+26) and fear (1+2+4+5+20+26) at 512²,
 front, without anti-aliasing: the sclera bared above and below the iris down its middle column,
-in mm (the iris's width in pixels is 11.7 mm); the visible iris's top third's mean luminance
+in mm (the iris's width in pixels is 11.7 mm); where 5 bares it, the mean luminance of the sclera
+over the iris against the sclera's beside the iris's middle rows; the visible iris's top third's mean luminance
 over its bottom third's (the upper lid's shade); the sclera's mean luminance.
 
 Open mouth (``--cavity``), surprise (1+2+5+26) at 512², front: within the mouth's opening (the
@@ -213,7 +214,7 @@ def aperture_figures(character, expression, size=512, engine="registers") -> dic
     sclera = _changed(sclera_marked, image) & ~iris
     eyes, count = ndimage.label(ndimage.binary_dilation(iris, iterations=2))
     luminance = image @ LUMINANCE
-    above, below, shade = [], [], []
+    above, below, shade, bared = [], [], [], []
     for k in sorted(range(1, count + 1), key=lambda k: np.nonzero(eyes == k)[1].mean()):
         ys, xs = np.nonzero(iris & (eyes == k))
         if len(ys) < 20:
@@ -224,11 +225,21 @@ def aperture_figures(character, expression, size=512, engine="registers") -> dic
         column = sclera[:, middle].any(axis=1)
         above.append(round(float(column[max(top - 40, 0): top].sum() * mm), 1))
         below.append(round(float(column[bottom + 1: bottom + 41].sum() * mm), 1))
+        half = np.zeros_like(sclera)
+        half[:, : size // 2] = xs.mean() < size / 2
+        half[:, size // 2:] = xs.mean() >= size / 2
+        over = sclera & half
+        over[top:] = False
+        over[:, : xs.min()] = over[:, xs.max() + 1:] = False
+        beside = sclera & half & (np.abs(np.arange(size) - ys.mean())[:, None] < 3)
+        if over.sum() >= 5 and beside.sum():
+            bared.append(round(float(luminance[over].mean() / luminance[beside].mean()), 2))
         visible = np.arange(ys.min(), ys.max() + 1)
         thirds = np.array_split(visible, 3)
         rows = [np.isin(ys, third) for third in (thirds[0], thirds[-1])]
         shade.append(round(float(luminance[ys[rows[0]], xs[rows[0]]].mean() / luminance[ys[rows[1]], xs[rows[1]]].mean()), 2))
-    return {"sclera_above_mm": above, "sclera_below_mm": below, "iris_top_over_bottom": shade,
+    return {"sclera_above_mm": above, "sclera_below_mm": below, "above_over_beside": bared,
+            "iris_top_over_bottom": shade,
             "sclera_luminance": round(float(luminance[sclera].mean()), 1)}
 
 

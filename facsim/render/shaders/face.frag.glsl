@@ -273,6 +273,18 @@ const vec2 LOWER_LID_SHADE = vec2(0.2, 3.0);
 const vec2 UPPER_LID_CAST = vec2(0.45, 8.0);
 #endif
 
+#ifdef REGION_EYEBALL
+// The eyeball's top, above the iris (hy: height above the eye's centre in eyeball radii),
+// lies under the lid at rest; bared by 5 it is still deep under the brow ridge and the
+// retracted lid fold, which hide most of the key above: in photographs of surprise and fear
+// the white above the iris is a shaded band, and lit as brightly as beside the iris it read
+// as an eyeball popping out (issue 13: "bulging eyes").
+const vec2 ORBIT_SHADE = vec2(0.4, 0.5);   // how much darker at hy = ORBIT_SHADE.y; from hy 0.3
+float orbit_shade(float hy) {
+    return 1.0 - ORBIT_SHADE.x * smoothstep(0.3, ORBIT_SHADE.y, hy);
+}
+#endif
+
 #if defined(REGION_SKIN) || defined(REGION_MOUTH_INTERIOR)
 const vec3 MUCOSA = vec3(0.40, 0.075, 0.09);   // the lips' mucosa (linear; sRGB ~ #aa4d54)
 #endif
@@ -465,18 +477,19 @@ void main() {
     // the blotches' few-millimetre cells as a height drew a network of lit and shaded cell
     // walls over the cheek, a craquelure rather than skin (issue 13, ava's raised cheek in
     // 6+12 most of all); the blotches stay in the colour.
-    // Pores show at this size too where they are largest (nose, the cheeks beside it: tone.b),
-    // as a faint speckle of small pits about a millimetre apart that darken a little and break
-    // the sheen; faded to nothing where they would be finer than a pixel. (Shallow: pixel-sized
-    // pits as deep as a pore read as red dots, blotchy skin.)
+    // Pores show at this size too where they are largest (nose, the cheeks beside it, less on
+    // the forehead and chin: tone.b), as a speckle of small pits about a millimetre apart that
+    // darken a little and break the sheen; faded to nothing where they would be finer than a
+    // pixel. (Shallow: pixel-sized pits as deep as a pore read as red dots, blotchy skin; at
+    // 0.04 and only where tone.b passed 0.3 the skin at 768² read as airbrushed wax, issue 13.)
     // (The grain's own peaks, so no further noise is evaluated; it is already faded to its
     // flat mean where it would be finer than a pixel.)
-    float pit = smoothstep(0.64, 0.9, grain) * smoothstep(0.3, 0.9, tone.b) * (1.0 - paint.g) * (1.0 - hair);
+    float pit = smoothstep(0.62, 0.9, grain) * smoothstep(0.15, 0.8, tone.b) * (1.0 - paint.g) * (1.0 - hair);
     float relief_h = 0.4 * grain - 0.6 * pit;
     vec3 grad = sign(det) * (dFdx(relief_h) * r1 + dFdy(relief_h) * r2);
     float relief = (0.0016 + 0.0008 * u_age) * (0.5 + tone.b) * (1.0 - paint.g) * (1.0 - hair);
     vec3 bumped = normalize(abs(det) * n - relief * grad);
-    cavity *= 1.0 - 0.04 * pit;
+    cavity *= 1.0 - 0.09 * pit;
     float spec_break = 1.0 - 0.7 * pit;   // pores hold no oil film facing the light
 #endif
     // The lips' furrows are grooves (~0.1 mm deep), not only darker lines: their slopes catch
@@ -594,7 +607,8 @@ void main() {
     float ri = length(seen);
     float aai = max(fwidth(ri), 1e-4);
     float iris_mask = front * (1.0 - smoothstep(IRIS_RADIUS - aa, IRIS_RADIUS + aa, r));
-    float pupil_mask = front * (1.0 - smoothstep(PUPIL_RADIUS - aai, PUPIL_RADIUS + aai, ri));
+    // (A soft edge, ~0.1 mm: the pupillary ruff and the cornea blur it; a cut-out disc read as a doll's.)
+    float pupil_mask = front * (1.0 - smoothstep(PUPIL_RADIUS - aai - 0.006, PUPIL_RADIUS + aai + 0.003, ri));
     float t = clamp((ri - PUPIL_RADIUS) / (IRIS_RADIUS - PUPIL_RADIUS), 0.0, 1.0);
     float angle = atan(seen.y, seen.x);
     float turns = (angle / (2.0 * PI) + 0.5) * float(IRIS_FIBRES);
@@ -603,10 +617,14 @@ void main() {
     float fibre_detail = clamp(1.6 - 0.6 * fwidth(turns), 0.0, 1.0);
     // (The fibres wander: evenly spaced straight spokes read as a wheel of glass.)
     float wander = 1.6 * (value_noise(vec2(turns * 0.125, t * 4.0 + 21.0), IRIS_FIBRES / 8) - 0.5);
-    float fibre = 0.55 * value_noise(vec2(turns + wander, t * 3.0), IRIS_FIBRES)
-                + 0.3 * value_noise(vec2(turns * 2.0 + 2.0 * wander, t * 1.5 + 3.0), IRIS_FIBRES * 2)
-                + 0.15 * value_noise(vec2(turns * 0.25, t * 6.0 + 11.0), IRIS_FIBRES / 4);
-    fibre = mix(0.5, fibre, fibre_detail);
+    // The coarse bundles (a quarter as many around) fade only where they in turn would be finer
+    // than a pixel: at 448² the fine fibres are gone, and a disc of one even colour read as a
+    // glass or doll's eye (issue 13); a photographed iris there still shows its streaks.
+    float fibre = 0.45 * value_noise(vec2(turns + wander, t * 3.0), IRIS_FIBRES)
+                + 0.25 * value_noise(vec2(turns * 2.0 + 2.0 * wander, t * 1.5 + 3.0), IRIS_FIBRES * 2);
+    fibre = mix(0.35, fibre, fibre_detail);
+    float bundle_detail = clamp(1.6 - 0.6 * fwidth(turns * 0.25), 0.0, 1.0);
+    fibre += 0.3 * mix(0.5, value_noise(vec2(turns * 0.25 + 0.5 * wander, t * 2.0 + 11.0), IRIS_FIBRES / 4), bundle_detail);
     // The collarette, a third of the way out, is a wavy ridge (it zigzags around the iris):
     // inside it the pupillary zone is darker and warmer, outside it the ciliary zone is
     // broken by darker crypts; a dark ruff rims the pupil and a dark limbal ring the iris.
@@ -705,7 +723,7 @@ void main() {
     // lids). The socket around it hides much of the sky: the whole eyeball
     // takes less ambient than the skin.
     float lid_shade = 0.7 * (1.0 - 0.15 * smoothstep(-0.05, 0.3, hy)) * (1.0 - 0.5 * smoothstep(0.32, 0.68, abs(hx)))
-                    * lash_shadow;
+                    * lash_shadow * orbit_shade(hy);
     vec3 diffuse = diffuse_light(n, vec3(0.15), occ) * albedo * lid_shade * lid_cast;
     // Wet surface. The cornea bulges over the iris as a sphere of 1.33 iris radii (7.8 mm
     // over an 11.7-mm iris), so its normal tilts faster than the eyeball's: the catch-light
