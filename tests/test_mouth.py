@@ -356,3 +356,27 @@ def test_parted_lips_light_the_lining_just_inside_them(face_of):
     opened = face.frame_occlusion(np.asarray(face.deform("1+2+5+26").positions))
     assert (opened[first] >= LINING_RING_VISIBILITY[0] - 1e-6).mean() > 0.5
     assert np.median(opened[first]) > np.median(rest[first]) + 0.2
+
+
+def test_a_wide_open_mouth_shows_the_tongues_back_in_a_dark_red_not_black(face_of):
+    # The tongue's back rises toward the throat and fills the upper half of a wide-open mouth.
+    # Its light fell to 0.015 by mid-tongue: one flat black ("dark holes", a blind reviewer),
+    # cut by the tongue's crest in a hard line. The light falls off with depth to what the
+    # cheeks and lips scatter in, warm: dark red-brown, darkening toward the throat.
+    from facsim import Face
+
+    face = face_of("ava")
+    deformation = face.deform("1+2+5+20+25+27")
+    renders = []
+    for colour in (None, "#ffffff", "#000000"):
+        character = face.character if colour is None else face.character.with_(colors={"tongue": colour})
+        with Face(character) as marked:
+            renders.append(marked.render(deformation=deformation, size=256, antialias=1)[..., :3].astype(float))
+    image, white, black = renders
+    tongue = np.abs(white - black).max(axis=-1) > 3
+    rows = np.flatnonzero(tongue.any(axis=1))
+    back = tongue & (np.arange(256)[:, None] < rows.min() + 0.4 * (rows.max() - rows.min()))
+    red, green, _ = image[back].mean(axis=0)
+    assert back.sum() > 100
+    assert red > 22 and red > 2 * green           # a dark red (16 before), not black, nor grey
+    assert _luminance(image[back]).mean() < 40    # still the mouth's shade
