@@ -177,7 +177,8 @@ def lip_figures(character, expression, size=512, engine="registers") -> dict:
     from facsim.render.camera import project
 
     image, marked = _renders(character, expression, [{"lips": "#00ff00"}], size=size, antialias=1, engine=engine)
-    lips = _changed(marked, image)
+    # (Closed over a few pixels: a lip furrow or the wet glint can fail the recolouring test.)
+    lips = ndimage.binary_closing(_changed(marked, image), structure=np.ones((5, 1)))
     with Face(character, engine=engine) as face:
         positions = np.asarray(face.deform(expression).positions)
         rim = face._mouth_rim
