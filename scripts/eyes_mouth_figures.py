@@ -34,12 +34,18 @@ as seen), their mean sRGB colour (and the same pixels' without the mucosa) again
 recolouring the lips), the share of them darker than the vermilion's median, and their 99th
 percentile luminance (the wet glint).
 
+The lips (``--lips``), at rest, 6+12+25, 1+2+5+26, 1+2+4+5+20+26 and 20+25+27 at 512², front:
+the height (mm) of the upper and the lower lip's red at the mouth's midline as seen (the
+recoloured lips' pixels in the 5 columns there, scaled at the lips' depth) and the opening
+between them: stretched lips keep their volume, so their red flattens but stays full.
+
 Usage::
 
     python3 scripts/eyes_mouth_figures.py [CHARACTER ...]      (default: amara liam mei george)
     python3 scripts/eyes_mouth_figures.py --cavity [--engine muscle] [--expression 27] [CHARACTER ...]
     python3 scripts/eyes_mouth_figures.py --mucosa [--engine muscle] [CHARACTER ...]
     python3 scripts/eyes_mouth_figures.py --aperture [--engine muscle] [CHARACTER ...]
+    python3 scripts/eyes_mouth_figures.py --lips [--engine muscle] [CHARACTER ...]
 """
 from __future__ import annotations
 
@@ -53,6 +59,8 @@ from facsim.head.character import preset
 
 LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
 WHITE = (1.0, 1.0, 1.0)
+#: The lips' heights (``--lips``) at rest, in a smile, surprise, fear and a wide stretched mouth.
+LIP_EXPRESSIONS = ("", "6+12+25", "1+2+5+26", "1+2+4+5+20+26", "20+25+27")
 
 
 def _renders(character, expression, recolours, *, size, view="front", antialias=4, engine="registers"):
@@ -168,6 +176,37 @@ def mucosa_figures(character, expression="6+12+25", size=512, engine="registers"
             "band_luminance_p99": round(float(np.percentile(luminance[band], 99)), 1)}
 
 
+def lip_figures(character, expression, size=512, engine="registers") -> dict:
+    """The lips' red as seen from the front at the mouth's midline: the upper and the lower
+    lip's height (mm, pixels of the recoloured lips in the 5 columns at the middle of the
+    mouth's inner rim, scaled by the camera at the rim's depth), and the mouth's opening
+    there (mm between the lips' red)."""
+    from facsim.render.camera import project
+
+    image, marked = _renders(character, expression, [{"lips": "#00ff00"}], size=size, antialias=1, engine=engine)
+    # (Closed over a few pixels: a lip furrow or the wet glint can fail the recolouring test.)
+    lips = ndimage.binary_closing(_changed(marked, image), structure=np.ones((5, 1)))
+    with Face(character, engine=engine) as face:
+        positions = np.asarray(face.deform(expression).positions)
+        rim = face._mouth_rim
+        # The rims' vertices nearest the midline: the lips meet (or part) between them.
+        meeting = [rim_side[np.argmin(np.abs(positions[rim_side, 0]))] for rim_side in (rim.upper, rim.lower)]
+        centre = positions[meeting].mean(axis=0)
+        (a, b), _ = project(face.camera(size=(size, size)), [centre, centre + [0.01, 0.0, 0.0]], (size, size))
+    mm_per_px = 1.0 / abs(b[0] - a[0])
+    middle, split = int(round(a[0])), int(round(a[1]))
+    heights = []
+    for column in lips[:, middle - 2: middle + 3].T:
+        upper, lower = np.flatnonzero(column[:split]), split + np.flatnonzero(column[split:])
+        # Each lip's red is its run of pixels nearest the split (not a stray pixel beyond).
+        upper = upper[upper > upper[-1] - np.r_[np.flatnonzero(np.diff(upper[::-1]) < -1), len(upper)][0] - 1]
+        lower = lower[lower < lower[0] + np.r_[np.flatnonzero(np.diff(lower) > 1), len(lower)][0] + 1]
+        heights.append((len(upper), len(lower), lower[0] - upper[-1] - 1))
+    upper, lower, gap = np.median(np.array(heights), axis=0) * mm_per_px
+    return {"upper_lip_mm": round(float(upper), 1), "lower_lip_mm": round(float(lower), 1),
+            "opening_mm": round(float(gap), 1)}
+
+
 def catch_light_figures(character, size=320) -> dict:
     image, marked = _renders(character, "", [{"iris": "#ff0000", "pupil": "#ff0000"}], size=size, antialias=1)
     bright = _changed(marked, image) & (image @ LUMINANCE > 120)
@@ -252,9 +291,16 @@ def main(argv=None) -> None:
     parser.add_argument("--mucosa", action="store_true", help="the lips' mucosa figures only")
     parser.add_argument("--aperture", action="store_true",
                         help="sclera bared above and below the iris at rest, 5E, surprise and fear only")
+    parser.add_argument("--lips", action="store_true", help="the lips' red heights at the midline, per expression")
     args = parser.parse_args(argv)
     for name in args.characters:
         character = preset(name)
+        if args.lips:
+            for expression in LIP_EXPRESSIONS:
+                figures = lip_figures(character, expression, engine=args.engine)
+                print(name, args.engine, expression or "neutral", "  ".join(f"{k} {v}" for k, v in figures.items()),
+                      flush=True)
+            continue
         if args.mucosa:
             for expression in ("6+12+25", "1+2+5+26"):
                 figures = mucosa_figures(character, expression, engine=args.engine)

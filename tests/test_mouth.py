@@ -356,3 +356,61 @@ def test_parted_lips_light_the_lining_just_inside_them(face_of):
     opened = face.frame_occlusion(np.asarray(face.deform("1+2+5+26").positions))
     assert (opened[first] >= LINING_RING_VISIBILITY[0] - 1e-6).mean() > 0.5
     assert np.median(opened[first]) > np.median(rest[first]) + 0.2
+
+
+def test_a_wide_open_mouth_shows_the_tongues_back_in_a_dark_red_not_black(face_of):
+    # The tongue's back rises toward the throat and fills the upper half of a wide-open mouth.
+    # Its light fell to 0.015 by mid-tongue: one flat black ("dark holes", a blind reviewer),
+    # cut by the tongue's crest in a hard line. The light falls off with depth to what the
+    # cheeks and lips scatter in, warm: dark red-brown, darkening toward the throat.
+    from facsim import Face
+
+    face = face_of("ava")
+    deformation = face.deform("1+2+5+20+25+27")
+    renders = []
+    for colour in (None, "#ffffff", "#000000"):
+        character = face.character if colour is None else face.character.with_(colors={"tongue": colour})
+        with Face(character) as marked:
+            renders.append(marked.render(deformation=deformation, size=256, antialias=1)[..., :3].astype(float))
+    image, white, black = renders
+    tongue = np.abs(white - black).max(axis=-1) > 3
+    rows = np.flatnonzero(tongue.any(axis=1))
+    back = tongue & (np.arange(256)[:, None] < rows.min() + 0.4 * (rows.max() - rows.min()))
+    red, green, _ = image[back].mean(axis=0)
+    assert back.sum() > 100
+    assert red > 22 and red > 2 * green           # a dark red (16 before), not black, nor grey
+    assert _luminance(image[back]).mean() < 40    # still the mouth's shade
+
+
+def _upper_lip_red_px(face, expression, size=512):
+    """Pixels of the upper lip's red down the 5 columns at the face's midline (median): from
+    the red's top to where it ends or, on closed lips, to where the lips meet (halfway between
+    the rims' midline vertices)."""
+    from facsim import Face
+    from facsim.render.camera import project
+
+    deformation = face.deform(expression)
+    renders = []
+    for colour in ("#00ff00", "#0000ff"):
+        with Face(face.character.with_(colors={"lips": colour})) as marked:
+            renders.append(marked.render(deformation=deformation, size=size, antialias=1)[..., :3].astype(float))
+    lips = np.abs(renders[0] - renders[1]).sum(axis=-1) > 60
+    positions = np.asarray(deformation.positions)
+    rim = face._mouth_rim
+    meeting = positions[[side[np.argmin(np.abs(positions[side, 0]))] for side in (rim.upper, rim.lower)]].mean(axis=0)
+    (x, rim_y), = project(face.camera(size=(size, size)), meeting[None], (size, size))[0]
+    counts = []
+    for column in lips[:, int(x) - 2: int(x) + 3].T:
+        rows = np.flatnonzero(column)
+        run = rows[: np.argmax(np.r_[np.diff(rows) > 2, True]) + 1]   # the first run from the top
+        counts.append(min(run[-1] + 1, rim_y) - run[0])
+    return float(np.median(counts))
+
+
+@pytest.mark.parametrize("expression", ["27", "1+2+4+5+20+26"])
+def test_open_and_stretched_lips_keep_their_red(face_of, expression):
+    # The jaw's drop and 20's stretch thinned george's upper lip's red to 1.9 mm of its 5.2
+    # at the midline: a rubbery band. Stretched lips keep their volume: they flatten, but
+    # their red stays full (at least 70 % of the closed lip's height as seen).
+    face = face_of("george")
+    assert _upper_lip_red_px(face, expression) >= 0.7 * _upper_lip_red_px(face, "0")

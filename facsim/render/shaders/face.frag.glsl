@@ -297,6 +297,34 @@ const vec3 MUCOSA = vec3(0.40, 0.075, 0.09);   // the lips' mucosa (linear; sRGB
 const float UPPER_TEETH[8] = float[8](0.0, 0.085, 0.150, 0.225, 0.295, 0.360, 0.460, 0.560);
 const float LOWER_TEETH[8] = float[8](0.0, 0.052, 0.108, 0.176, 0.246, 0.316, 0.426, 0.530);
 #endif
+#ifdef REGION_TONGUE
+// The light an open mouth lets in falls off with depth behind the lips: about 1/e every
+// TONGUE_LIGHT_FALLOFF of the tongue's length (~8 cm tip to root, so ~1.8 cm) from
+// TONGUE_LIGHT_TIP at the tip, down to TONGUE_LIGHT_FLOOR, the light the cheeks and lips
+// scatter in, itself fading toward the throat (to a third at the root, which rises under
+// the palate's shadow). What reaches the back has bounced off the red lining: warm. (A steep fall to
+// 0.015 by mid-tongue drew the tongue's back, which rises toward the throat and fills the
+// upper half of a wide-open mouth, as one flat black: "a dark hole" cut by the tongue's
+// crest in a hard line.)
+const float TONGUE_LIGHT_TIP = 0.36;
+const float TONGUE_LIGHT_FALLOFF = 0.22;
+const float TONGUE_LIGHT_FLOOR = 0.045;
+const vec3 DEEP_BOUNCE = vec3(1.0, 0.55, 0.5);
+vec3 tongue_depth_light(float along) {
+    float direct = exp(-along / TONGUE_LIGHT_FALLOFF);
+    float scattered = TONGUE_LIGHT_FLOOR * (1.0 - 0.65 * smoothstep(0.3, 0.9, along));
+    return (TONGUE_LIGHT_TIP * direct + scattered) * mix(DEEP_BOUNCE, vec3(1.0), direct);
+}
+#endif
+#ifdef REGION_MOUTH_INTERIOR
+// Deep in the mouth the lining takes only what light the cheeks and lips scatter in, after
+// bouncing off more red lining: a dull, dark red-brown. (A greyed dark, 0.18 of the lining's
+// colour half desaturated, drew the lining seen past the teeth at a wide mouth's corners as
+// grey wedges, and the floor of the mouth under the tongue's tip as a grey-black diamond.)
+vec3 cavity_deep_colour(vec3 lining) {
+    return 0.15 * lining * vec3(1.0, 0.9, 0.9);
+}
+#endif
 #if defined(ONE_ALBEDO) || defined(REGION_MOUTH_INTERIOR) || defined(REGION_LASHES) || defined(REGION_GARMENT)
 uniform vec3 u_albedo;
 #endif
@@ -870,11 +898,11 @@ void main() {
     float papillae = 0.85 + 0.3 * value_noise(v_uv * vec2(40.0, 60.0), 0);
     vec3 albedo = u_albedo * vec3(0.88, 0.72, 0.74) * papillae * groove;
     // The tongue lies in the shadow of the lips and upper teeth: dim at the tip, dark at its
-    // sides against the teeth and falling into the throat's dark toward the root (where it
-    // rises to the back wall: lit there, its sides and groove drew pale and dark stripes).
-    // How much light the parted lips let in arrives in occ (facsim.head.mouth.mouth_light).
-    float mouth_shade = mix(0.38, 0.015, smoothstep(0.0, 0.5, along)) * mix(1.0, 0.5, smoothstep(0.4, 1.0, abs(across)))
-                      * mix(0.1, 1.0, occ);
+    // sides against the teeth, the light falling off with depth toward the root
+    // (tongue_depth_light). How much light the parted lips let in arrives in occ
+    // (facsim.head.mouth.mouth_light).
+    vec3 mouth_shade = tongue_depth_light(along) * mix(1.0, 0.5, smoothstep(0.4, 1.0, abs(across)))
+                     * mix(0.1, 1.0, occ);
     // Moist: a soft sheen broken by the papillae, and a tighter glint on the film of saliva.
     vec3 spec = specular_light(n, v, 40.0) * 0.12 * papillae + specular_light(n, v, 90.0) * 0.3 * smoothstep(0.8, 1.1, papillae);
     // The film mirrors the key through the opening wherever the tongue's front faces it: the
@@ -894,7 +922,7 @@ void main() {
     float mouth_shade = occ * occ;
     float lip_side = smoothstep(0.6, 0.9, occ);
     vec3 spec = specular_light(n, v, 30.0) * mix(0.04, 0.3, lip_side);
-    vec3 deep = 0.18 * mix(vec3(dot(u_albedo, vec3(0.33))), u_albedo, 0.5);
+    vec3 deep = cavity_deep_colour(u_albedo);
     vec3 albedo = mix(u_albedo * 0.45, MUCOSA * 0.8, lip_side);
     radiance = (diffuse_light(n, vec3(0.3, 0.1, 0.1), 1.0) * albedo + spec) * mouth_shade
              + deep * (1.0 - mouth_shade);
