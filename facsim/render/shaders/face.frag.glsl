@@ -635,8 +635,7 @@ void main() {
     float ri = length(seen);
     float aai = max(fwidth(ri), 1e-4);
     float iris_mask = front * (1.0 - smoothstep(IRIS_RADIUS - aa, IRIS_RADIUS + aa, r));
-    // (A soft edge, ~0.1 mm: the pupillary ruff and the cornea blur it; a cut-out disc read as a doll's.)
-    float pupil_mask = front * (1.0 - smoothstep(PUPIL_RADIUS - aai - 0.006, PUPIL_RADIUS + aai + 0.003, ri));
+    float pupil_mask = front * (1.0 - smoothstep(PUPIL_RADIUS - aai, PUPIL_RADIUS + aai, ri));
     float t = clamp((ri - PUPIL_RADIUS) / (IRIS_RADIUS - PUPIL_RADIUS), 0.0, 1.0);
     float angle = atan(seen.y, seen.x);
     float turns = (angle / (2.0 * PI) + 0.5) * float(IRIS_FIBRES);
@@ -648,11 +647,14 @@ void main() {
     // The coarse bundles (a quarter as many around) fade only where they in turn would be finer
     // than a pixel: at 448² the fine fibres are gone, and a disc of one even colour read as a
     // glass or doll's eye (issue 13); a photographed iris there still shows its streaks.
-    float fibre = 0.45 * value_noise(vec2(turns + wander, t * 3.0), IRIS_FIBRES)
-                + 0.25 * value_noise(vec2(turns * 2.0 + 2.0 * wander, t * 1.5 + 3.0), IRIS_FIBRES * 2);
-    fibre = mix(0.35, fibre, fibre_detail);
+    // (Where the fibres show, the bundles keep their old share, 0.15; where the fibres have
+    // faded, twice that. The mean stays 0.5.)
+    float fibre = 0.55 * value_noise(vec2(turns + wander, t * 3.0), IRIS_FIBRES)
+                + 0.3 * value_noise(vec2(turns * 2.0 + 2.0 * wander, t * 1.5 + 3.0), IRIS_FIBRES * 2);
+    fibre = mix(0.425, fibre, fibre_detail);
     float bundle_detail = clamp(1.6 - 0.6 * fwidth(turns * 0.25), 0.0, 1.0);
-    fibre += 0.3 * mix(0.5, value_noise(vec2(turns * 0.25 + 0.5 * wander, t * 2.0 + 11.0), IRIS_FIBRES / 4), bundle_detail);
+    float bundle = mix(0.5, value_noise(vec2(turns * 0.25, t * 6.0 + 11.0), IRIS_FIBRES / 4), bundle_detail);
+    fibre += 0.075 + mix(0.3, 0.15, fibre_detail) * (bundle - 0.5);
     // The collarette, a third of the way out, is a wavy ridge (it zigzags around the iris):
     // inside it the pupillary zone is darker and warmer, outside it the ciliary zone is
     // broken by darker crypts; a dark ruff rims the pupil and a dark limbal ring the iris.
@@ -717,6 +719,7 @@ void main() {
     float limbal = front * exp(-pow((r - IRIS_RADIUS) / 0.035, 2.0));
     sclera *= 1.0 - 0.35 * limbal;
     float iris_soft = front * (1.0 - smoothstep(IRIS_RADIUS - aa - 0.015, IRIS_RADIUS + aa, r));
+    sclera *= orbit_shade(hy);   // (the white only: the lids hide the iris's top but where 5 bares it)
     vec3 albedo = mix(sclera, iris, max(iris_mask, 0.6 * iris_soft));
 #ifdef USE_LIDS
     // Along the lids (v_lids: degrees of arc from each margin; ~1.7 px per degree at 1024²):
@@ -751,7 +754,7 @@ void main() {
     // lids). The socket around it hides much of the sky: the whole eyeball
     // takes less ambient than the skin.
     float lid_shade = 0.7 * (1.0 - 0.15 * smoothstep(-0.05, 0.3, hy)) * (1.0 - 0.5 * smoothstep(0.32, 0.68, abs(hx)))
-                    * lash_shadow * orbit_shade(hy);
+                    * lash_shadow;
     vec3 diffuse = diffuse_light(n, vec3(0.15), occ) * albedo * lid_shade * lid_cast;
     // Wet surface. The cornea bulges over the iris as a sphere of 1.33 iris radii (7.8 mm
     // over an 11.7-mm iris), so its normal tilts faster than the eyeball's: the catch-light
