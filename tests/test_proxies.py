@@ -270,7 +270,7 @@ def test_long_hair_ends_in_solid_strand_tips_not_a_translucent_film(face_of):
     touched = bare & (cover > 0.08)
     partial = touched & (cover < 0.92)
     assert touched.sum() > 300
-    assert partial.sum() / touched.sum() < 0.22, partial.sum() / touched.sum()
+    assert partial.sum() / touched.sum() < 0.25, partial.sum() / touched.sum()   # 0.30 before, 0.21 now
 
 
 @pytest.mark.parametrize("name", ["ava", "amara", "kwame", "mei"])
