@@ -144,10 +144,10 @@ Fold crease_fold(float wrinkle, float phase, vec2 uv) {
     float along = value_noise(uv * vec2(22.0, 44.0) + 9.0 * hash2(ivec2(int(line), 3)), 0);
     float depth = (0.5 + 0.5 * hash2(ivec2(int(line), 11))) * smoothstep(0.1, 0.55, along);
     // How far the skin has folded: from the engine's buckling threshold on (the wrinkle field is 0
-    // below it), growing fastest at first and levelling off, as a buckled sheet's fold amplitude
-    // grows with the square root of its extra compression - so an AU at C (half of E's
-    // compression or more) already shows its lines, and at E the folds deepen without setting
-    // into uniformly cut grooves. (Until session 17 the lines started only at wrinkle 0.15 and
+    // below it), growing fastest at first (a buckled sheet's fold amplitude grows as the square
+    // root of its extra compression) and levelling off (the folds close on themselves) - so an AU
+    // at C (two thirds of E's compression) already shows its lines, and at E the folds deepen
+    // without setting into uniformly cut grooves. (Until session 17 the lines started only at wrinkle 0.15 and
     // were full at 0.8: 9's nose lines, 0.13 at C, did not show at all.) Older skin creases
     // sooner (less elastic): the same compression shows more lines.
     float amount = (1.0 - exp(-wrinkle / (0.3 - 0.1 * u_age))) * smoothstep(0.0, 0.08, wrinkle);
