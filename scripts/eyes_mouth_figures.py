@@ -39,6 +39,11 @@ the height (mm) of the upper and the lower lip's red at the mouth's midline as s
 recoloured lips' pixels in the 5 columns there, scaled at the lips' depth) and the opening
 between them: stretched lips keep their volume, so their red flattens but stays full.
 
+The smile's teeth along the row (``--teeth``), 6+12+25 at 448², front: per column of the
+upper teeth's top run of pixels, its mean luminance; the 10th and 90th percentile of those in
+the middle half of the row (crowns, their shaded flanks and the embrasures: a flat strip has
+them close), and the row's outer sixths' mean over its middle third's (the buccal corridor).
+
 Usage::
 
     python3 scripts/eyes_mouth_figures.py [CHARACTER ...]      (default: amara liam mei george)
@@ -46,6 +51,7 @@ Usage::
     python3 scripts/eyes_mouth_figures.py --mucosa [--engine muscle] [CHARACTER ...]
     python3 scripts/eyes_mouth_figures.py --aperture [--engine muscle] [CHARACTER ...]
     python3 scripts/eyes_mouth_figures.py --lips [--engine muscle] [CHARACTER ...]
+    python3 scripts/eyes_mouth_figures.py --teeth [--engine muscle] [CHARACTER ...]
 """
 from __future__ import annotations
 
@@ -97,6 +103,31 @@ def teeth_figures(character, expression="6+12+25", size=512) -> dict:
     return {"luminance": round(float((pixels @ LUMINANCE).mean()), 1),
             "chroma": round(float((pixels.max(1) - pixels.min(1)).mean()), 1),
             "edge_bluer_by": round(float((edge[:, 2] - edge[:, 0]).mean() - (crown[:, 2] - crown[:, 0]).mean()), 1)}
+
+
+def teeth_row_figures(character, expression="6+12+25", size=448, engine="registers") -> dict:
+    """The upper teeth's row as a row of crowns, not a flat strip: along the row (the teeth's
+    pixels in their top run, per column), the spread of the columns' mean luminance in the
+    middle half of the row (10th to 90th percentile: crowns, their shaded flanks and the
+    embrasures between) and the mean luminance of the row's outer sixths against its middle
+    third (the buccal corridor's shade)."""
+    image, marked = _renders(character, expression, [{"teeth": "#00ff00"}], size=size, engine=engine)
+    teeth = (marked[..., 1] > marked[..., 0] + 20) & (marked[..., 1] > marked[..., 2] + 20)
+    luminance = image @ LUMINANCE
+    ys, xs = np.nonzero(teeth)
+    columns = np.unique(xs)
+    means = []
+    for x in columns:
+        column = np.sort(ys[xs == x])
+        top = column[: np.argmax(np.diff(np.r_[column, column[-1] + 2]) > 1) + 1]
+        means.append(luminance[top, x].mean())
+    means = np.array(means)
+    position = (columns - columns.min()) / max(columns.max() - columns.min(), 1)
+    middle = means[np.abs(position - 0.5) < 0.25]
+    outer = means[np.abs(position - 0.5) > 1 / 3]
+    centre = means[np.abs(position - 0.5) < 1 / 6]
+    return {"column_luminance_p10_p90": [round(float(q), 1) for q in np.percentile(middle, [10, 90])],
+            "outer_over_middle": round(float(outer.mean() / centre.mean()), 2)}
 
 
 def cavity_figures(character, expression="1+2+5+26", size=512, engine="registers") -> dict:
@@ -292,9 +323,14 @@ def main(argv=None) -> None:
     parser.add_argument("--aperture", action="store_true",
                         help="sclera bared above and below the iris at rest, 5E, surprise and fear only")
     parser.add_argument("--lips", action="store_true", help="the lips' red heights at the midline, per expression")
+    parser.add_argument("--teeth", action="store_true", help="the smile's upper teeth along the row at 448 px")
     args = parser.parse_args(argv)
     for name in args.characters:
         character = preset(name)
+        if args.teeth:
+            figures = teeth_row_figures(character, engine=args.engine)
+            print(name, args.engine, "6+12+25", "  ".join(f"{k} {v}" for k, v in figures.items()), flush=True)
+            continue
         if args.lips:
             for expression in LIP_EXPRESSIONS:
                 figures = lip_figures(character, expression, engine=args.engine)

@@ -272,9 +272,10 @@ TONGUE_LIT_GAP = (0.003, 0.025)
 #: around them (the buccal corridor): a tooth vertex's height below the upper lip's edge
 #: is taken as at most (slope × its distance across the mouth from the nearer corner −
 #: offset, dm), so the lip's shadow deepens toward the corners, darkest at them and gone
-#: ~10 mm in. Lit evenly to the corners, the back teeth of a wide mouth (20+26) showed as
-#: pale slabs filling the commissures.
-COMMISSURE_SHADE = (0.3, 0.008)
+#: ~12 mm in. Lit evenly to the corners, the back teeth of a wide mouth (20+26) showed as
+#: pale slabs filling the commissures; gone 10 mm in (slope 0.3), a smile's teeth stayed
+#: bright out to its corners, a white strip filling the crescent.
+COMMISSURE_SHADE = (0.25, 0.008)
 #: How many rings of skin around the rim count as the upper lip's free margin.
 UPPER_LIP_RINGS = 5
 @dataclass(frozen=True)

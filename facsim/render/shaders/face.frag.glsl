@@ -318,11 +318,58 @@ vec3 tongue_depth_light(float along) {
 #endif
 #ifdef REGION_MOUTH_INTERIOR
 // Deep in the mouth the lining takes only what light the cheeks and lips scatter in, after
-// bouncing off more red lining: a dull, dark red-brown. (A greyed dark, 0.18 of the lining's
-// colour half desaturated, drew the lining seen past the teeth at a wide mouth's corners as
-// grey wedges, and the floor of the mouth under the tongue's tip as a grey-black diamond.)
+// bouncing off more red lining: a dull, dark red-brown, as dark as the tongue's back
+// (tongue_depth_light). (A greyed dark, 0.18 of the lining's colour half desaturated, drew
+// the lining seen past the teeth at a wide mouth's corners as grey wedges, and the floor of
+// the mouth under the tongue's tip as a black diamond in the muscle engine's 27.)
 vec3 cavity_deep_colour(vec3 lining) {
-    return 0.15 * lining * vec3(1.0, 0.9, 0.9);
+    return 0.4 * lining * vec3(1.0, 0.9, 0.9);
+}
+#endif
+#ifdef REGION_TEETH
+// How far (band units, ~1.6 cm) the biting edge is cut back at ``side`` (0 mid-crown .. 1 at
+// its neighbours) of a tooth of ``kind`` (0 central incisor .. 6 molar) in the upper
+// (lower = 0) or lower row (1): incisors square with rounded corners, the upper laterals
+// ~0.6 mm shorter than the centrals, so the upper front teeth part at their tips in small
+// V-shaped embrasures (~1 mm), each crown its own outline; the lower incisors almost
+// straight across (their embrasures, cut deep, showed the dark behind them as specks along
+// the row's edge); canines a cusp; premolars and molars cusps set higher (the curve of Spee).
+float incisal_notch(int kind, float side, float lower) {
+    if (kind <= 1) {
+        float corner = clamp((side - 0.35) / 0.65, 0.0, 1.0);
+        return mix(0.06, 0.01, lower) * corner * corner + (kind == 1 ? 0.035 * (1.0 - lower) : 0.0);
+    }
+    if (kind == 2) return 0.06 * pow(side, 1.6) - 0.01;
+    // (Shallow: the back teeth's cusps show only in the buccal corridor's shade, where a
+    // deep cut read as broken black teeth.)
+    return 0.03 + 0.04 * pow(side, 3.0) + 0.01 * float(kind - 3);
+}
+// Each crown is convex: its middle faces the light and its flanks turn away toward its
+// neighbours, brightness varying by this much across it about the same mean (0.08, darkening
+// only the flanks, drew the row as one flat white strip at 448 px).
+const float CROWN_ROUNDING = 0.18;
+// The light left on a tooth right under the upper lip's edge and in the mouth's corners,
+// where the lips and cheeks wrap the teeth (facsim.head.mouth.mouth_light). (At 0.5 the
+// back teeth of a stretched mouth (20+26) showed as grey slabs in its corners.)
+const float LIP_SHADOW_FLOOR = 0.3;
+// Where two crowns touch they leave a soft shadow (an embrasure) ``to_gap`` (dm) from the
+// contact, darkest at the biting edge where they part and a thin shade up the crowns to the
+// gum (``h``, band units up the outer wall) - never a dark line, which read as braces; faded
+// to a faint mean where it would be finer than a pixel (``aa``, dm per pixel). The lower
+// row's edges stay light: seen from above, their embrasures read as dark specks.
+// The crown's normal tilted by its bulge's surface gradient ``grad`` (``det`` the screen
+// frame's determinant), by at most ~27 degrees: where a pixel quad straddles the band's fold
+// at the biting edge the gradient spikes, and the normal turned from the light drew the lower
+// row's edge and crowns with dark specks.
+vec3 crown_normal(vec3 n, float det, vec3 grad) {
+    float most = 0.5 * abs(det);
+    float size = length(grad);
+    return normalize(abs(det) * n - grad * min(1.0, most / max(size, 1e-12)));
+}
+float embrasure_shade(float to_gap, float aa, float h, float lower) {
+    float at_edge = mix(1.0, 0.5, lower);
+    return 0.35 * (1.0 - smoothstep(0.0, aa + 0.006, to_gap)) * clamp(1.5 - 120.0 * aa, 0.3, 1.0)
+         * mix(at_edge, 0.6, smoothstep(0.04, 0.25, h));
 }
 #endif
 #if defined(ONE_ALBEDO) || defined(REGION_MOUTH_INTERIOR) || defined(REGION_LASHES) || defined(REGION_GARMENT)
@@ -802,33 +849,18 @@ void main() {
     float b1 = mix(UPPER_TEETH[kind + 1], LOWER_TEETH[kind + 1], lower);
     float w = clamp((arc - b0) / (b1 - b0), 0.0, 1.0);     // 0..1 across this tooth
     float side = abs(2.0 * w - 1.0);                        // 0 mid-crown .. 1 at its neighbours
-    // The biting edge's outline, as the height (band units, ~1.6 cm) cut away below it:
-    // incisors square with rounded corners (laterals a little shorter), canines a cusp,
-    // premolars and molars cusps set higher (the curve of Spee). Cutting it out of the
-    // band (discard) gives each tooth its own silhouette and the dark embrasures between.
-    float notch;
-    if (kind <= 1) {
-        float corner = clamp((side - 0.45) / 0.55, 0.0, 1.0);
-        notch = 0.035 * corner * corner + (kind == 1 ? mix(0.02, 0.01, lower) : 0.0);
-    } else if (kind == 2) {
-        notch = 0.06 * pow(side, 1.6) - 0.01;
-    } else {
-        // (Shallow: the back teeth's cusps show only in the buccal corridor's shade, where a
-        // deep cut read as broken black teeth.)
-        notch = 0.03 + 0.04 * pow(side, 3.0) + 0.01 * float(kind - 3);
-    }
+    // The biting edge's outline (incisal_notch): cutting it out of the band (discard) gives
+    // each tooth its own silhouette and the dark embrasures between.
+    float notch = incisal_notch(kind, side, lower);
     // A band without coordinates (all (0, 0): constant, so no derivative) stays whole.
     bool shaped = fwidth(v_uv.x) + fwidth(v_uv.y) > 0.0;
     if (shaped && max(h, lingual) < notch) discard;
     // Each crown is convex: it turns away from the light toward its neighbours, and where two
-    // touch they leave a soft shadow (an embrasure, deeper toward the biting edge where crowns
-    // part) - never a dark line, which read as braces. Faded to a faint mean where it would be
-    // finer than a pixel.
+    // touch they leave a soft shadow (embrasure_shade).
     float gap_aa = fwidth(arc);
     float to_gap = min(arc - b0, b1 - arc);
-    float convex = 1.0 - 0.08 * pow(side, 3.0);
-    float gap = 1.0 - 0.26 * (1.0 - smoothstep(0.0, gap_aa + 0.006, to_gap))
-                    * clamp(1.5 - 120.0 * gap_aa, 0.3, 1.0) * mix(1.0, 0.3, smoothstep(0.04, 0.25, h));
+    float convex = 1.0 + CROWN_ROUNDING * (1.0 / 3.0 - side * side);
+    float gap = 1.0 - embrasure_shade(to_gap, gap_aa, h, lower);
     // Scalloped gum line, arched rootward over each crown (crowns ~10 mm of the band's 16),
     // papillae reaching toward the biting edge between crowns. A smile rarely shows it;
     // where it shows it is pink, lit like the teeth (no dark band under the lip).
@@ -868,7 +900,7 @@ void main() {
     vec3 r1 = cross(dpdy, n), r2 = cross(n, dpdx);
     float det = dot(dpdx, r1);
     float bulge_h = 0.01 * (b1 - b0) / 0.08 * (1.0 - (2.0 * w - 1.0) * (2.0 * w - 1.0)) * (1.0 - gum);
-    n = normalize(abs(det) * n - sign(det) * (dFdx(bulge_h) * r1 + dFdy(bulge_h) * r2));
+    n = crown_normal(n, det, sign(det) * (dFdx(bulge_h) * r1 + dFdy(bulge_h) * r2));
     // Light inside the mouth falls off with depth: the front teeth catch it, the back ones sit
     // in the shadow of the cheeks (the dark buccal corridor). The upper lip casts a soft
     // contact shadow just under its edge: v_occlusion is the fragment's height (dm) below
@@ -879,7 +911,7 @@ void main() {
     // (The lower row's back teeth sit lower in the cheeks' shade: its corridor starts nearer
     // the front, or a stretched mouth (20+26) showed them as pale slabs in its corners.)
     float depth_shade = mix(1.0, 0.09, smoothstep(mix(0.12, 0.08, lower), mix(0.36, 0.28, lower), arc));
-    float lip_shadow = mix(0.5, 1.0, smoothstep(-0.002, 0.022, v_occlusion));
+    float lip_shadow = mix(LIP_SHADOW_FLOOR, 1.0, smoothstep(-0.002, 0.022, v_occlusion));
     float row_light = mix(1.0, 0.62, lower);
     // The inside of the arch faces the tongue and throat: it only catches light scattered in.
     float mouth_shade = depth_shade * lip_shadow * row_light * mix(1.0, 0.12, smoothstep(0.0, 0.1, lingual))
