@@ -431,6 +431,10 @@ def test_a_character_s_natural_asymmetry_moves_one_side_more(face_of):
     smile = {c.side: w for c, w in weights.items() if c.target.startswith("faceunits/mouthSmile")}
     assert smile["left"] / smile["right"] == pytest.approx(gain["left"] / gain["right"])
     assert face_of("liam").engine.side_gain == {"left": 1.0, "right": 1.0}
+    # Session 17: the mandible is one bone - 26 drops both halves of the jaw alike (a blind reviewer
+    # saw liam's and george's surprise with the mouth skewed and the chin shifted sideways).
+    jaw = {c.side: w for c, w in engine.weights(activations(parse("26"))).items() if c.target == "faceunits/jawOpen"}
+    assert jaw["left"] == jaw["right"] > 0
 
 
 def test_a_half_smile_narrows_the_eye_from_below(engine, marks):

@@ -36,6 +36,10 @@ MIDLINE_BLEND = 0.06
 #: beyond this band (dm): the authored Face Units carry stray offsets on the far
 #: side (eyeBlinkLeft moves the right eye socket), which unilateral AUs must not show.
 SIDED_REACH = (0.05, 0.15)
+#: Two-sided targets that move the mandible, one bone: the character's natural asymmetry (one
+#: hemiface acting more strongly) must not drop one half of the jaw further than the other - it
+#: skewed the open mouth and shifted the chin sideways (liam's and george's surprise, blind review).
+BONE_TARGETS = frozenset({"faceunits/jawOpen", "faceunits/jawForward"})
 
 
 @lru_cache(maxsize=1)
@@ -277,7 +281,8 @@ class RegisterEngine:
         asymmetry), plus the relaxed lids' share of the closing target."""
         from facsim.engines.lids import rest_table
 
-        weights = {col: w * self.side_gain[col.side] for col, w in register_weights(act).items()}
+        weights = {col: w * (1.0 if col.pattern in BONE_TARGETS else self.side_gain[col.side])
+                   for col, w in register_weights(act).items()}
         for side in ("left", "right"):
             share = self.rest_lids.share(act, side)
             if share:
