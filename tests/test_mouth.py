@@ -217,21 +217,27 @@ def test_the_inside_of_the_arch_is_not_a_grey_wall(face_of):
     assert grey.sum() < 300
 
 
-def test_an_open_mouths_tongue_is_wet(face_of):
-    # The tongue's film mirrors the key through the opening: a sheen on its front (its
-    # brightest pixels ~160-180 at 512 px), where the shade of the mouth dimmed it to a
-    # matte 120-140 like the rest of the tongue.
+def _render_with_tongue(face, expression, size):
+    """``face`` showing ``expression`` at ``size`` px (RGB floats), and the tongue's pixels: where
+    recolouring the tongue white and then black changes the picture."""
     from facsim import Face
 
-    face = face_of("ava")
-    deformation = face.deform("1+2+5+26")
+    deformation = face.deform(expression)
     renders = []
     for colour in (None, "#ffffff", "#000000"):
         character = face.character if colour is None else face.character.with_(colors={"tongue": colour})
         with Face(character) as marked:
-            renders.append(marked.render(deformation=deformation, size=512, antialias=1)[..., :3].astype(float))
+            renders.append(marked.render(deformation=deformation, size=size, antialias=1)[..., :3].astype(float))
     image, white, black = renders
-    luminance = _luminance(image[np.abs(white - black).max(axis=-1) > 3])
+    return image, np.abs(white - black).max(axis=-1) > 3
+
+
+def test_an_open_mouths_tongue_is_wet(face_of):
+    # The tongue's film mirrors the key through the opening: a sheen on its front (its
+    # brightest pixels ~160-180 at 512 px), where the shade of the mouth dimmed it to a
+    # matte 120-140 like the rest of the tongue.
+    image, tongue = _render_with_tongue(face_of("ava"), "1+2+5+26", 512)
+    luminance = _luminance(image[tongue])
     lit = luminance[luminance > 30]
     assert len(lit) > 500
     assert np.percentile(lit, 99) > 150 > 2 * np.median(lit)
@@ -363,17 +369,7 @@ def test_a_wide_open_mouth_shows_the_tongues_back_in_a_dark_red_not_black(face_o
     # Its light fell to 0.015 by mid-tongue: one flat black ("dark holes", a blind reviewer),
     # cut by the tongue's crest in a hard line. The light falls off with depth to what the
     # cheeks and lips scatter in, warm: dark red-brown, darkening toward the throat.
-    from facsim import Face
-
-    face = face_of("ava")
-    deformation = face.deform("1+2+5+20+25+27")
-    renders = []
-    for colour in (None, "#ffffff", "#000000"):
-        character = face.character if colour is None else face.character.with_(colors={"tongue": colour})
-        with Face(character) as marked:
-            renders.append(marked.render(deformation=deformation, size=256, antialias=1)[..., :3].astype(float))
-    image, white, black = renders
-    tongue = np.abs(white - black).max(axis=-1) > 3
+    image, tongue = _render_with_tongue(face_of("ava"), "1+2+5+20+25+27", 256)
     rows = np.flatnonzero(tongue.any(axis=1))
     back = tongue & (np.arange(256)[:, None] < rows.min() + 0.4 * (rows.max() - rows.min()))
     red, green, _ = image[back].mean(axis=0)
