@@ -155,11 +155,11 @@ def _size(text: str):
 def add_view_options(p: argparse.ArgumentParser) -> None:
     """Options shared by every command that renders."""
     from facsim.engines import DEFAULT_ENGINE, ENGINES
-    from facsim.head.proxies import hair_names
     from facsim.render.options import DEFAULT_BODY, VIEWS
 
     p.add_argument("--character", "-c", default="ava", help="preset name (see `facsim characters`) or random:SEED")
-    p.add_argument("--hair", help=f"hair style ({', '.join(hair_names())}) or none; default: the character's own")
+    p.add_argument("--hair", help="hair style (bob01, bob02, short01-04, long01, ponytail01, braid01, afro01, crop) "
+                                  "or none; default: the character's own")
     p.add_argument("--engine", choices=tuple(ENGINES), default=DEFAULT_ENGINE, help="how AUs move the face")
     p.add_argument("--view", choices=sorted(VIEWS), default="front")
     p.add_argument("--yaw", type=number(-360, 360, unit="degrees"), help="camera yaw in degrees (positive: toward the character's left)")
