@@ -378,6 +378,35 @@ def test_a_wide_open_mouth_shows_the_tongues_back_in_a_dark_red_not_black(face_o
     assert _luminance(image[back]).mean() < 40    # still the mouth's shade
 
 
+@pytest.mark.parametrize("character", ["mei", "george"])
+def test_a_stretched_open_mouths_back_teeth_are_not_black_wedges(face_of, character):
+    # Fear (1+2+4+5+20+26) stretches the opening wide: its corners show the lower row's back
+    # teeth and the inside of its arch. In the cheeks' shade they fell to pure black wedges
+    # with straight edges (a blind reviewer: "molar wedges"; a third to a half of those pixels
+    # under 12 of 255). The light scattered into the mouth keeps them a warm, dark brown-red.
+    from facsim import Face
+
+    face = face_of(character)
+    deformation = face.deform("1+2+4+5+20+26")
+    renders = []
+    for colour in (None, "#ffffff", "#000000"):
+        marked_character = face.character if colour is None else face.character.with_(colors={"teeth": colour})
+        with Face(marked_character) as marked:
+            renders.append(marked.render(deformation=deformation, size=256, antialias=1)[..., :3].astype(float))
+    image, white, black = renders
+    teeth = np.abs(white - black).max(axis=-1) > 3
+    columns = np.flatnonzero(teeth.any(axis=0))
+    fifth = (columns.max() - columns.min()) // 5
+    corners = teeth.copy()
+    corners[:, columns.min() + fifth: columns.max() - fifth] = False
+    shown = image[corners]
+    assert corners.sum() > 15
+    assert (_luminance(shown) < 12).mean() < 0.05     # not black
+    assert _luminance(shown).mean() < 80              # still in the corridor's shade
+    red, green, blue = shown.mean(axis=0)
+    assert red > 1.2 * green and red > blue           # warm, lit by the red lining
+
+
 def _upper_lip_red_px(face, expression, size=512):
     """Pixels of the upper lip's red down the 5 columns at the face's midline (median): from
     the red's top to where it ends or, on closed lips, to where the lips meet (halfway between

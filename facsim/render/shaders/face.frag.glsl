@@ -14,7 +14,7 @@ in float v_occlusion;
 #ifdef USE_UV
 in vec2 v_uv;
 #endif
-#ifdef REGION_SKIN
+#if defined(REGION_SKIN) || defined(REGION_TONGUE)
 in vec3 v_scatter_normal;   // the normal averaged over a few millimetres (Renderer: scattered_normals)
 #endif
 #ifdef USE_EYE
@@ -310,6 +310,8 @@ const float TONGUE_LIGHT_TIP = 0.36;
 const float TONGUE_LIGHT_FALLOFF = 0.22;
 const float TONGUE_LIGHT_FLOOR = 0.045;
 const vec3 DEEP_BOUNCE = vec3(1.0, 0.55, 0.5);
+// How much of the tongue's shading normal is its normal averaged over ~2 rings of its mesh.
+const float TONGUE_SMOOTHING = 0.8;
 vec3 tongue_depth_light(float along) {
     float direct = exp(-along / TONGUE_LIGHT_FALLOFF);
     float scattered = TONGUE_LIGHT_FLOOR * (1.0 - 0.65 * smoothstep(0.3, 0.9, along));
@@ -352,6 +354,13 @@ const float CROWN_ROUNDING = 0.18;
 // where the lips and cheeks wrap the teeth (facsim.head.mouth.mouth_light). (At 0.5 the
 // back teeth of a stretched mouth (20+26) showed as grey slabs in its corners.)
 const float LIP_SHADOW_FLOOR = 0.3;
+// What light the cheeks and lips scatter into the mouth reaches its back teeth too, after
+// bouncing off the red lining: the deepest teeth keep this much of their colour, warmed
+// (DEEP_TEETH_BOUNCE), as the tongue's back does (TONGUE_LIGHT_FLOOR). Without it the lower
+// row's back teeth and the inside of its arch, which a stretched open mouth (20+26) shows in
+// its corners, were pure black wedges with straight edges (issue 13: "molar wedges").
+const float DEEP_TEETH_LIGHT = 0.045;
+const vec3 DEEP_TEETH_BOUNCE = vec3(1.0, 0.5, 0.45);
 // Where two crowns touch they leave a soft shadow (an embrasure) ``to_gap`` (dm) from the
 // contact, darkest at the biting edge where they part and a thin shade up the crowns to the
 // gum (``h``, band units up the outer wall) - never a dark line, which read as braces; faded
@@ -923,14 +932,24 @@ void main() {
     // What light reaches the back teeth has bounced off the cheeks' red lining: warm, not grey.
     // So does what reaches the inside of the arch.
     radiance *= mix(vec3(1.0, 0.6, 0.5), vec3(1.0), depth_shade * (1.0 - 0.8 * smoothstep(0.0, 0.3, lingual)));
+    radiance += DEEP_TEETH_LIGHT * DEEP_TEETH_BOUNCE * albedo * (1.0 - mouth_shade);
 #endif
 
 #ifdef REGION_TONGUE
     // v_uv = (across -1..1, along 0 at the tip .. 1 at the root), facsim.head.mouth.tongue_coordinates.
     float across = v_uv.x, along = clamp(v_uv.y, 0.0, 1.0);
+    // hm08's tongue is coarse (~1 cm facets): its interpolated normals drew the wet sheen as
+    // streaks along the triangles' edges and the diffuse light in facets (issue 13). A tongue
+    // is a smooth, soft dome: it is shaded with its normal averaged over its neighbours.
+    vec3 n_smooth = normalize(gl_FrontFacing ? v_scatter_normal : -v_scatter_normal);
+    n = normalize(mix(n, n_smooth, TONGUE_SMOOTHING));
     // Median groove, papillae as fine mottling, a paler coat toward the middle.
     float groove = 1.0 - 0.35 * exp(-across * across / 0.012) * smoothstep(0.05, 0.3, along) * (1.0 - smoothstep(0.35, 0.6, along));
-    float papillae = 0.85 + 0.3 * value_noise(v_uv * vec2(40.0, 60.0), 0);
+    // (~1-mm cells: where they are finer than a pixel they fade to their mean, or their
+    // aliased noise drew the sheen as streaks and specks.)
+    vec2 papillae_uv = v_uv * vec2(40.0, 60.0);
+    float papillae_detail = clamp(1.5 - max(fwidth(papillae_uv.x), fwidth(papillae_uv.y)), 0.0, 1.0);
+    float papillae = 0.85 + 0.3 * mix(0.5, value_noise(papillae_uv, 0), papillae_detail);
     vec3 albedo = u_albedo * vec3(0.88, 0.72, 0.74) * papillae * groove;
     // The tongue lies in the shadow of the lips and upper teeth: dim at the tip, dark at its
     // sides against the teeth, the light falling off with depth toward the root
@@ -939,7 +958,7 @@ void main() {
     vec3 mouth_shade = tongue_depth_light(along) * mix(1.0, 0.5, smoothstep(0.4, 1.0, abs(across)))
                      * mix(0.1, 1.0, occ);
     // Moist: a soft sheen broken by the papillae, and a tighter glint on the film of saliva.
-    vec3 spec = specular_light(n, v, 40.0) * 0.12 * papillae + specular_light(n, v, 90.0) * 0.3 * smoothstep(0.8, 1.1, papillae);
+    vec3 spec = specular_light(n, v, 40.0) * 0.12 * papillae + specular_light(n, v, 90.0) * 0.22 * smoothstep(0.8, 1.1, papillae);
     // The film mirrors the key through the opening wherever the tongue's front faces it: the
     // sheen is dimmed by how far back it lies and by the light the lips let in, not by the
     // shade that scattered light falls into (there it was lost, a matte tongue).

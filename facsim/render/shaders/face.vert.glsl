@@ -20,7 +20,7 @@ out float v_crease;
 #ifdef USE_LASH
 out float v_lash;
 #endif
-#ifdef REGION_SKIN
+#if defined(REGION_SKIN) || defined(REGION_TONGUE)
 in vec3 in_scatter_normal;  // the normal averaged over a few millimetres (subsurface light sees it)
 out vec3 v_scatter_normal;
 #endif
@@ -43,7 +43,7 @@ void main() {
     v_pos = in_pos;
     v_normal = in_normal;
     v_occlusion = in_occlusion;
-#ifdef REGION_SKIN
+#if defined(REGION_SKIN) || defined(REGION_TONGUE)
     v_scatter_normal = in_scatter_normal;
 #endif
 #ifdef USE_WRINKLE
