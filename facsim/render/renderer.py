@@ -171,7 +171,8 @@ class Renderer:
     shadows : bool
         Cast the key light's soft shadows (the nose's on the lip, the brows' and lids' on the
         eyes, the hair's on the forehead, the chin's on the neck) with a shadow map drawn
-        each frame; ``False`` leaves only the baked occlusion (about N % faster).
+        each frame; ``False`` leaves only the baked occlusion (about 7 % less CPU per 512²
+        FXAA frame on llvmpipe).
     cull_backfaces : bool
         Skip skin and eyeball triangles facing away (about 1.5x faster). Needs those
         surfaces closed (cap the neck); the winding is checked on the first frame and
