@@ -46,8 +46,9 @@ vec3 surface_normal() {
 // dims the ambient, fill and rim fully and the key partly; key_shadow (shadow.glsl) is the
 // key's cast shadow. Without cast shadows the occlusion stands in for them in creases and
 // sockets; with them it only says how much of the large softbox a crease still hides (the
-// shadow map sees the key from its middle), or sockets would darken twice.
-#ifdef USE_SHADOW
+// shadow map sees the key from its middle), or sockets would darken twice. Not on the eyeballs:
+// their occlusion carries the lids' shade (USE_LIDS), finer than the map's texels resolve.
+#if defined(USE_SHADOW) && !defined(REGION_EYEBALL)
 const float KEY_OCCLUSION = 0.25;
 #else
 const float KEY_OCCLUSION = 0.6;
