@@ -462,7 +462,7 @@ class Face:
         from facsim.render.renderer import Renderer
 
         options = _options(options, option_values)
-        key = (options.size, options.antialias, options.background, options.body)
+        key = (options.size, options.antialias, options.background, options.body, options.shadows)
         if key not in self._renderers:
             self._renderers[key] = Renderer(self.render_topology(options.body), size=options.size,
                                             background=options.background, **options.renderer_settings())

@@ -2,13 +2,14 @@
 
 One context per process (EGL, created lazily on first use, reused by every
 :class:`~facsim.render.Renderer` and by :func:`~facsim.render_occlusion.bake_occlusion`,
-and recreated in a forked child). Shaders are read from ``facsim/shaders`` with
-``#include "common.glsl"`` expanded and a variant's ``#define`` lines put in front.
+and recreated in a forked child). Shaders are read from ``facsim/render/shaders`` with
+their ``#include "name.glsl"`` lines expanded and a variant's ``#define`` lines put in front.
 ``moderngl`` is imported only when a context is first needed.
 """
 from __future__ import annotations
 
 import os
+import re
 import threading
 from pathlib import Path
 
@@ -56,9 +57,8 @@ _SHADER_DIR = Path(__file__).with_name("shaders")
 
 def _shader_source(name: str, defines: dict[str, object]) -> str:
     text = (_SHADER_DIR / name).read_text()
-    include = '#include "common.glsl"'
-    if include in text:
-        text = text.replace(include, (_SHADER_DIR / "common.glsl").read_text())
+    for included in re.findall(r'^#include "([\w.]+)"$', text, flags=re.M):
+        text = text.replace(f'#include "{included}"', (_SHADER_DIR / included).read_text())
     head = ["#version 330 core"] + [f"#define {k} {v}".rstrip() for k, v in defines.items()]
     return "\n".join(head) + "\n#line 1\n" + text
 

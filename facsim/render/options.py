@@ -5,7 +5,7 @@ Examples
 >>> RenderOptions(size=256, view="three-quarter-left").size
 (256, 256)
 >>> RenderOptions(antialias="fxaa").renderer_settings()
-{'antialias': 1, 'aa_method': 'fxaa'}
+{'antialias': 1, 'aa_method': 'fxaa', 'shadows': True}
 >>> RenderOptions(yaw=float("inf"))
 Traceback (most recent call last):
 ...
@@ -122,6 +122,9 @@ class RenderOptions:
     body : str
         What is under the head: a garment of ``facsim/data/body.yaml`` over hm08's neck and
         shoulders (``"crewneck"``), or ``"none"`` for the head alone (see :mod:`facsim.head.body`).
+    shadows : bool
+        The key light's soft cast shadows (nose, brows, hair, chin); False leaves only the
+        baked ambient occlusion (see :class:`~facsim.render.renderer.Renderer`).
     """
 
     view: str = "front"
@@ -132,6 +135,7 @@ class RenderOptions:
     background: tuple[float, float, float] | None = (1.0, 1.0, 1.0)
     antialias: int | str = 4
     body: str = DEFAULT_BODY
+    shadows: bool = True
 
     def __post_init__(self):
         if self.view not in VIEWS:
@@ -148,13 +152,15 @@ class RenderOptions:
         from facsim.head.body import check_body_style
 
         check_body_style(self.body)
+        if not isinstance(self.shadows, bool):
+            raise ValueError(f"shadows must be True or False, got {self.shadows!r}")
         samples, method = parse_antialias(self.antialias)
         set_(self, "antialias", "fxaa" if method == "fxaa" else f"ssaa{samples}" if method == "ssaa" else samples)
 
     def renderer_settings(self) -> dict:
-        """The :class:`~facsim.render.renderer.Renderer` keyword arguments for the anti-aliasing."""
+        """The :class:`~facsim.render.renderer.Renderer` keyword arguments for the anti-aliasing and shadows."""
         samples, method = parse_antialias(self.antialias)
-        return {"antialias": samples, "aa_method": method}
+        return {"antialias": samples, "aa_method": method, "shadows": self.shadows}
 
     def replace(self, **changes) -> "RenderOptions":
         """A copy with ``changes`` (validated again)."""

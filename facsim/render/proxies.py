@@ -583,6 +583,13 @@ class ProxyLayer:
             for name, value in lights.items():
                 _set_uniform(prog, name, value)
 
+    def caster_vertex_array(self, program):
+        """A vertex array of this layer's cards for ``program`` (inputs ``in_pos``, ``in_uv``,
+        ``in_rest``), e.g. a shadow map's depth pass; the caller releases it."""
+        return self.ctx.vertex_array(
+            program, [(self._vbo, "3f 32x", "in_pos"), (self._uv, "2f 4x 3f 12x", "in_uv", "in_rest")],
+            index_buffer=self._ibo["OPAQUE"], index_element_size=4, skip_errors=True)
+
     def draw(self, stage: str, triangles: np.ndarray | None = None) -> None:
         """Draw one pass (``"OPAQUE"`` or ``"BLEND"``); ``triangles``, a (T,) bool mask,
         limits the alpha-tested pass to some triangles (still front to back)."""

@@ -7,6 +7,7 @@
 // All colour uniforms are linear RGB (render.py linearises the appearance's sRGB colours).
 
 #include "common.glsl"
+#include "shadow.glsl"
 
 in vec3 v_pos;
 in vec3 v_normal;
@@ -42,19 +43,26 @@ vec3 surface_normal() {
 
 // Diffuse + ambient from the whole rig. `wrap` > 0 lets light bleed past the terminator per
 // channel (a cheap subsurface look when red wraps furthest). `occ` (ambient visibility)
-// dims the ambient, fill and rim fully and the key partly: there are no cast shadows, so
-// occlusion stands in for them in creases and sockets.
+// dims the ambient, fill and rim fully and the key partly; key_shadow (shadow.glsl) is the
+// key's cast shadow. Without cast shadows the occlusion stands in for them in creases and
+// sockets; with them it only says how much of the large softbox a crease still hides (the
+// shadow map sees the key from its middle), or sockets would darken twice. Not on the eyeballs:
+// their occlusion carries the lids' shade (USE_LIDS), finer than the map's texels resolve.
+#if defined(USE_SHADOW) && !defined(REGION_EYEBALL)
+const float KEY_OCCLUSION = 0.25;
+#else
 const float KEY_OCCLUSION = 0.6;
+#endif
 vec3 diffuse_light(vec3 n, vec3 wrap, float occ) {
     vec3 k = clamp((dot(n, u_key_dir) + wrap) / (1.0 + wrap), 0.0, 1.0);
     vec3 f = clamp((dot(n, u_fill_dir) + wrap) / (1.0 + wrap), 0.0, 1.0);
     vec3 r = clamp((dot(n, u_rim_dir) + wrap) / (1.0 + wrap), 0.0, 1.0);
-    return k * u_key_col * mix(1.0, occ, KEY_OCCLUSION)
+    return k * u_key_col * key_shadow * mix(1.0, occ, KEY_OCCLUSION)
          + (f * u_fill_col + r * u_rim_col + hemisphere(n)) * occ;
 }
 
 vec3 specular_light(vec3 n, vec3 v, float shininess) {
-    return blinn(n, u_key_dir, v, shininess) * u_key_col
+    return blinn(n, u_key_dir, v, shininess) * u_key_col * key_shadow
          + blinn(n, u_fill_dir, v, shininess) * u_fill_col
          + blinn(n, u_rim_dir, v, shininess) * u_rim_col;
 }
@@ -407,6 +415,9 @@ void main() {
     float occ = clamp(v_occlusion, 0.0, 1.0);
     float alpha = 1.0;
     vec3 radiance;
+#ifdef USE_SHADOW
+    key_shadow = vec3(key_visibility(v_pos, n));
+#endif
 
 #ifdef REGION_SKIN
     vec4 paint = texture(u_paint, v_uv);
@@ -598,7 +609,8 @@ void main() {
     vec3 softness = SCATTER_SOFTNESS * (1.0 - hair);
     // (The key only: it alone draws the small relief's light and shade; the fill, rim and
     // sky are broad and dim, and a second full evaluation cost ~10 % of a video frame.)
-    vec3 key_reach = u_key_col * mix(1.0, contact, KEY_OCCLUSION);
+    skin_shadow_edge((1.0 - hair) * (1.0 - 0.6 * melanin_rich));
+    vec3 key_reach = u_key_col * key_shadow * mix(1.0, contact, KEY_OCCLUSION);
     vec3 key_sharp = clamp((dot(n, u_key_dir) + wrap) / (1.0 + wrap), 0.0, 1.0) * key_reach;
     vec3 key_part = mix(key_sharp, clamp((dot(n_scatter, u_key_dir) + wrap) / (1.0 + wrap), 0.0, 1.0) * key_reach,
                         softness);
@@ -615,12 +627,12 @@ void main() {
 #ifndef USE_PORES
     // The relief shades the key light too (first order in the tilt: cheap), mostly in green
     // and blue; red, scattered further under the skin, sees the smooth surface.
-    lit += u_key_col * vec3(0.35, 1.0, 1.0) * (dot(bumped, u_key_dir) - dot(n, u_key_dir));
+    lit += u_key_col * key_shadow * vec3(0.35, 1.0, 1.0) * (dot(bumped, u_key_dir) - dot(n, u_key_dir));
 #endif
     // Subsurface scattering reddens the terminator: where the key grazes the surface, light
     // that entered on the lit side comes out beyond it, its green and blue absorbed on the way.
     float key_cos = dot(n_scatter, u_key_dir);
-    lit += u_key_col * vec3(0.075, 0.018, 0.006) * exp(-key_cos * key_cos * 16.0) * contact * scatter;
+    lit += u_key_col * key_shadow * vec3(0.075, 0.018, 0.006) * exp(-key_cos * key_cos * 16.0) * contact * scatter;
     // Light that scatters out of the skin's shadowed side is redder than the light going in.
     lit *= mix(vec3(1.0), vec3(1.06, 0.97, 0.95), (1.0 - contact) * (1.0 - hair));
     vec3 diffuse = lit * albedo;
@@ -646,7 +658,7 @@ void main() {
     // Lobe weights (broad, tight); the fill is too weak to show: key and rim only.
     vec2 weight = vec2(0.6 - 0.3 * wet, 0.22 * film + 0.2 * wet);
     vec2 roughness = vec2(SKIN_ROUGHNESS.x, mix(SKIN_ROUGHNESS.y, LIP_ROUGHNESS, min(2.0 * wet, 1.0)));
-    vec3 spec = dot(skin_specular(bumped, u_key_dir, v, ndv, roughness), weight) * u_key_col
+    vec3 spec = dot(skin_specular(bumped, u_key_dir, v, ndv, roughness), weight) * u_key_col * key_shadow
               + dot(skin_specular(bumped, u_rim_dir, v, ndv, roughness), weight) * u_rim_col;
     // (Times pi: the diffuse term here is albedo times N.L, without the Lambert 1/pi.)
     spec *= PI * (1.0 - hair) * (0.85 + 0.3 * grain) * spec_break;
@@ -654,13 +666,13 @@ void main() {
     // inner edge turns toward them. (A branch: llvmpipe skips it for the blocks of pixels
     // away from the lips, nearly all of them.)
     if (mucosa > 0.0) {
-        spec += mucosa * MUCOSA_SHINE * (blinn(n, u_key_dir, v, 50.0) * u_key_col + blinn(n, u_rim_dir, v, 50.0) * u_rim_col);
+        spec += mucosa * MUCOSA_SHINE * (blinn(n, u_key_dir, v, 50.0) * u_key_col * key_shadow + blinn(n, u_rim_dir, v, 50.0) * u_rim_col);
     }
     // Peach fuzz: the fine vellus hair on the cheeks and forehead scatters a faint, soft sheen
     // where the skin turns away from the eye (toward the face's outline), never a highlight.
     float graze = 1.0 - ndv;
     graze *= graze;
-    vec3 fuzz_light = u_key_col * max(dot(n_smooth, u_key_dir), 0.0) + u_rim_col * max(dot(n_smooth, u_rim_dir), 0.0)
+    vec3 fuzz_light = u_key_col * key_shadow * max(dot(n_smooth, u_key_dir), 0.0) + u_rim_col * max(dot(n_smooth, u_rim_dir), 0.0)
                     + hemisphere(n_smooth);
     spec += PEACH_FUZZ * graze * graze * fuzz_light * mix(vec3(1.0), albedo, 0.5) * (1.0 - lips) * (1.0 - hair);
 #ifdef USE_WRINKLE
