@@ -5,7 +5,7 @@
 Sheets (front view, white background, 4x MSAA):
 
 - ``gallery-presets.jpg``: the 18 character presets at neutral with their hair;
-- ``gallery-emotions.jpg``: the 10 HapFACS emotions (neutral included) on 4 presets;
+- ``gallery-emotions.jpg``: the 10 emotions of the default preset table (neutral included) on 4 presets;
 - ``gallery-aus.jpg``: every single AU the engine renders, at intensity E, on 2 presets.
 
 Deterministic: the same code and data give the same images.

@@ -3,11 +3,11 @@ import pytest
 
 from facsim.facs.activations import activations
 from facsim.facs.notation import Expression, parse
-from facsim.facs.emotions import blend, describe_emotions, emotion, emotion_names, preset_tables
+from facsim.facs.emotions import DEFAULT_TABLE, _same_as, blend, describe_emotions, emotion, emotion_names, preset_tables
 
 EMOTIONS = ["happiness", "sadness", "surprise", "anger", "fear", "disgust", "contempt", "embarrassment",
             "pride", "neutral"]
-TABLES = ["hapfacs", "emfacs"]
+TABLES = ["facsim", "hapfacs", "emfacs"]
 
 
 def test_names_and_tables():
@@ -46,6 +46,32 @@ def test_known_presets(table, name, canonical):
     assert str(emotion(name, table=table)) == canonical
 
 
+def test_default_table_is_table_5_with_emfacs_anger():
+    """Session 18: HapFACS Table 5's anger (5+7+9+10+15+17+42) carries disgust's 9, 10 and 15
+    and was read as disgust; the default set takes EMFACS's anger and Table 5 for the rest."""
+    tables = preset_tables()
+    assert DEFAULT_TABLE == "facsim" and next(iter(tables)) == DEFAULT_TABLE
+    for name in EMOTIONS:
+        source = "emfacs" if name == "anger" else "hapfacs"
+        assert tables["facsim"].presets[name] == tables[source].presets[name]
+        assert emotion(name) == emotion(name, table=source)
+    assert tables["facsim"].notes["sadness"] == tables["hapfacs"].notes["sadness"]
+    assert "--table hapfacs" in tables["facsim"].notes["anger"]
+    assert not {9, 10, 15} & emotion("anger").codes
+    text = describe_emotions()
+    assert "anger          4+5+7+23" in text and "Table 5" in text
+
+
+def test_same_as_must_name_a_table_that_prints_the_preset():
+    tables = {"a": {"presets": {"anger": {"facs": "4+5+7+23"}}},
+              "b": {"presets": {"anger": {"same_as": "a"}}}}
+    assert _same_as(tables, "anger", {"same_as": "a", "note": "mine"}, "here") == {"facs": "4+5+7+23", "note": "mine"}
+    with pytest.raises(ValueError, match="here: `same_as` must name a table"):
+        _same_as(tables, "anger", {"same_as": "b"}, "here")
+    with pytest.raises(ValueError, match="got 'c'"):
+        _same_as(tables, "anger", {"same_as": "c"}, "here")
+
+
 def test_head_codes_in_social_emotions():
     assert {54, 64} <= emotion("embarrassment", table="emfacs").codes
     assert {53, 58} <= emotion("pride", table="emfacs").codes
@@ -73,7 +99,7 @@ def test_full_intensity_keeps_letters():
 
 @pytest.mark.parametrize("call, match", [
     (lambda: emotion("joy"), r"unknown emotion 'joy'; choose one of happiness, sadness"),
-    (lambda: emotion("happiness", table="ekman"), r"unknown emotion table 'ekman'; choose one of 'hapfacs'"),
+    (lambda: emotion("happiness", table="ekman"), r"unknown emotion table 'ekman'; choose one of 'facsim', 'hapfacs'"),
     (lambda: emotion("happiness", intensity=2), "intensity must be between 0 and 1"),
     (lambda: emotion("happiness", intensity="lots"), "intensity must be a number"),
     (lambda: blend("happiness", "sadness", weight=1.5), "weight must be between 0 and 1"),

@@ -67,6 +67,22 @@ def test_5_widens_and_43_closes_from_the_relaxed_rest(face_of, engine):
     assert np.abs(gap).max() < 2.0, gap                # closed: the margins meet over the eye (degrees of arc)
 
 
+@pytest.mark.parametrize("name", ["ava", "mei", "kwame", "george"])
+def test_5E_bares_the_sclera_above_the_iris_on_every_preset(face_of, name):
+    """FACS 5 at E shows white above the iris. Session 18: AU 5's targets lift every lid about
+    5 mm from where it rests, so kwame's and george's (which cover 5 mm of the iris at rest) bared
+    none (their margin 0.3 and -0.5 mm over the iris's top) and mei's, over a smaller eye, rose 3.9
+    iris-mm over it; lids.yaml's `raise` fits the factor per character (3.5 iris-mm: ava 3.5,
+    mei 3.5; the skin guard, which will not let the lid's skin fold under the hood, holds kwame's
+    at 2.3 and george's at 1.4)."""
+    face = face_of(name)
+    centre, radius = face.head.eye_pivot(face.base_positions, "left")
+    iris_mm = 100.0 * float(rest_table()["iris_radius"]) * radius / (0.5 * float(rest_table()["iris_mm"]))
+    over_iris = -_cover_mm(face, face.deform("5E").positions) / iris_mm
+    assert 1.2 < over_iris < 3.7
+    assert -_cover_mm(face, face.neutral) < 0.0                 # at rest the lid covers the iris's top
+
+
 def test_the_lids_shade_on_the_eyeball_follows_the_upper_lid(face_of):
     """Sclera just above the iris lies under the upper lid or in its shadow at rest (the shader
     shades the eyeball by its distance below the margin, Face.frame_lids), bared by 5, covered

@@ -21,7 +21,7 @@ EXPRESSIONS = {
     "7": parse("7"),
     "5+7": parse("5+7"),
     "anger_emfacs": emotion("anger", table="emfacs"),   # 4+5+7+23
-    "anger": emotion("anger"),                          # HapFACS 5+7+9+10+15+17+42
+    "anger": emotion("anger", table="hapfacs"),         # HapFACS 5+7+9+10+15+17+42
 }
 
 

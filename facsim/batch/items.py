@@ -172,7 +172,7 @@ def _expression_codes(facs, emotion, table) -> set[int]:
     if emotion is not None:
         from facsim.facs.emotions import emotion as preset
 
-        return set(preset(emotion, table=table or "hapfacs").codes)
+        return set(preset(emotion, **({"table": table} if table else {})).codes)
     from facsim.facs.notation import parse
 
     return set(parse(facs).codes)

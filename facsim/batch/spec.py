@@ -277,11 +277,11 @@ def _facs_stimuli(block: Mapping, field: str, where: tuple) -> list[Stimulus]:
 
 
 def _emotion_stimuli(block: Mapping, where: tuple) -> list[Stimulus]:
-    from facsim.facs.emotions import emotion, emotion_names, preset_tables
+    from facsim.facs.emotions import DEFAULT_TABLE, emotion, emotion_names, preset_tables
     from facsim.facs.notation import format_expression
 
     names = list(emotion_names()) if block["emotions"] == "all" else block["emotions"]
-    tables = block.get("tables", ["hapfacs"])
+    tables = block.get("tables", [DEFAULT_TABLE])
     for k, table in enumerate(tables):
         if table not in preset_tables():
             raise SpecError(f"unknown emotion table {table!r}; choose one of {', '.join(preset_tables())}",

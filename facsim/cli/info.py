@@ -11,7 +11,7 @@ def add_commands(sub) -> None:
     p.set_defaults(handler=cmd_aus)
 
     p = sub.add_parser("emotions", help="list the emotion presets")
-    p.add_argument("--table", default="hapfacs", help="hapfacs or emfacs")
+    p.add_argument("--table", default="facsim", help="emotion preset table: facsim (the default: HapFACS Table 5, anger from EMFACS), hapfacs or emfacs")
     p.set_defaults(handler=cmd_emotions)
 
     p = sub.add_parser("data", help="download / rebuild / locate the face data cache")

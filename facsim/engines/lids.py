@@ -218,6 +218,31 @@ def rest_lid_weight(lids: EyeLids, rest: np.ndarray, closing: np.ndarray, radius
     return float(np.clip((height - target) / drop, 0.0, float(spec["max_weight"])))
 
 
+def raise_gain(lids: EyeLids, rest: np.ndarray, raising: np.ndarray, radius: float,
+               spec: dict | None = None) -> float:
+    """The factor on AU 5's targets that lifts this eye's upper margin ``bare_mm`` above the iris.
+
+    The margin over the pupil (as in :func:`rest_lid_weight`) on the sculpted skin ``rest``
+    (N, 3) rises by ``raising`` (N, 3), AU 5's targets at E, times the factor; heights change
+    linearly with it, so it is solved directly and clipped to ``gain`` (``lids.yaml``,
+    ``raise``). 1 where the eye has no upper margin to measure.
+    """
+    table = load_yaml("lids.yaml")
+    rest_spec, spec = table["rest"], spec or table["raise"]
+    if not lids.ok:
+        return 1.0
+    ahead = np.abs(lids.upper_lam) < float(rest_spec["ahead_degrees"])
+    upper = lids.upper[ahead] if ahead.sum() >= 2 else lids.upper
+    height = float(np.mean(rest[upper, 1])) - float(lids.centre[1])
+    lift = float(np.mean(raising[upper, 1]))
+    iris_top = float(rest_spec["iris_radius"]) * radius
+    mm = iris_top / (0.5 * float(rest_spec["iris_mm"]))
+    low, high = (float(g) for g in spec["gain"])
+    if lift <= 1e-9:
+        return 1.0
+    return float(np.clip((iris_top + float(spec["bare_mm"]) * mm - height) / lift, low, high))
+
+
 @dataclass(frozen=True)
 class RestLids:
     """The relaxed upper lids of one character: a share of each eye's closing target.

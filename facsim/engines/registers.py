@@ -272,16 +272,35 @@ class RegisterEngine:
         return RestLids.measure(self.sculpted[:skin], lambda side: self.column(Column(pattern, side))[:skin], eye, margin)
 
     @cached_property
+    def lid_raise(self) -> tuple[frozenset, float]:
+        """AU 5's lid-raising column patterns and this character's factor on them
+        (:func:`~facsim.engines.lids.raise_gain`, ``lids.yaml`` ``raise``; the mean of both eyes)."""
+        from facsim.engines.lids import raise_gain
+
+        spec = load_yaml("lids.yaml")["raise"]
+        registers = register_table()["action_units"][int(spec["au"])]["registers"]
+        skin = self.head.skin_vertex_count
+        gains = []
+        for side in ("left", "right"):
+            raising = sum(float(reg["max"]) * self.column(Column(reg["target"], side))[:skin] for reg in registers)
+            lids = self.lids["faceunits/eyeBlink{Side}", side]
+            gains.append(raise_gain(lids, self.sculpted[:skin], raising, self.head.eye_pivot(self.base_positions, side)[1]))
+        return frozenset(reg["target"] for reg in registers), float(np.mean(gains))
+
+    @cached_property
     def neutral(self) -> np.ndarray:
         """The face at rest (N_geo, 3): the sculpted face with relaxed lids."""
         return self.deform(Activations()).positions
 
     def weights(self, act: Activations) -> dict[Column, float]:
         """Column weights of ``act`` (Eq. 1), each side's by the character's gain there (its natural
-        asymmetry), plus the relaxed lids' share of the closing target."""
+        asymmetry) and AU 5's lid-raising targets by :attr:`lid_raise`, plus the relaxed lids'
+        share of the closing target."""
         from facsim.engines.lids import rest_table
 
+        raising, raise_gain = self.lid_raise
         weights = {col: w * (1.0 if col.pattern in BONE_TARGETS else self.side_gain[col.side])
+                   * (raise_gain if col.pattern in raising else 1.0)
                    for col, w in register_weights(act).items()}
         for side in ("left", "right"):
             share = self.rest_lids.share(act, side)

@@ -1,9 +1,11 @@
 """Emotion presets: named emotions as FACS expressions, and blends of two.
 
 The presets live in ``facsim/data/emotions.yaml``, one table per source:
-``"hapfacs"`` (HapFACS 3.0, Table 5, the default) and ``"emfacs"`` (the
-classic EMFACS prototypes, with embarrassment after Keltner 1995 and pride
-after Tracy & Robins 2004). Each preset is a FACS string read by
+``"hapfacs"`` (HapFACS 3.0, Table 5) and ``"emfacs"`` (the classic EMFACS
+prototypes, with embarrassment after Keltner 1995 and pride after Tracy &
+Robins 2004), and the default ``"facsim"``: Table 5 for every emotion but
+anger, which is EMFACS's 4+5+7+23 (Table 5's anger carries disgust's 9 and
+10 and was read as disgust). Each preset is a FACS string read by
 :func:`facsim.notation.parse`.
 
 Examples
@@ -12,6 +14,8 @@ Examples
 '1+2+5B+26'
 >>> str(emotion("happiness", intensity="50%"))
 '6@0.5+12@0.5+25@0.5'
+>>> str(emotion("anger")), str(emotion("anger", table="hapfacs"))
+('4+5+7+23', '5+7+9+10+15+17+42')
 >>> str(blend("happiness", "surprise", table="emfacs"))
 '1@0.5+2@0.5+5@0.15+6@0.5+12@0.5+26@0.5'
 """
@@ -32,6 +36,8 @@ from facsim.facs.notation import ActionUnit, Expression, NotationError, parse, p
 #: libyaml's loader when present: ten times faster than the pure-Python one.
 _YAML_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 DATA_FILE = "emotions.yaml"
+#: The table used when none is named (``default`` in emotions.yaml, checked when it is read).
+DEFAULT_TABLE = "facsim"
 
 
 @dataclass(frozen=True)
@@ -45,11 +51,23 @@ class PresetTable:
     notes: Mapping[str, str]
 
 
+def _same_as(tables: dict, emotion_name: str, entry: dict, where: str) -> dict:
+    """The entry for ``emotion_name`` in the table that ``entry`` names (``same_as``), with
+    ``entry``'s own note if it gives one."""
+    source = tables.get(entry["same_as"])
+    if source is None or "same_as" in source["presets"].get(emotion_name, {"same_as": None}):
+        raise ValueError(f"{where}: `same_as` must name a table that prints this preset, got {entry['same_as']!r}")
+    return {**source["presets"][emotion_name], **{k: v for k, v in entry.items() if k == "note"}}
+
+
 @lru_cache(maxsize=1)
 def _load() -> tuple[tuple[str, ...], Mapping[str, PresetTable]]:
     text = (resources.files("facsim") / "data" / DATA_FILE).read_text(encoding="utf-8")
     data = yaml.load(text, Loader=_YAML_LOADER)
     names = tuple(data["emotions"])
+    if data.get("default") != DEFAULT_TABLE or DEFAULT_TABLE not in data["tables"]:
+        raise ValueError(f"{DATA_FILE}: `default` must name the table {DEFAULT_TABLE!r} "
+                         f"(facsim.facs.emotions.DEFAULT_TABLE), got {data.get('default')!r}")
     tables = {}
     for table_name, table in data["tables"].items():
         presets, notes = {}, {}
@@ -57,6 +75,8 @@ def _load() -> tuple[tuple[str, ...], Mapping[str, PresetTable]]:
             where = f"{DATA_FILE}, table {table_name!r}, emotion {emotion_name!r}"
             if emotion_name not in names:
                 raise ValueError(f"{where}: not one of the emotions {names}")
+            if "same_as" in entry:
+                entry = _same_as(data["tables"], emotion_name, entry, where)
             try:
                 parse(entry["facs"])
             except NotationError as exc:   # a broken data file must say where
@@ -86,12 +106,12 @@ def emotion_names() -> tuple[str, ...]:
 
 
 def preset_tables() -> Mapping[str, PresetTable]:
-    """The preset tables by name (read-only); ``"hapfacs"`` is the default.
+    """The preset tables by name (read-only); :data:`DEFAULT_TABLE` (``"facsim"``) is the default.
 
     Examples
     --------
     >>> list(preset_tables())
-    ['hapfacs', 'emfacs']
+    ['facsim', 'hapfacs', 'emfacs']
     >>> preset_tables()["emfacs"].presets["contempt"]
     'R12A+R14A'
     """
@@ -105,7 +125,7 @@ def _table(table: str) -> PresetTable:
     return tables[table]
 
 
-def emotion(name: str, *, table: str = "hapfacs", intensity: float | str = 1.0,
+def emotion(name: str, *, table: str = DEFAULT_TABLE, intensity: float | str = 1.0,
             intensities: str = "hapfacs") -> Expression:
     """The expression of one emotion.
 
@@ -114,7 +134,7 @@ def emotion(name: str, *, table: str = "hapfacs", intensity: float | str = 1.0,
     name : str
         One of :func:`emotion_names` (case-insensitive).
     table : str
-        Preset table, see :func:`preset_tables`.
+        Preset table, see :func:`preset_tables` (default :data:`DEFAULT_TABLE`).
     intensity : float or str
         Global intensity, ``0.5`` or ``"50%"``; multiplies every unit.
     intensities : str
@@ -175,7 +195,7 @@ def _blend_code(code: int, a: Expression, b: Expression, weight: float) -> list[
 
 
 def blend(first: str | Expression, second: str | Expression, weight: float | str = 0.5, *,
-          table: str = "hapfacs", intensities: str = "hapfacs") -> Expression:
+          table: str = DEFAULT_TABLE, intensities: str = "hapfacs") -> Expression:
     """Mix two emotions: the union of their units, intensities interpolated.
 
     Each unit gets ``(1 - weight) * a + weight * b``, where ``a`` and ``b`` are
@@ -211,7 +231,7 @@ def blend(first: str | Expression, second: str | Expression, weight: float | str
     return Expression(tuple(u for u in units if u is not None))
 
 
-def describe_emotions(table: str = "hapfacs") -> str:
+def describe_emotions(table: str = DEFAULT_TABLE) -> str:
     """One preset table as plain text (for the CLI): title, source, presets, notes.
 
     Examples

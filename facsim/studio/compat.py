@@ -38,6 +38,7 @@ _WHERE = {
     "blend": "facsim.facs.emotions",
     "emotion_names": "facsim.facs.emotions",
     "preset_tables": "facsim.facs.emotions",
+    "DEFAULT_TABLE": "facsim.facs.emotions",
     "Character": "facsim.head.character",
     "CharacterError": "facsim.head.character",
     "preset_names": "facsim.head.character",

@@ -215,7 +215,7 @@ def create_app(*, workdir, token: str | None = None, allowed_hosts: set[str] | N
     async def emotion(request: Request):
         body = await json_object(request, "send {\"name\": \"surprise\"}")
         table = checks.intensities_table(body.get("intensities"))
-        preset_table = body.get("table", "hapfacs")
+        preset_table = body.get("table", compat.DEFAULT_TABLE)
         try:
             expr = compat.emotion(str(body.get("name", "")), table=preset_table, intensity=body.get("intensity", 1.0),
                                   intensities=table)

@@ -34,7 +34,7 @@ Times are seconds from the start of the video; intensities are fractions
         intensity: 1.0       # peak level (default 1)
         easing: sigmoid      # for the rise and the fall (default linear)
       - emotion: happiness   # a preset of facsim.emotions
-        table: hapfacs       # preset table (default hapfacs)
+        table: hapfacs       # preset table (default facsim: HapFACS Table 5, anger from EMFACS)
         start: 0.5           # constant hold from start (default 0) to end
         end: 1.5
         intensity: 50%
@@ -415,7 +415,7 @@ class Track:
     emotion : str, optional
         A preset name of :mod:`facsim.facs.emotions`; scaled like ``facs``.
     table : str, optional
-        For ``emotion`` only: the preset table (``None`` means ``"hapfacs"``).
+        For ``emotion`` only: the preset table (``None`` means the default, ``"facsim"``).
 
     Examples
     --------
@@ -493,7 +493,7 @@ class Track:
                 raise TimelineError(f"expected an emotion name, got {self.emotion!r}", location=("emotion",))
             object.__setattr__(self, "emotion", self.emotion.strip().lower())
             try:
-                expr = emotion(self.emotion, table=self.table or "hapfacs")
+                expr = emotion(self.emotion, **({"table": self.table} if self.table else {}))
             except ValueError as exc:
                 where = "table" if str(exc).startswith("unknown emotion table") else "emotion"
                 raise TimelineError(str(exc), location=(where,)) from None
@@ -758,7 +758,7 @@ def track_activations(track: Track, intensities: str) -> Activations:
     else:
         from facsim.facs.emotions import emotion
 
-        expr = emotion(track.emotion, table=track.table or "hapfacs", intensities=intensities)
+        expr = emotion(track.emotion, **({"table": track.table} if track.table else {}), intensities=intensities)
     return activations(expr)
 
 
