@@ -364,8 +364,8 @@ const float LIP_SHADOW_FLOOR = 0.3;
 // (DEEP_TEETH_BOUNCE), as the tongue's back does (TONGUE_LIGHT_FLOOR). Without it the lower
 // row's back teeth and the inside of its arch, which a stretched open mouth (20+26) shows in
 // its corners, were pure black wedges with straight edges (issue 13: "molar wedges").
-const float DEEP_TEETH_LIGHT = 0.045;
-const vec3 DEEP_TEETH_BOUNCE = vec3(1.0, 0.5, 0.45);
+const float DEEP_TEETH_LIGHT = 0.04;
+const vec3 DEEP_TEETH_BOUNCE = vec3(1.0, 0.42, 0.38);
 // Where two crowns touch they leave a soft shadow (an embrasure) ``to_gap`` (dm) from the
 // contact, darkest at the biting edge where they part and a thin shade up the crowns to the
 // gum (``h``, band units up the outer wall) - never a dark line, which read as braces; faded
