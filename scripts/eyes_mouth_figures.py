@@ -39,6 +39,11 @@ the height (mm) of the upper and the lower lip's red at the mouth's midline as s
 recoloured lips' pixels in the 5 columns there, scaled at the lips' depth) and the opening
 between them: stretched lips keep their volume, so their red flattens but stays full.
 
+The sclera (``--sclera``), at rest, surprise (1+2+5+26) and fear (1+2+4+5+20+26) at 448², front,
+without anti-aliasing: the sclera's median and 95th-percentile luminance against the cheek's
+(a grey white well below the skin's read as a glass eye), the iris's median luminance and the
+pupil's width over the iris's per eye.
+
 The smile's teeth along the row (``--teeth``), 6+12+25 at 448², front: per column of the
 upper teeth's top run of pixels, its mean luminance; the 10th and 90th percentile of those in
 the middle half of the row (crowns, their shaded flanks and the embrasures: a flat strip has
@@ -52,6 +57,7 @@ Usage::
     python3 scripts/eyes_mouth_figures.py --aperture [--engine muscle] [CHARACTER ...]
     python3 scripts/eyes_mouth_figures.py --lips [--engine muscle] [CHARACTER ...]
     python3 scripts/eyes_mouth_figures.py --teeth [--engine muscle] [CHARACTER ...]
+    python3 scripts/eyes_mouth_figures.py --sclera [--engine muscle] [CHARACTER ...]
 """
 from __future__ import annotations
 
@@ -313,6 +319,34 @@ def aperture_figures(character, expression, size=512, engine="registers") -> dic
             "sclera_luminance": round(float(luminance[sclera].mean()), 1)}
 
 
+def sclera_figures(character, expression, size=448, engine="registers") -> dict:
+    """The sclera's median and 95th-percentile luminance (0-255) against the cheek's (the skin
+    in a 16 x 40 px patch 45 px under the eyes, left of the face's middle), the iris's median
+    luminance and the pupil's width over the iris's (per eye), at ``size`` px, front, without
+    anti-aliasing."""
+    image, sclera_marked, iris_marked, pupil_marked, skin_marked = _renders(
+        character, expression, [{"sclera": "#00ff00"}, {"iris": "#ffffff", "pupil": "#ffffff"},
+                                {"pupil": "#ffffff"}, {"skin": "#00ff00"}], size=size, antialias=1, engine=engine)
+    iris = _changed(iris_marked, image)
+    sclera = _changed(sclera_marked, image) & ~iris
+    pupil = _changed(pupil_marked, image)
+    skin = _changed(skin_marked, image)
+    luminance = image @ LUMINANCE
+    below = int(np.nonzero(sclera)[0].mean()) + 45 * size // 448
+    cheek = np.zeros_like(skin)
+    cheek[below - 8: below + 8, 130 * size // 448: 170 * size // 448] = True
+    cheek &= skin
+    half = size // 2
+    ratios = []
+    for side in (slice(0, half), slice(half, size)):
+        widths = [np.ptp(np.flatnonzero(mask[:, side].any(axis=0))) + 1 for mask in (pupil, iris)]
+        ratios.append(round(float(widths[0] / widths[1]), 2))
+    return {"sclera_p50_p95": [round(float(np.percentile(luminance[sclera], q)), 1) for q in (50, 95)],
+            "cheek": round(float(np.median(luminance[cheek])), 1),
+            "iris_p50": round(float(np.median(luminance[iris & ~pupil])), 1),
+            "pupil_over_iris_width": ratios}
+
+
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("characters", nargs="*", default=["amara", "liam", "mei", "george"])
@@ -324,9 +358,17 @@ def main(argv=None) -> None:
                         help="sclera bared above and below the iris at rest, 5E, surprise and fear only")
     parser.add_argument("--lips", action="store_true", help="the lips' red heights at the midline, per expression")
     parser.add_argument("--teeth", action="store_true", help="the smile's upper teeth along the row at 448 px")
+    parser.add_argument("--sclera", action="store_true",
+                        help="the sclera's and iris's luminance against the cheek's, and the pupil's width, at 448 px")
     args = parser.parse_args(argv)
     for name in args.characters:
         character = preset(name)
+        if args.sclera:
+            for expression in ("", "1+2+5+26", "1+2+4+5+20+26"):
+                figures = sclera_figures(character, expression, engine=args.engine)
+                print(name, args.engine, expression or "neutral", "  ".join(f"{k} {v}" for k, v in figures.items()),
+                      flush=True)
+            continue
         if args.teeth:
             figures = teeth_row_figures(character, engine=args.engine)
             print(name, args.engine, "6+12+25", "  ".join(f"{k} {v}" for k, v in figures.items()), flush=True)

@@ -102,6 +102,24 @@ def test_the_upper_lid_and_lashes_shade_the_sclera_below_them(eye_pixels):
         assert np.mean(rows[:3]) < 0.65 * max(rows), rows
 
 
+def test_a_young_adults_pupil_is_a_studio_portraits(eye_pixels):
+    """Under studio light a young adult's pupil is ~3.7 mm (4.2 seen through the cornea) of an
+    11.7-mm iris: a 4-mm pupil left ava's iris a thin ring round a dark disc, a doll's eye (its
+    width 0.46 of the iris's at 512 px, now 0.37)."""
+    ava = preset("ava").with_(symmetric=True)
+    with Face(ava) as face:
+        normal = face.render("", size=512, antialias=1, background=(1.0, 1.0, 1.0))[..., :3].astype(int)
+    with Face(ava.with_(colors={**ava.colors, "pupil": "#ffffff"})) as face:
+        marked = face.render("", size=512, antialias=1, background=(1.0, 1.0, 1.0))[..., :3].astype(int)
+    with Face(ava.with_(colors={**ava.colors, "pupil": "#ffffff", "iris": "#ffffff"})) as face:
+        cornea = face.render("", size=512, antialias=1, background=(1.0, 1.0, 1.0))[..., :3].astype(int)
+    pupil = np.abs(marked - normal).sum(-1) > 60
+    iris = np.abs(cornea - normal).sum(-1) > 60
+    for side in (slice(0, 256), slice(256, 512)):
+        width = lambda mask: np.ptp(np.flatnonzero(mask[:, side].any(axis=0))) + 1   # noqa: E731
+        assert 0.28 < width(pupil) / width(iris) < 0.42
+
+
 @pytest.mark.parametrize("mirrored", [False, True])
 def test_eye_rotation_recovers_the_eyes_turn(mirrored):
     """The cornea's refraction is computed in the eye's own frame: the renderer recovers each

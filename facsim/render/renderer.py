@@ -458,6 +458,7 @@ class Renderer:
         elif name == "eyeball":
             for key in ("sclera", "iris", "pupil"):
                 _set_uniform(prog, f"u_{key}", lin(key))
+            _set_uniform(prog, "u_age", appearance.age)   # (the pupil narrows with age)
         else:
             _set_uniform(prog, "u_albedo", lin(_SINGLE_COLOR[name]))
 

@@ -208,6 +208,7 @@ vec2 brow_hair(vec2 uv, float density) {
 uniform vec3 u_sclera;
 uniform vec3 u_iris;
 uniform vec3 u_pupil;
+uniform float u_age;         // 0..1: 32 to 77 years (facsim.head.appearance)
 // Both eyeballs' centres and radius this frame (Renderer._set_eye_centres; a lone eye: the
 // same point twice): what belongs to the socket (caruncle, canthi) is placed from them, not
 // from the eye's own frame, which turns with the gaze (61-64).
@@ -220,10 +221,13 @@ uniform mat3 u_eye_rot_a = mat3(1.0);
 uniform mat3 u_eye_rot_b = mat3(1.0);
 // Radii as fractions of the eyeball radius, measured in the plane across the gaze axis
 // (length of eye_coord.xy on the front half). hm08's eyeballs are 1.59 cm in radius:
-// an iris 11.7 mm across (the adult mean) and a 4 mm pupil.
+// an iris 11.7 mm across (the adult mean) and the pupil of a studio portrait: 3.7 mm in a young
+// adult, narrowing with age to 3.0 mm (senile miosis) (a 4-mm pupil, magnified by the cornea,
+// left dark irises a thin rim around it: a doll's black disc, issue 13).
 const float IRIS_RADIUS = 0.368;
-const float PUPIL_RADIUS = 0.13;
-const float LIMBUS_WIDTH = 0.26;   // fraction of the iris annulus darkened at its rim
+const vec2 PUPIL_RADIUS = vec2(0.116, 0.094);   // young (u_age 0), old (u_age 1)
+const float LIMBUS_WIDTH = 0.26;   // fraction of the iris annulus darkened at its rim ...
+const float LIMBAL_RING = 0.4;     // ... to this much of its light at the rim
 const float CORNEA_RADIUS = 0.49;  // radius of the cornea's curvature, 1.33 iris radii
 // The iris lies in the anterior chamber, behind the cornea: the eyeball's sphere puts it
 // only ~1.1 mm under the corneal apex, the apex is ~3.6 mm in front of it; this is the extra depth
@@ -233,8 +237,9 @@ const float ANTERIOR_CHAMBER = 0.15;
 const float CORNEA_INDEX = 1.376;
 const int IRIS_FIBRES = 96;        // radial noise cells around the iris
 const float COLLARETTE = 0.33;     // where the collarette lies across the iris annulus (0 pupil, 1 rim)
-const vec2 CARUNCLE = vec2(0.46, 0.56);
-const float IRIS_CAUSTIC = 0.5;    // how much brighter the iris's lower rim is (the key is above)   // nasal e.x where the caruncle begins and is full
+const vec2 CARUNCLE = vec2(0.46, 0.56);   // nasal e.x where the caruncle begins and is full
+const float SCLERA_MOTTLE = 0.1;    // the sclera's patchiness (relative, about its mean)
+const float IRIS_CAUSTIC = 0.3;    // how much brighter the iris's lower rim is (the key is above; 0.5 glowed as in a glass marble)
 // The key's reflection in the cornea: the softbox's half-size (radians, across and up) and
 // strength; the room's faint reflection over the whole cornea. (Issue 13: at 0.22 x 0.19
 // with the fill's at 0.6, two large bright patches read as glossy doll's eyes.)
@@ -367,8 +372,8 @@ const float LIP_SHADOW_FLOOR = 0.3;
 // (DEEP_TEETH_BOUNCE), as the tongue's back does (TONGUE_LIGHT_FLOOR). Without it the lower
 // row's back teeth and the inside of its arch, which a stretched open mouth (20+26) shows in
 // its corners, were pure black wedges with straight edges (issue 13: "molar wedges").
-const float DEEP_TEETH_LIGHT = 0.045;
-const vec3 DEEP_TEETH_BOUNCE = vec3(1.0, 0.5, 0.45);
+const float DEEP_TEETH_LIGHT = 0.04;
+const vec3 DEEP_TEETH_BOUNCE = vec3(1.0, 0.42, 0.38);
 // Where two crowns touch they leave a soft shadow (an embrasure) ``to_gap`` (dm) from the
 // contact, darkest at the biting edge where they part and a thin shade up the crowns to the
 // gum (``h``, band units up the outer wall) - never a dark line, which read as braces; faded
@@ -703,8 +708,9 @@ void main() {
     float ri = length(seen);
     float aai = max(fwidth(ri), 1e-4);
     float iris_mask = front * (1.0 - smoothstep(IRIS_RADIUS - aa, IRIS_RADIUS + aa, r));
-    float pupil_mask = front * (1.0 - smoothstep(PUPIL_RADIUS - aai, PUPIL_RADIUS + aai, ri));
-    float t = clamp((ri - PUPIL_RADIUS) / (IRIS_RADIUS - PUPIL_RADIUS), 0.0, 1.0);
+    float pupil_radius = mix(PUPIL_RADIUS.x, PUPIL_RADIUS.y, u_age);
+    float pupil_mask = front * (1.0 - smoothstep(pupil_radius - aai, pupil_radius + aai, ri));
+    float t = clamp((ri - pupil_radius) / (IRIS_RADIUS - pupil_radius), 0.0, 1.0);
     float angle = atan(seen.y, seen.x);
     float turns = (angle / (2.0 * PI) + 0.5) * float(IRIS_FIBRES);
     // Stroma: fine radial fibres (long along the radius, narrow around it), coarser bundles,
@@ -746,14 +752,14 @@ void main() {
     iris *= 1.0 - 0.3 * ridge * fibre_detail;                          // the collarette's dark fold
     iris *= 1.0 - 0.3 * crypt;
     iris *= mix(0.45, 1.0, smoothstep(0.0, 0.08, t));                 // pupillary ruff
-    iris *= mix(1.0, 0.2, smoothstep(1.0 - LIMBUS_WIDTH, 1.0, t));    // limbal ring
+    iris *= mix(1.0, LIMBAL_RING, smoothstep(1.0 - LIMBUS_WIDTH, 1.0, t));    // limbal ring
     // The cornea gathers the key's light from above onto the iris's lower part (the limbal
     // caustic): in photographs the iris glows below its pupil and darkens under the upper lid,
     // where a flat, evenly lit disc read as glass.
     iris *= 1.0 + IRIS_CAUSTIC * smoothstep(0.0, 0.9, -seen.y / IRIS_RADIUS) * smoothstep(0.25, 0.75, t);
     // The pupil is not ink: the lens behind it returns a little light (and the cornea in
     // front reflects the room, below).
-    vec3 pupil = max(u_pupil, vec3(0.006, 0.0055, 0.0055)) * mix(1.3, 0.8, smoothstep(0.0, 0.8, ri / PUPIL_RADIUS));
+    vec3 pupil = max(u_pupil, vec3(0.006, 0.0055, 0.0055)) * mix(1.3, 0.8, smoothstep(0.0, 0.8, ri / pupil_radius));
     iris = mix(iris, pupil, pupil_mask);
     // The socket's frame: hx across the eye toward the nose (the other eye), hy up, in
     // eyeball radii from this eye's centre.
@@ -773,9 +779,13 @@ void main() {
     float vessel_w = 0.05 + fwidth(vessel_n);
     float vessels = (1.0 - smoothstep(0.0, vessel_w, abs(vessel_n - 0.75))) * 0.05 / vessel_w
                   * smoothstep(0.45, 0.85, theta) * (0.5 + 0.5 * abs(cos(angle)));
-    vec3 sclera = u_sclera * vec3(0.84, 0.8, 0.74)
-                * mix(vec3(1.0), vec3(0.9, 0.7, 0.63), 0.7 * corner)
+    vec3 sclera = u_sclera * vec3(0.88, 0.85, 0.81)
+                * mix(vec3(1.0), vec3(0.9, 0.7, 0.63), corner)
                 * mix(vec3(1.0), vec3(0.95, 0.55, 0.5), clamp(1.1 * vessels, 0.0, 0.6));
+    // Nor is it porcelain: faint patches a few millimetres across, warmer or cooler where the
+    // conjunctiva is thicker or its vessels closer (one even white read as a glass eye).
+    float mottle = value_noise(e.xy * 6.0 + 31.0, 0) + 0.5 * value_noise(e.xy * 13.0 + 5.0, 0) - 0.75;
+    sclera *= 1.0 + SCLERA_MOTTLE * mottle * vec3(0.85, 1.0, 1.15);
     // Caruncle and plica: a pink, fleshy, wet mound fills the inner corner (e.x toward the
     // nose: -x for the eye on the +x side of the head), a darker fold (the plica) between
     // it and the sclera.
@@ -784,8 +794,8 @@ void main() {
     sclera *= 1.0 - 0.25 * plica;
     sclera = mix(sclera, u_sclera * vec3(0.78, 0.42, 0.40) * (0.85 + 0.3 * value_noise(e.xy * 60.0, 0)), nasal);
     // The limbus blends softly into the sclera as a greyish ring (no cut-out edge).
-    float limbal = front * exp(-pow((r - IRIS_RADIUS) / 0.035, 2.0));
-    sclera *= 1.0 - 0.35 * limbal;
+    float limbal = front * exp(-pow((r - IRIS_RADIUS) / 0.045, 2.0));
+    sclera *= 1.0 - 0.25 * limbal;
     float iris_soft = front * (1.0 - smoothstep(IRIS_RADIUS - aa - 0.015, IRIS_RADIUS + aa, r));
     sclera *= orbit_shade(hy);   // (the white only: the lids hide the iris's top but where 5 bares it)
     vec3 albedo = mix(sclera, iris, max(iris_mask, 0.6 * iris_soft));
@@ -821,7 +831,8 @@ void main() {
     // frame: at rest about hy in [-0.2, 0.2] and hx in [-0.65, 0.65] show between the
     // lids). The socket around it hides much of the sky: the whole eyeball
     // takes less ambient than the skin.
-    float lid_shade = 0.7 * (1.0 - 0.15 * smoothstep(-0.05, 0.3, hy)) * (1.0 - 0.5 * smoothstep(0.32, 0.68, abs(hx)))
+    // (0.7 left the sclera beside the iris a grey ring well below the skin's brightness: glass.)
+    float lid_shade = 0.85 * (1.0 - 0.15 * smoothstep(-0.05, 0.3, hy)) * (1.0 - 0.5 * smoothstep(0.32, 0.68, abs(hx)))
                     * lash_shadow;
     vec3 diffuse = diffuse_light(n, vec3(0.15), occ) * albedo * lid_shade * lid_cast;
     // Wet surface. The cornea bulges over the iris as a sphere of 1.33 iris radii (7.8 mm
@@ -842,12 +853,15 @@ void main() {
     // The sclera and the lid's wet rim are wet too but less smooth (a broad sheen), and the
     // tear meniscus catches a thin bright line of the key.
     spec += specular_light(n, v, 40.0) * 0.03 + tear * u_key_col * TEAR_SHINE;
-    spec *= mix(0.5, 1.0, lash_shadow) * mix(0.4, 1.0, lid_shade / 0.7);
+    spec *= mix(0.5, 1.0, lash_shadow) * mix(0.4, 1.0, lid_shade / 0.85);
     // The lower lid's wet margin faces up and out of the socket: it takes the room's ambient
     // light that the eyeball under the lids does not, and its film mirrors the room as a
     // soft sheen, so it reads as a moist band, not a painted pink line.
     spec += wet_rim * mix(u_ground_col, u_sky_col, 0.5 + 0.5 * refl.y) * WET_RIM_SHEEN;
-    diffuse += wet_rim * WET_RIM_COLOR * hemisphere(n) * 0.5 * (1.0 - lid_shade);
+    // Its margin is a ledge that faces up toward the key: lit as one, not in the eyeball's
+    // shade (there it drew a dark line under the eye, an outline round a doll's eye).
+    vec3 rim_n = normalize(n + vec3(0.0, 1.5, 0.0));
+    diffuse = mix(diffuse, diffuse_light(rim_n, vec3(0.2, 0.1, 0.1), occ) * WET_RIM_COLOR, 0.5 * wet_rim);
     radiance = diffuse + spec * occ;
 #endif
 
