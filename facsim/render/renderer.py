@@ -50,7 +50,7 @@ from facsim.render.camera import Camera, projection_matrix, view_matrix, _size_p
 from facsim.media.images import write_png
 from facsim.render.geometry import (CREASES_PER_DM, _faces_touching, _orientation, crease_phase, eye_rotation, lash_coordinates,
                               normal_operator, region_components, scattered_normals, smoothing_operator,
-                              sphere_centre, sphere_directions, vertex_normals)
+                              sphere_centre, sphere_directions, surface_curvature, vertex_normals)
 from facsim.render.gl import RenderError, _set_uniform, _shader_source, gl_context
 from facsim.render.inputs import (COLOR_NAMES, DEFAULT_BROW_UV_FRAME, DEFAULT_COLORS, HM08_BROW_UV_FRAME, REGIONS,
                             Appearance, Lighting, RenderTopology, brow_uv_frame, srgb_to_linear)
@@ -114,6 +114,10 @@ _VARIANTS = {**_PASSES, **{plain: tuple(d for d in _PASSES[name] if d != "USE_WR
 #: Groups drawn with back faces culled (closed, outward-wound after _fix_winding); the rest
 #: are two-sided (teeth bands, lash cards, the inside of the mouth).
 _CULLED = ("skin", "skin_brows", "eyeball")
+#: Floats per vertex in the dynamic buffer (see Renderer.__init__), and its layout for passes
+#: that read only the position.
+_VERTEX_FLOATS = 13
+_POSITION_ONLY = f"3f {4 * (_VERTEX_FLOATS - 3)}x"
 #: Groups shaded with the key's cast shadow (USE_SHADOW). The mouth's parts are not: what light
 #: the lips let in reaches them per frame from facsim.head.mouth (mouth_light), and the lips'
 #: thin edges are finer than the shadow map's texels.
@@ -238,9 +242,9 @@ class Renderer:
         self._winding_checked = False
         self._draws: list[tuple[str, int, int]] = []
         # Per-frame vertex data: position (3), normal (3), wrinkle, occlusion, crease phase,
-        # the normal as light scattered under the skin sees it (3).
-        self._geo_buffer = np.zeros((self._n_geo, 12), dtype=np.float32)
-        self._render_buffer = np.zeros((topology.n_render, 12), dtype=np.float32)
+        # the normal as light scattered under the skin sees it (3), the surface's curvature.
+        self._geo_buffer = np.zeros((self._n_geo, _VERTEX_FLOATS), dtype=np.float32)
+        self._render_buffer = np.zeros((topology.n_render, _VERTEX_FLOATS), dtype=np.float32)
         self._appearance = None
         self._proxy_layers: dict = {}  # ProxyMesh -> ProxyLayer, created on first use
         self._proxy_draws: tuple = ()
@@ -284,8 +288,8 @@ class Renderer:
             vertex_shader=_shader_source("face.vert.glsl", defines),
             fragment_shader=_shader_source("face.frag.glsl", defines)))
         vao = self._track(ctx.vertex_array(
-            prog, [(self._vbo_dynamic, "3f 3f 1f 1f 1f 3f", "in_pos", "in_normal", "in_wrinkle",
-                    "in_occlusion", "in_crease", "in_scatter_normal"),
+            prog, [(self._vbo_dynamic, "3f 3f 1f 1f 1f 3f 1f", "in_pos", "in_normal", "in_wrinkle",
+                    "in_occlusion", "in_crease", "in_scatter_normal", "in_curvature"),
                    (self._vbo_static, "2f 3f", "in_uv", "in_eye")],
             index_buffer=self._ibo, index_element_size=4, skip_errors=True))
         _set_uniform(prog, "u_paint", 0)
@@ -355,7 +359,7 @@ class Renderer:
         self._tone_tex = None
         self._folds_tex = None
         self._depth_vao = self._depth_prog = None
-        self._key_shadow = KeyShadow(ctx, self._track) if self.shadows else None
+        self._key_shadow = KeyShadow(ctx, self._track, _POSITION_ONLY) if self.shadows else None
         self._vp_bytes = b""
         self._lights: dict = {}
         self._camera_uniforms: dict = {}  # program name -> (view-projection, lights) it holds
@@ -711,7 +715,7 @@ class Renderer:
             prog = self._track(ctx.program(vertex_shader=_DEPTH_VERTEX, fragment_shader=_DEPTH_FRAGMENT))
             self._depth_prog = prog
             self._depth_vao = self._track(ctx.vertex_array(
-                prog, [(self._vbo_dynamic, "3f 36x", "in_pos")], index_buffer=self._ibo, index_element_size=4))
+                prog, [(self._vbo_dynamic, _POSITION_ONLY, "in_pos")], index_buffer=self._ibo, index_element_size=4))
         self._depth_prog["u_view_proj"].write(self._vp_bytes)
         fbo.color_mask = (False, False, False, False)
         if self.cull_backfaces:
@@ -781,6 +785,7 @@ class Renderer:
         geo[:, 0:3] = p
         geo[:, 3:6] = normals
         geo[:, 9:12] = scattered_normals(normals, self._smoothing_op)
+        geo[:, 12] = surface_curvature(p, normals, self._smoothing_op)
         out = self._render_buffer
         np.take(geo, self.topology.render_to_geo, axis=0, out=out)
         if wrinkle is not None and wrinkle.any() and phase is not None:

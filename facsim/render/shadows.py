@@ -146,8 +146,9 @@ def linear_map(points: np.ndarray, matrix: np.ndarray) -> np.ndarray:
 class KeyShadow:
     """The key light's shadow map: GL objects owned by a Renderer (``track`` registers them)."""
 
-    def __init__(self, ctx, track):
+    def __init__(self, ctx, track, position_format: str = "3f"):
         self.ctx = ctx
+        self._position_format = position_format  # the vertex buffer's layout, position first
         self._track = track
         self.texture = None
         self._fbo = None
@@ -180,8 +181,8 @@ class KeyShadow:
     def draw(self, direction, points: np.ndarray, vbo, ibo, draws, hair_layers=(), seen=None) -> None:
         """Draw the casters' depth from ``direction`` (world, toward the light).
 
-        ``points`` bound the casters; ``vbo``/``ibo`` are the renderer's vertex buffer (12
-        floats per vertex, the position first) and index buffer, ``draws`` the (first
+        ``points`` bound the casters; ``vbo``/``ibo`` are the renderer's vertex buffer (laid out
+        as the ``position_format`` given at construction) and index buffer, ``draws`` the (first
         triangle, count) ranges that cast; ``hair_layers`` the ProxyLayers of the hair cards;
         ``seen`` which points the camera sees (see :func:`light_frame`).
         """
@@ -195,7 +196,7 @@ class KeyShadow:
         clip[:3, 3] -= 1.0
         clip_bytes = clip.T.astype(np.float32).tobytes()
         if self._vao is None:
-            self._vao = self._track(ctx.vertex_array(self._program, [(vbo, "3f 36x", "in_pos")],
+            self._vao = self._track(ctx.vertex_array(self._program, [(vbo, self._position_format, "in_pos")],
                                                      index_buffer=ibo, index_element_size=4))
         self._fbo.use()
         self._fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)

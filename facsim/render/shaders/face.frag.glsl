@@ -17,6 +17,7 @@ in vec2 v_uv;
 #endif
 #if defined(REGION_SKIN) || defined(REGION_TONGUE)
 in vec3 v_scatter_normal;   // the normal averaged over a few millimetres (Renderer: scattered_normals)
+in float v_curvature;       // 1 / radius (dm^-1), Renderer: surface_curvature
 #endif
 #ifdef USE_EYE
 in vec3 v_eye;
@@ -109,11 +110,10 @@ const vec3 SCATTER_SOFTNESS = vec3(0.6, 0.3, 0.12);
 const float LIP_ROUGHNESS = 0.38;
 
 // Skin's specular (Fresnel F0 = SKIN_F0) from one light, in its two lobes (broad, tight):
-// GGX distributions of the given roughness (SKIN_ROUGHNESS, the tight lobe LIP_ROUGHNESS on
-// the wet lips; alpha = roughness²) with Hammon's
+// GGX distributions of the given roughness (by region: skin_lobes in skin_light.glsl, the tight
+// lobe LIP_ROUGHNESS on the wet lips; alpha = roughness²) with Hammon's
 // approximation of the height-correlated Smith visibility, times N.L.
 const float SKIN_F0 = 0.028;
-const vec2 SKIN_ROUGHNESS = vec2(0.6, 0.45);   // (a tighter film, 0.38, read as plastic on the nose)
 const float PEACH_FUZZ = 0.05;   // grazing sheen of the vellus hair, of the light reaching it
 const float MUCOSA_SHINE = 0.3;                // its wet film's glint, of the light reaching it
                                                // (broad: a tight one broke into beads along the lip)
@@ -414,6 +414,8 @@ const float FOLD_LENGTH = 5.0;    // band widths below the neckline where they h
 const float FOLD_REACH = 0.5;     // dm along the neckline from the front where they fade
 #endif
 
+#include "skin_light.glsl"
+
 void main() {
     vec3 n = surface_normal();
     vec3 v = normalize(u_cam_pos - v_pos);
@@ -605,7 +607,7 @@ void main() {
     // soft and warm (less with age: thinner skin); only a little, as skin scatters light a
     // few millimetres and too much wrap is what looks waxy. Red scatters furthest under the
     // skin, so it sees the smooth normal; green and blue see the pores' relief.
-    vec3 wrap = vec3(0.3, 0.13, 0.08) * (1.0 - hair) * (1.0 - 0.3 * u_age);
+    vec3 wrap = vec3(0.3, 0.13, 0.08) * (1.0 - hair) * (1.0 - 0.3 * u_age) * scatter_reach(v_curvature);
     // Light entering a fold's shaded flank or a crease comes out a few millimetres away, so
     // the surface's small relief (the mesh's folds and the drawn grooves) shades red least and
     // blue most: folds look soft and warm, not carved in grey (v_scatter_normal is the normal
@@ -646,8 +648,9 @@ void main() {
     float back_rim = clamp(dot(v, -normalize(u_rim_dir + 0.4 * n)), 0.0, 1.0);
     vec3 glow = back_rim * back_rim * u_rim_col * occ;
     diffuse += tone.g * 0.55 * glow * u_skin * vec3(1.0, 0.42, 0.3);
-    // Specular in two GGX lobes, as measured on skin: a broad one (roughness 0.6) from the
-    // rough horny layer, over the whole face, and a tighter one (0.38) from the oil film, with
+    // Specular in two GGX lobes, as measured on skin: a broad one from the rough horny layer,
+    // over the whole face (roughness 0.53 on the T-zone to 0.66 on the cheeks: skin_lobes), and
+    // a tighter one from the oil film, with
     // Fresnel from skin's reflectance at normal incidence (F0 = 0.028, IOR 1.4). The weights
     // sum to about one, so skin stays mostly diffuse with a broad soft sheen. The film is thin
     // and only where the skin is oiliest (detail.b: the forehead's middle, the nose, the chin),
@@ -661,8 +664,9 @@ void main() {
     // glossy band along the lip read as rubber.
     float wet = max(lips * (1.0 - 0.85 * lip_line) * (0.55 + 0.45 * blotch), mucosa);
     // Lobe weights (broad, tight); the fill is too weak to show: key and rim only.
-    vec2 weight = vec2(0.6 - 0.3 * wet, 0.22 * film + 0.2 * wet);
-    vec2 roughness = vec2(SKIN_ROUGHNESS.x, mix(SKIN_ROUGHNESS.y, LIP_ROUGHNESS, min(2.0 * wet, 1.0)));
+    SkinLobes lobes = skin_lobes(oil, film, wet, blotch, patches);
+    vec2 weight = lobes.weight;
+    vec2 roughness = lobes.roughness;
     vec3 spec = dot(skin_specular(bumped, u_key_dir, v, ndv, roughness), weight) * u_key_col * key_shadow
               + dot(skin_specular(bumped, u_rim_dir, v, ndv, roughness), weight) * u_rim_col;
     // (Times pi: the diffuse term here is albedo times N.L, without the Lambert 1/pi.)

@@ -23,6 +23,8 @@ out float v_lash;
 #if defined(REGION_SKIN) || defined(REGION_TONGUE)
 in vec3 in_scatter_normal;  // the normal averaged over a few millimetres (subsurface light sees it)
 out vec3 v_scatter_normal;
+in float in_curvature;      // 1 / radius of the surface (dm^-1), render.geometry.surface_curvature
+out float v_curvature;
 #endif
 #ifdef USE_UV
 in vec2 in_uv;
@@ -45,6 +47,7 @@ void main() {
     v_occlusion = in_occlusion;
 #if defined(REGION_SKIN) || defined(REGION_TONGUE)
     v_scatter_normal = in_scatter_normal;
+    v_curvature = in_curvature;
 #endif
 #ifdef USE_WRINKLE
     v_wrinkle = in_wrinkle;
