@@ -46,18 +46,20 @@ def test_known_presets(table, name, canonical):
     assert str(emotion(name, table=table)) == canonical
 
 
-def test_default_table_is_table_5_with_emfacs_anger():
+def test_default_table_is_table_5_with_emfacs_anger_and_surprise():
     """Session 18: HapFACS Table 5's anger (5+7+9+10+15+17+42) carries disgust's 9, 10 and 15
-    and was read as disgust; the default set takes EMFACS's anger and Table 5 for the rest."""
+    and was read as disgust, and its surprise raises the lid fully (5, EMFACS 5B); the default
+    set takes EMFACS's anger and surprise and Table 5 for the rest."""
     tables = preset_tables()
     assert DEFAULT_TABLE == "facsim" and next(iter(tables)) == DEFAULT_TABLE
     for name in EMOTIONS:
-        source = "emfacs" if name == "anger" else "hapfacs"
+        source = "emfacs" if name in ("anger", "surprise") else "hapfacs"
         assert tables["facsim"].presets[name] == tables[source].presets[name]
         assert emotion(name) == emotion(name, table=source)
     assert tables["facsim"].notes["sadness"] == tables["hapfacs"].notes["sadness"]
     assert "--table hapfacs" in tables["facsim"].notes["anger"]
     assert not {9, 10, 15} & emotion("anger").codes
+    assert [u.intensity for u in emotion("surprise").units if u.code == 5] == [0.30]
     text = describe_emotions()
     assert "anger          4+5+7+23" in text and "Table 5" in text
 

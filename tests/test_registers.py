@@ -118,7 +118,7 @@ def test_eq1_sums_shared_registers_and_clamps_to_the_smallest_max():
     assert combine_registers([(0.5, 0.6), (0.4, 0.8)]) == pytest.approx(0.6)  # 0.62 clamped to 0.6
     weights = register_weights(Activations({(42, "left"): 0.2, (4, "left"): 0.2}))
     shared = [w for c, w in weights.items() if c.target == "faceunits/browDownLeft"]
-    assert len(weights) == 2  # browDown shared, eyebrows-down summed as well
+    assert len(weights) == 3  # browDown shared, eyebrows-down summed as well; 4's push on the lid (eyeBlink)
     # each AU at the engine's response to 0.2: r·1.0 + r·0.6, under min(1.0, 0.6)
     assert shared == [pytest.approx(1.6 * response(0.2))] and 1.6 * response(0.2) < 0.6
 
@@ -396,6 +396,24 @@ def test_default_anger_has_none_of_disgusts_lower_face(engine, marks, level):
     assert anger[marks["upper_lip"], 1] < 0.0 < disgust[marks["upper_lip"], 1]
     assert anger[marks["nose_wing_left"], 1] < 0.001 and disgust[marks["nose_wing_left"], 1] > 0.02 * level
     assert anger[marks["lip_corner_left"], 1] > disgust[marks["lip_corner_left"], 1] + 0.01 * level
+
+
+@pytest.mark.parametrize("level", [1.0, 0.5])
+def test_sad_upper_lids_droop_where_fear_and_anger_keep_theirs_up(face_of, marks, level):
+    """FACS 2002: 4 pushes down on the upper eyelid, 1+2 counteracts it and 1 alone does not; with 5
+    the levator holds it up. Session 18: sadness (1+4+15) kept the open lids of rest (the margin
+    0.4 mm lower on ava) where the manual's sad face has its upper lids drooping slightly. Hooded
+    lids that already cover 4 mm of the iris (george) are not pushed further (lids.yaml)."""
+    ava, george = face_of("ava").engine, face_of("george").engine
+
+    def lid(engine, delta):
+        return delta[marks["upper_lid_left"], 1]
+
+    assert lid(ava, _emotion_moved(ava, "sadness", level)) < -0.012 * level
+    assert lid(ava, _emotion_moved(ava, "fear", level)) > -0.005
+    assert lid(ava, _moved(ava, "1+2+4")) > -0.006
+    assert lid(ava, _emotion_moved(ava, "anger", level)) > 0.0
+    assert lid(george, _emotion_moved(george, "sadness", level)) > -0.008     # the brows alone: 0.6 mm
 
 
 @pytest.mark.parametrize("level", [1.0, 0.5])

@@ -1,7 +1,7 @@
 """The CLI's time-based commands: ``facsim animate``, ``facsim emotion``, ``facsim plot``."""
 from __future__ import annotations
 
-from facsim.cli.options import add_view_options, character_of, fps, number, output, render_options
+from facsim.cli.options import TABLE_HELP, add_view_options, character_of, fps, number, output, render_options
 
 
 def add_commands(sub) -> None:
@@ -18,7 +18,7 @@ def add_commands(sub) -> None:
     p.add_argument("name", help='an emotion (see `facsim emotions`) or a FACS string such as "1+2+5B+26"')
     p.add_argument("-o", "--output", required=True)
     p.add_argument("--intensity", default="100%", help="peak intensity, e.g. 50%% (HapFACS used 50 and 100)")
-    p.add_argument("--table", help="emotion preset table: facsim (the default: HapFACS Table 5, anger from EMFACS), hapfacs or emfacs")
+    p.add_argument("--table", help=TABLE_HELP)
     p.add_argument("--onset", type=number(0, 3600, unit="seconds"), default=1.0, help="seconds (default 1)")
     p.add_argument("--apex", type=number(0, 3600, unit="seconds"), default=1.0, help="seconds (default 1)")
     p.add_argument("--offset", type=number(0, 3600, unit="seconds"), default=1.0, help="seconds (default 1)")

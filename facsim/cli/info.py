@@ -1,6 +1,8 @@
 """Commands that describe facsim's tables: ``characters``, ``aus``, ``emotions``, ``data``."""
 from __future__ import annotations
 
+from facsim.cli.options import TABLE_HELP
+
 
 def add_commands(sub) -> None:
     p = sub.add_parser("characters", help="list the character presets and their parameters")
@@ -11,7 +13,7 @@ def add_commands(sub) -> None:
     p.set_defaults(handler=cmd_aus)
 
     p = sub.add_parser("emotions", help="list the emotion presets")
-    p.add_argument("--table", default="facsim", help="emotion preset table: facsim (the default: HapFACS Table 5, anger from EMFACS), hapfacs or emfacs")
+    p.add_argument("--table", default="facsim", help=TABLE_HELP)
     p.set_defaults(handler=cmd_emotions)
 
     p = sub.add_parser("data", help="download / rebuild / locate the face data cache")

@@ -11,6 +11,9 @@ from __future__ import annotations
 import argparse
 import math
 
+#: ``--table``'s help, wherever an emotion preset is named (the tables are facsim/data/emotions.yaml's).
+TABLE_HELP = "emotion preset table: facsim (the default: HapFACS Table 5, anger and surprise from EMFACS), hapfacs or emfacs"
+
 
 def number(low: float | None = None, high: float | None = None, *, unit: str = "",
            low_open: bool = False, high_open: bool = False):

@@ -1,7 +1,7 @@
 """``facsim render``: one FACS expression, emotion or timeline frame to a PNG."""
 from __future__ import annotations
 
-from facsim.cli.options import add_view_options, character_of, number, output, render_options
+from facsim.cli.options import TABLE_HELP, add_view_options, character_of, number, output, render_options
 
 
 def add_commands(sub) -> None:
@@ -9,7 +9,7 @@ def add_commands(sub) -> None:
     p.add_argument("expression", nargs="?", default=None, help='FACS string, e.g. "1+2+5B+26", "R12A+L14", "neutral"')
     p.add_argument("-o", "--output", required=True, type=output(".png"), help="PNG file to write")
     p.add_argument("--emotion", help="an emotion preset instead of an expression (see `facsim emotions`)")
-    p.add_argument("--table", default="facsim", help="emotion preset table: facsim (the default: HapFACS Table 5, anger from EMFACS), hapfacs or emfacs")
+    p.add_argument("--table", default="facsim", help=TABLE_HELP)
     p.add_argument("--intensity", default="100%", help="global intensity for --emotion, e.g. 50%% or 0.5")
     p.add_argument("--timeline", help="render one frame of a timeline file (YAML or JSON) ...")
     p.add_argument("--time", type=number(0, unit="seconds"), help="... at this time in seconds")

@@ -1,7 +1,7 @@
 """The CLI's speech commands: ``facsim speak`` and ``facsim visemes``."""
 from __future__ import annotations
 
-from facsim.cli.options import add_view_options, render_options
+from facsim.cli.options import TABLE_HELP, add_view_options, render_options
 
 
 def add_commands(sub) -> None:
@@ -14,7 +14,7 @@ def add_commands(sub) -> None:
     p.add_argument("--transcript", help="the words spoken in --audio")
     p.add_argument("--emotion", help="an emotion shown while speaking (see `facsim emotions`)")
     p.add_argument("--intensity", default="100%", help="the emotion's intensity, e.g. 70%% or 0.7")
-    p.add_argument("--table", help="emotion preset table: facsim (the default: HapFACS Table 5, anger from EMFACS), hapfacs or emfacs")
+    p.add_argument("--table", help=TABLE_HELP)
     p.add_argument("--no-blinks", action="store_true", help="no spontaneous blinks")
     p.add_argument("--seed", type=int, default=0, help="seed for the blinks")
     p.add_argument("--fps", type=float, default=30.0)

@@ -19,7 +19,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import cached_property, lru_cache
-from typing import Iterable
+from typing import Iterable, Mapping
 
 import numpy as np
 
@@ -126,14 +126,16 @@ def _expand(pattern: str, side: str) -> tuple[str, bool]:
     return name, sided
 
 
-def register_weights(act: Activations) -> dict[Column, float]:
+def register_weights(act: Activations, fitted: Mapping[tuple[int, str], float] | None = None) -> dict[Column, float]:
     """Column weights for ``act`` by Eq. 1 — the pure heart of the engine.
 
     Each AU takes :func:`response` of its intensity times each register's maximum
-    (the combination rules, read from intensities, may scale the maximum). A
+    (the combination rules, read from intensities, may scale the maximum; ``fitted``
+    maps ``(code, target pattern)`` to a character's own factor on one register). A
     two-sided target used by an AU on one side only is split at the midline:
     it gets a left and a right column, each weighted by its own side's AUs.
     """
+    fitted = fitted or {}
     table = register_table()["action_units"]
     contributions: dict[Column, list[tuple[float, float]]] = {}
     for (code, side), level in act:
@@ -142,7 +144,7 @@ def register_weights(act: Activations) -> dict[Column, float]:
         scale = combination_scales(act, code, side)
         weight = response(level)
         for reg in table.get(code, {}).get("registers", []):
-            vmax = float(reg["max"]) * scale.get(reg["target"], 1.0)
+            vmax = float(reg["max"]) * scale.get(reg["target"], 1.0) * fitted.get((code, reg["target"]), 1.0)
             contributions.setdefault(Column(reg["target"], side), []).append((weight, vmax))
     return {col: combine_registers(pairs) for col, pairs in contributions.items()}
 
@@ -288,20 +290,39 @@ class RegisterEngine:
         return frozenset(reg["target"] for reg in registers), float(np.mean(gains))
 
     @cached_property
+    def brow_push(self) -> dict[tuple[int, str], float]:
+        """The lowered brow's push on the upper lid fitted to the character (``lids.yaml``
+        ``brow_push``): AU 4's share of the closing target, scaled so that at E it lowers the relaxed
+        lid to cover at most ``cover_mm`` of the iris (none on lids that rest that low already)."""
+        from facsim.engines.lids import rest_lid_weight, rest_table
+
+        spec = load_yaml("lids.yaml")["brow_push"]
+        code, pattern = int(spec["au"]), spec["target"]
+        vmax = next(float(reg["max"]) for reg in register_table()["action_units"][code]["registers"]
+                    if reg["target"] == pattern)
+        skin = self.head.skin_vertex_count
+        relaxed = self.sculpted[:skin] + self.rest_lids.offsets(Activations(), skin)
+        limits = {**rest_table(), "cover_mm": float(spec["cover_mm"]), "max_weight": vmax}
+        shares = [rest_lid_weight(self.lids[pattern, side], relaxed, self.column(Column(pattern, side))[:skin],
+                                  self.head.eye_pivot(self.base_positions, side)[1], limits)
+                  for side in ("left", "right")]
+        return {(code, pattern): float(np.mean(shares)) / vmax}
+
+    @cached_property
     def neutral(self) -> np.ndarray:
         """The face at rest (N_geo, 3): the sculpted face with relaxed lids."""
         return self.deform(Activations()).positions
 
     def weights(self, act: Activations) -> dict[Column, float]:
         """Column weights of ``act`` (Eq. 1), each side's by the character's gain there (its natural
-        asymmetry) and AU 5's lid-raising targets by :attr:`lid_raise`, plus the relaxed lids'
-        share of the closing target."""
+        asymmetry) and AU 5's lid-raising targets by :attr:`lid_raise`, AU 4's push on the lid
+        fitted (:attr:`brow_push`), plus the relaxed lids' share of the closing target."""
         from facsim.engines.lids import rest_table
 
         raising, raise_gain = self.lid_raise
         weights = {col: w * (1.0 if col.pattern in BONE_TARGETS else self.side_gain[col.side])
                    * (raise_gain if col.pattern in raising else 1.0)
-                   for col, w in register_weights(act).items()}
+                   for col, w in register_weights(act, self.brow_push).items()}
         for side in ("left", "right"):
             share = self.rest_lids.share(act, side)
             if share:

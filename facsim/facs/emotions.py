@@ -4,8 +4,9 @@ The presets live in ``facsim/data/emotions.yaml``, one table per source:
 ``"hapfacs"`` (HapFACS 3.0, Table 5) and ``"emfacs"`` (the classic EMFACS
 prototypes, with embarrassment after Keltner 1995 and pride after Tracy &
 Robins 2004), and the default ``"facsim"``: Table 5 for every emotion but
-anger, which is EMFACS's 4+5+7+23 (Table 5's anger carries disgust's 9 and
-10 and was read as disgust). Each preset is a FACS string read by
+anger and surprise, which are EMFACS's 4+5+7+23 and 1+2+5B+26 (Table 5's anger
+carries disgust's 9 and 10 and was read as disgust; its surprise raises the
+upper lid fully and stared as fear does). Each preset is a FACS string read by
 :func:`facsim.notation.parse`.
 
 Examples

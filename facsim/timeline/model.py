@@ -34,7 +34,7 @@ Times are seconds from the start of the video; intensities are fractions
         intensity: 1.0       # peak level (default 1)
         easing: sigmoid      # for the rise and the fall (default linear)
       - emotion: happiness   # a preset of facsim.emotions
-        table: hapfacs       # preset table (default facsim: HapFACS Table 5, anger from EMFACS)
+        table: hapfacs       # preset table (default facsim: HapFACS Table 5, anger and surprise from EMFACS)
         start: 0.5           # constant hold from start (default 0) to end
         end: 1.5
         intensity: 50%
