@@ -110,6 +110,25 @@ float strand_diffuse(vec3 t, vec3 l) {
 }
 
 
+#if defined(KIND_HAIR) && defined(COILY)
+// Coily hair seen as a mass (afro01): light falls off into it. Where the eye looks straight
+// into the mass it sees down between the coils, into their shade; toward the outline it
+// grazes the coils' lit tips, so the mass is darker inside and lighter at its rim, as a
+// volume of fine fibres is, not a shell painted one tone. n: the volume's normal.
+float coily_depth_shade(vec3 n, vec3 v) {
+    float grazing = 1.0 - clamp(dot(n, v), 0.0, 1.0);
+    return mix(0.78, 1.25, grazing * grazing);
+}
+
+// Coils face every way: their highlight is a broad soft sheen where the mass faces the key
+// light, carried by the coils' crowns (clump: 0 crevice ... 1 crown), not the strand lobes of
+// straight hair, which the cards' tangents drew as pale scratches across the mass.
+vec3 coily_sheen(vec3 n, vec3 v, float crown) {
+    vec3 h = normalize(u_key_dir + v);
+    return u_key_col * 0.05 * pow(max(dot(n, h), 0.0), 4.0) * mix(0.4, 1.0, crown);
+}
+#endif
+
 #ifdef KIND_SCALP
 #ifdef CROP
 // A close crop (facsim/head/scalp.py; no cards over it): coily hair a few millimetres long is
@@ -253,9 +272,23 @@ void main() {
     f_color = vec4(finish(albedo * lit * 0.75 + spec).rgb, alpha);
 }
 #else
+#if defined(KIND_HAIR) && !defined(COILY)
+// MakeHuman's straight-hair textures fade their strands' tips over the last centimetre or two
+// of a card: where cards end over the skin (a fringe over the forehead, short01's front edge)
+// that fade drew a see-through band of brown film with the skin showing through it. Strands
+// are dense to near their tips: the fade is steepened into the last few millimetres, where
+// the strands end one by one (the fraying below), and the gaps between strands stay open.
+float dense_tips(float alpha) {
+    return smoothstep(0.04, 0.42, alpha);
+}
+#endif
+
 void main() {
     vec4 tex = texture(u_texture, v_uv);
     float alpha = tex.a;
+#if defined(KIND_HAIR) && !defined(COILY)
+    alpha = dense_tips(alpha);
+#endif
 #if defined(KIND_EYEBROWS) || defined(KIND_EYELASHES)
     // Brows and lashes are one thin layer of fine hairs: drawn whole in the blended pass and
     // translucent, so skin shows between the hairs and they read as hair, not paint. Their
@@ -396,6 +429,10 @@ void main() {
         // The cards' thin margins (the blended pass: the hairline, the temples) break into
         // curls with skin between them instead of lying over the skin as a pale glassy film.
         alpha *= mix(1.0, smoothstep(0.4, 0.6, halo), u_coil * (1.0 - smoothstep(0.3, 0.6, alpha)));
+        // A card's own cut edge (where the mass ends over the temples and the forehead) breaks
+        // into curls and clumps of curls ending at different places, so the mass meets the
+        // skin in a ragged fringe of coils, not along a brim.
+        alpha *= 1.0 - u_coil * smoothstep(0.35, 0.8, v_edge + 0.8 * (0.5 - 0.6 * coil_clump - 0.4 * halo) - 0.1);
     }
 #endif
     // Over a thinning hairline (v_cover < 1, see facsim/head/scalp.py) the cards break up into
@@ -444,6 +481,7 @@ void main() {
     float strand = (0.62 + 0.76 * tex.r) * (0.7 + 0.6 * fine) * (0.6 + 0.8 * px) * (0.8 + 0.4 * mid)
                  * (0.9 + 0.2 * clump);
 #ifdef COILY
+    float crown;   // coily clumps: 0 in a crevice ... 1 on a crown
     {
         // Coily hair (both passes: its translucent fringe at the hairline drew a flat light
         // band otherwise): at any distance its curls blend into a fine, even, matte texture. The
@@ -456,13 +494,16 @@ void main() {
         // The clumps' crevices are deep and dark; their crowns catch the light. The crevices
         // run where the clump noise crosses its mean: a connected network around rounded
         // clumps, not dark spots on a light field.
-        float crown = smoothstep(0.0, 0.22, abs(coil_clump - 0.5));
-        strand = mix(strand, (0.88 + 0.24 * tex.r) * (0.6 + 0.8 * kink) * (0.62 + 0.76 * curls)
-                             * mix(0.55, 1.1, crown), u_coil);
+        crown = smoothstep(0.0, 0.22, abs(coil_clump - 0.5));
+        // (the finest curls a pixel across keep little contrast: at full strength they
+        // speckled the mass)
+        strand = mix(strand, (0.88 + 0.24 * tex.r) * (0.8 + 0.4 * kink) * (0.7 + 0.6 * curls)
+                             * mix(0.6, 1.08, crown), u_coil);
         // Greying coily hair mixes white, grey and dark strands curl by curl and clump by
         // clump (placed on the head, not in the cards' mirrored UVs).
-        float white = clamp(u_grey + 0.5 * (value_noise3(v_rest * 22.0 + 4.0) - 0.5) + 0.45 * (kink - 0.5)
-                            + 0.2 * (crown - 0.5), 0.0, 1.0);
+        // (at full strength the mix speckled ngozi's afro grey and white pixel by pixel)
+        float white = clamp(u_grey + 0.4 * (value_noise3(v_rest * 22.0 + 4.0) - 0.5) + 0.2 * (kink - 0.5)
+                            + 0.15 * (crown - 0.5), 0.0, 1.0);
         albedo = (u_grey > 0.0 ? mix(u_pigment, u_white, white) : u_color) * strand;
     }
 #else
@@ -536,6 +577,10 @@ void main() {
                                     + 0.25 * glint * tint * exp2(40.0 * log2(s1)));
 #else
     vec3 spec = vec3(0.0);
+#endif
+#ifdef COILY
+    spec = mix(spec, coily_sheen(n, v, crown), u_coil);
+    self_shadow *= mix(1.0, coily_depth_shade(n, v), u_coil);
 #endif
     vec3 radiance = (albedo * lit + u_sheen * spec) * self_shadow;
 #else
