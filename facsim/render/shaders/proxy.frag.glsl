@@ -179,7 +179,12 @@ vec4 close_crop() {
     // A broad, soft sheen where the pile faces the key light, carried by the coils' tips.
     vec3 h = normalize(u_key_dir + v);
     vec3 sheen = u_key_col * 0.1 * u_sheen * pow(max(dot(n, h), 0.0), 6.0) * smoothstep(0.35, 0.8, tips);
-    vec3 albedo = hair_colour(v_rest.xy * 40.0) * (0.55 + 0.9 * tips) * 0.85;
+    // Greying: white and pigmented coils mixed clump by clump, placed on the head in 3-D (a
+    // pattern in two of its coordinates ran as streaks along the third, across the temples).
+    vec3 colour = u_color;
+    if (u_grey > 0.0)
+        colour = mix(u_pigment, u_white, clamp(u_grey + 0.35 * (coils - 0.5) + 0.3 * (value_noise3(p * 20.0 + 3.0) - 0.5), 0.0, 1.0));
+    vec3 albedo = colour * (0.55 + 0.9 * tips) * 0.85;
     return vec4(finish(albedo * lit + sheen).rgb, alpha);
 }
 #endif
