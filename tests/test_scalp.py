@@ -130,7 +130,7 @@ def test_hair_lying_on_the_skin_casts_no_shadow_down_the_cheeks(face_of):
 
 def test_a_close_crop_is_its_scalp_layer_alone_standing_off_the_skin(face_of):
     """kwame's close crop (``crops:`` in hair.yaml): no cards or loose strands drawn, only the
-    scalp layer over short04's footprint, coily, its length off the skin where it grows full
+    scalp layer (bound under short04), coily, its length off the skin where it grows full
     and on the skin at the hairline; it covers the crown and leaves the forehead bare."""
     from facsim.face import Face
 

@@ -16,6 +16,11 @@ This module builds that layer as plain data for the renderer (one more proxy, ki
   the direction the cards' own strands run (:func:`strand_coordinates`), so a tiling texture
   of fine hairs (:func:`strand_texture`) lies along the hair's flow.
 
+A close crop (``crops:`` in ``facsim/data/hair.yaml``) is this layer alone, with no cards: its
+hairline is drawn from an anatomical table (:func:`crop_hairline_height`), off the ears
+(:func:`thin_skin`), rounded off and handed to the renderer as a distance from it
+(:func:`crop_hairline`), so the hair thins over a band a few millimetres wide per pixel.
+
 The layer is bound to the skin vertices it covers, so it follows every frame exactly as the
 skin does (head motion, and the forehead under AU 1 and 2 carries the hairline's fine hairs).
 """
@@ -39,7 +44,7 @@ LIFT = 0.004
 #: Bump when the layer a character gets changes (its disk cache is keyed by it).
 VERSION = 12  # 2: afro01's cards stand off the skull (volume_mm in hair.yaml); 3: crops' rounded hairline
 #: Close crops (:func:`crop_hairline`): the radius (dm) over which the hairline is rounded off
-#: (the skin's vertices lie about a centimetre apart, the footprint's cards' edges in steps of that) ...
+#: (the skin's vertices lie about a centimetre apart: an edge along them runs in steps) ...
 CROP_ROUNDING = 0.07
 #: ... and the width (dm) of the band over which the hair thins from full cover to bare skin.
 CROP_EDGE = 0.1
