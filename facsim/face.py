@@ -117,14 +117,16 @@ class Face:
 
         from facsim.head.assets import cache_dir
         from facsim.head.proxies import bind_scalp, hair_table, hair_volume
-        from facsim.head.scalp import VERSION
+        from facsim.head.scalp import CROP_EDGE, CROP_ROUNDING, VERSION
 
         hair = [b for b in self.proxies if b.proxy.kind == "hair"]
         if not hair:
             return None
         # Cached on disk like the occlusion bake: by the head's shape, the style and its table.
         shape = self.character.with_(name="", description="", colors={}, hair="", brows="", lashes="")
-        key = hashlib.sha256(repr((VERSION, shape, hair[0].proxy.name, hair_table().get("scalp"),
+        key = hashlib.sha256(repr((VERSION, shape, hair[0].proxy.name,
+                                   (hair[0].crop, hair_table()["crops"][hair[0].crop], CROP_ROUNDING, CROP_EDGE)
+                                   if hair[0].crop else "", hair_table().get("scalp"),
                                    hair_volume(hair[0].proxy.name)))
                              .encode()).hexdigest()[:16]
         return bind_scalp(hair[0], self.head, self.neutral, cache=cache_dir() / "scalp" / f"{key}.npy")
@@ -159,7 +161,8 @@ class Face:
                           b.proxy.texture, b.depth, b.neutral if b.proxy.kind in ("hair", "wisps") or b.crop else None,
                           self._card_cover(b) if b.proxy.kind == "hair" else None, b.coil > 0.0,
                           b.strand_points, b.strand_width,
-                          self._hair_end_height if b.proxy.kind in ("hair", "wisps") else None, bool(b.crop))
+                          self._hair_end_height if b.proxy.kind in ("hair", "wisps") else None, bool(b.crop),
+                          b.hairline)
                 for b in self._drawn_proxies]
 
     @cached_property

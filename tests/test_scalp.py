@@ -130,7 +130,7 @@ def test_hair_lying_on_the_skin_casts_no_shadow_down_the_cheeks(face_of):
 
 def test_a_close_crop_is_its_scalp_layer_alone_standing_off_the_skin(face_of):
     """kwame's close crop (``crops:`` in hair.yaml): no cards or loose strands drawn, only the
-    scalp layer over short04's footprint, coily, its length off the skin where it grows full
+    scalp layer (bound under short04), coily, its length off the skin where it grows full
     and on the skin at the hairline; it covers the crown and leaves the forehead bare."""
     from facsim.face import Face
 
@@ -166,3 +166,77 @@ def test_crops_are_worn_by_name_and_only_where_the_table_names_them():
     assert Character(hair="crop").hair == "crop"
     with pytest.raises(CharacterError, match="unknown hair 'buzz'"):
         Character(hair="buzz")
+
+
+def test_crop_hairline_is_a_distance_from_the_rounded_edge_of_the_region():
+    """The crop's hairline field: the signed distance (dm) from the region's edge, running
+    midway between the vertices in and out, straight where the mesh draws the edge in steps."""
+    skin, tris = _grid(13, 1.2)                     # vertices 1 cm apart, as on the scalp
+    x, y = skin[:, 0], skin[:, 1]
+    straight = scalp.crop_hairline(skin, tris, x > 0.6)
+    assert straight == pytest.approx(x - 0.65, abs=0.012)            # midway between 0.6 and 0.7
+    # a staircase edge (a column further in on every other row of vertices) is rounded off:
+    # the zero line moves less than half as far as the steps do
+    stairs = x > 0.55 + 0.1 * (np.round(y * 10) % 2)
+    field = scalp.crop_hairline(skin, tris, stairs)
+    crossing = []
+    for row in np.unique(np.round(y, 6)):
+        on = np.isclose(y, row)
+        crossing.append(np.interp(0.0, field[on], x[on]))
+    assert np.ptp(crossing) < 0.05
+    assert (field[x < 0.3] < -0.2).all() and (field[x > 0.95] > 0.2).all()
+
+
+def test_thin_skin_is_a_flap_with_skin_close_behind_it():
+    front, _ = _grid(7, 0.6)
+    # a sheet of scalp, and beside it an ear: a flap 3 mm thick, its two faces facing apart
+    skin = np.concatenate([front, front + [1.0, 0.0, 0.0], front + [1.0, 0.0, -0.03]])
+    normals = np.concatenate([np.tile([0.0, 0.0, 1.0], (2 * len(front), 1)), np.tile([0.0, 0.0, -1.0], (len(front), 1))])
+    thin = scalp.thin_skin(skin, normals)
+    n = len(front)
+    assert not thin[:n].any()                        # the scalp: nothing but skull behind it
+    assert thin[n:].all()                            # both faces of the flap
+
+
+def test_a_close_crop_grows_on_the_scalp_with_temples_sideburns_and_a_soft_hairline(face_of):
+    """kwame's crop: its hairline from ``hairline_mm`` (hair.yaml), rounded: the forehead and the
+    temples beside the eyes bare, sideburns in front of the ears, none on the ears; the
+    renderer gets each vertex's distance inside the hairline (in CROP_EDGE widths), which
+    thins the hair over that band per pixel instead of along the skin's triangles."""
+    face = face_of("kwame")
+    layer = face.scalp
+    mesh = face.proxy_meshes[0]
+    assert mesh.crop and mesh.hairline is not None and len(mesh.hairline) == len(layer.shade)
+    geo = np.asarray(face.neutral, np.float64)
+    skin, _, normals = scalp.outward_skin(face.head, geo)
+    eyes = np.concatenate([np.asarray(v) for v in face.head.eye_vertices.values()])
+    eye_y, eye_z = geo[eyes, 1].mean(), geo[eyes, 2].mean()
+    density = np.zeros(len(skin))
+    density[layer.binding.ref[:, 0]] = layer.shade
+    hairline = np.full(len(skin), -10.0)
+    hairline[layer.binding.ref[:, 0]] = mesh.hairline
+    x, y, z = skin.T
+    # the forehead's midline: hair from 4-8 cm above the eyes
+    midline = (np.abs(x) < 0.1) & (normals[:, 2] > 0.5)
+    assert y[midline & (density > 0.5)].min() - eye_y == pytest.approx(0.6, abs=0.2)
+    assert density[midline & (y < eye_y + 0.4)].max() == 0.0
+    # the temples beside the eyes bare; sideburns in front of the ears, down to eye level
+    ears = scalp.thin_skin(skin, normals) & (np.abs(x) > 0.6) & (np.abs(y - eye_y) < 0.4) & (z < eye_z - 0.4)
+    assert ears.sum() > 100 and density[ears].max() < 0.05
+    for side in (-1, 1):
+        ear_front = z[ears & (np.sign(x) == side)].max()
+        temple = (np.sign(x) == side) & (np.abs(x) > 0.4) & (z > eye_z - 0.25) & (z < eye_z - 0.1) & (y > eye_y) & (y < eye_y + 0.2)
+        assert temple.any() and density[temple].max() < 0.05
+        sideburn = ((np.sign(x) == side) & (z > ear_front) & (z < ear_front + 0.15) & (np.abs(x) > 0.5)
+                    & (y > eye_y - 0.05) & (y < eye_y + 0.1) & ~ears)
+        assert sideburn.sum() >= 3 and np.median(density[sideburn]) > 0.5
+    # the field is a distance (1 CROP_EDGE per CROP_EDGE along the skin) across the triangles the
+    # hairline crosses, so the band is as wide there as anywhere
+    tris = layer.binding.ref[:, 0][layer.proxy.triangles]
+    straddle = tris[(hairline[tris].min(axis=1) < -0.3) & (hairline[tris].max(axis=1) > 0.3)
+                    & (hairline[tris].max(axis=1) < 4.0)]
+    edges = np.concatenate([straddle[:, [0, 1]], straddle[:, [1, 2]], straddle[:, [2, 0]]])
+    step = np.abs(hairline[edges[:, 0]] - hairline[edges[:, 1]]) * scalp.CROP_EDGE
+    length = np.linalg.norm(skin[edges[:, 0]] - skin[edges[:, 1]], axis=1)
+    assert len(edges) > 50 and np.all(step <= length * 1.05 + 1e-3)
+    assert np.median(step / length) > 0.4

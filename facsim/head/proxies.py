@@ -190,6 +190,13 @@ def crop_length(name: str) -> float:
     return float(hair_table().get("crops", {}).get(name, {}).get("length_mm", 0.0))
 
 
+def crop_hairline_table(name: str) -> list | None:
+    """Close crop ``name``'s hairline: (azimuth in degrees from the front, height in mm above the
+    eyes' centres) pairs (``hairline_mm`` in its ``crops:`` entry; :func:`facsim.head.scalp.
+    crop_hairline_height`), or None if ``name`` is no crop."""
+    return hair_table().get("crops", {}).get(name, {}).get("hairline_mm")
+
+
 def character_proxies(character) -> dict[str, str | None]:
     """Proxy names ``{"hair": …, "eyebrows": …, "eyelashes": …}`` (None = none) for ``character``.
 
@@ -480,6 +487,9 @@ class BoundProxy:
     #: Hair worn as a close crop (``crops:`` in ``hair.yaml``): its name. The proxy is then the
     #: style whose footprint the crop covers; its cards are never drawn, only the scalp layer.
     crop: str = ""
+    #: A close crop's scalp layer: each vertex's distance inside its hairline in the widths of
+    #: the band over which the hair thins (:attr:`facsim.head.scalp.ScalpLayer.hairline`).
+    hairline: np.ndarray | None = None
 
     @cached_property
     def depth(self) -> np.ndarray:
@@ -584,23 +594,17 @@ def bind_scalp(hair: BoundProxy, head, neutral_geometry: np.ndarray, *, cache: P
         corners = hair.binding.positions(geo)[hair.proxy.corner_vertex]  # cards split at their UV seams
         layer = scalp_layer(head, geo, corners, hair.proxy.triangles, hair.proxy.uv,
                             eye_y=float(geo[eyes, 1].mean()), eye_z=float(geo[eyes, 2].mean()),
-                            hairline=hair_table()["scalp"]["hairline_above_eyes_mm"])
-        return np.zeros((1, 7)) if layer is None else layer.to_array()
+                            hairline=hair_table()["scalp"]["hairline_above_eyes_mm"],
+                            crop=crop_hairline_table(hair.crop))
+        return np.zeros((1, 8)) if layer is None else layer.to_array()
 
     array = build() if cache is None else cached_array(
-        cache, build, valid=lambda a: a.ndim == 2 and a.shape[1] == 7 and int(a[0, 0]) < head.skin_vertex_count)
+        cache, build, valid=lambda a: a.ndim == 2 and a.shape[1] == 8 and int(a[0, 0]) < head.skin_vertex_count)
     if int(array[0, 0]) == 0:
         return None
     layer = ScalpLayer.from_array(array)
     vertices, normals = layer.vertices, layer.normals
     density = layer.density
-    if hair.crop:
-        # A crop is the only hair drawn: none on the ears, whose skin (facing up and back, not
-        # out from the skull) lies under the cards' footprint and grew hair on their rims.
-        points = geo[vertices]
-        centre = points.mean(axis=0) - np.array([0.0, 0.3 * np.ptp(points[:, 1]), 0.0])
-        radial = (points - centre) / (np.linalg.norm(points - centre, axis=1, keepdims=True) + 1e-12)
-        density = density * smoothstep(0.45, 0.75, np.einsum("ij,ij->i", radial, normals)).astype(np.float32)
     # A close crop stands its length off the skin where it grows full, rising from the hairline.
     lift = (LIFT + 0.01 * crop_length(hair.crop) * smoothstep(0.5, 1.0, density))[:, None]
     k = len(vertices)
@@ -612,7 +616,8 @@ def bind_scalp(hair: BoundProxy, head, neutral_geometry: np.ndarray, *, cache: P
                   triangles=layer.triangles, corner_vertex=np.arange(k, dtype=np.int32), uv=layer.uv,
                   png=b"", author="facsim", license="CC0", image=strand_texture())
     binding = FrameBinding(ref=ref, weights=weights, offsets=(lift * normals).astype(np.float32))
-    return BoundProxy(proxy, binding, "hair", 1.0, binding.positions(geo), shade=density, crop=hair.crop)
+    return BoundProxy(proxy, binding, "hair", 1.0, binding.positions(geo), shade=density, crop=hair.crop,
+                      hairline=layer.hairline)
 
 
 def bind_wisps(hair: BoundProxy, head, neutral_geometry: np.ndarray) -> BoundProxy | None:

@@ -16,6 +16,11 @@ This module builds that layer as plain data for the renderer (one more proxy, ki
   the direction the cards' own strands run (:func:`strand_coordinates`), so a tiling texture
   of fine hairs (:func:`strand_texture`) lies along the hair's flow.
 
+A close crop (``crops:`` in ``facsim/data/hair.yaml``) is this layer alone, with no cards: its
+hairline is drawn from an anatomical table (:func:`crop_hairline_height`), off the ears
+(:func:`thin_skin`), rounded off and handed to the renderer as a distance from it
+(:func:`crop_hairline`), so the hair thins over a band a few millimetres wide per pixel.
+
 The layer is bound to the skin vertices it covers, so it follows every frame exactly as the
 skin does (head motion, and the forehead under AU 1 and 2 carries the hairline's fine hairs).
 """
@@ -37,7 +42,12 @@ HAIRLINE_WIDTH = 0.06
 #: Height (dm) of the layer over the skin: enough not to fight it in the depth buffer.
 LIFT = 0.004
 #: Bump when the layer a character gets changes (its disk cache is keyed by it).
-VERSION = 2  # 2: afro01's cards stand off the skull (volume_mm in hair.yaml)
+VERSION = 12  # 2: afro01's cards stand off the skull (volume_mm in hair.yaml); 3: crops' rounded hairline
+#: Close crops (:func:`crop_hairline`): the radius (dm) over which the hairline is rounded off
+#: (the skin's vertices lie about a centimetre apart: an edge along them runs in steps) ...
+CROP_ROUNDING = 0.07
+#: ... and the width (dm) of the band over which the hair thins from full cover to bare skin.
+CROP_EDGE = 0.1
 #: One texture tile's size (dm) across and along the strands.
 TILE = (0.1, 0.2)
 
@@ -243,6 +253,11 @@ class ScalpLayer:
         Strand coordinates in texture tiles (:data:`TILE`): u across the strands, v along.
     normals : (K, 3) float32
         The skin's outward normals there at neutral (the layer is lifted along them).
+    hairline : (K,) float32 or None
+        A close crop's: each vertex's distance from its hairline along the skin, in
+        :data:`CROP_EDGE` widths, positive inside (:func:`crop_hairline`); the renderer thins
+        the hair over the band from 0 to 1 per pixel, so the hairline is a smooth curve however
+        coarse the skin's triangles. None under a hairstyle's cards.
     """
 
     vertices: np.ndarray
@@ -250,14 +265,17 @@ class ScalpLayer:
     density: np.ndarray
     uv: np.ndarray
     normals: np.ndarray
+    hairline: np.ndarray | None = None
 
     def to_array(self) -> np.ndarray:
-        """One (1 + K + M, 7) float64 array (for the disk cache; :meth:`from_array` reads it):
-        a header row (K, M), a row per vertex (vertex, density, u, v, normal), a row per triangle."""
+        """One (1 + K + M, 8) float64 array (for the disk cache; :meth:`from_array` reads it):
+        a header row (K, M), a row per vertex (vertex, density, u, v, normal, hairline (NaN
+        without one)), a row per triangle."""
         k, m = len(self.vertices), len(self.triangles)
-        out = np.zeros((1 + k + m, 7))
+        out = np.zeros((1 + k + m, 8))
         out[0, :2] = k, m
-        out[1 : 1 + k] = np.column_stack([self.vertices, self.density, self.uv, self.normals])
+        hairline = np.full(k, np.nan) if self.hairline is None else self.hairline
+        out[1 : 1 + k] = np.column_stack([self.vertices, self.density, self.uv, self.normals, hairline])
         out[1 + k :, :3] = self.triangles
         return out
 
@@ -265,22 +283,122 @@ class ScalpLayer:
     def from_array(cls, array: np.ndarray) -> ScalpLayer:
         k, m = (int(x) for x in array[0, :2])
         rows, tris = array[1 : 1 + k], array[1 + k : 1 + k + m, :3]
+        hairline = None if np.isnan(rows[:, 7]).all() else rows[:, 7].astype(np.float32)
         return cls(vertices=rows[:, 0].astype(np.int64), triangles=tris.astype(np.int32),
                    density=rows[:, 1].astype(np.float32), uv=rows[:, 2:4].astype(np.float32),
-                   normals=rows[:, 4:7].astype(np.float32))
+                   normals=rows[:, 4:7].astype(np.float32), hairline=hairline)
+
+
+def off_the_ears(skin: np.ndarray, normals: np.ndarray, grown: np.ndarray) -> np.ndarray:
+    """(N,) 1 where skin faces out from the skull (as the ``grown`` (N,) bool skin does, on the
+    whole), 0 on the ears, whose skin faces up and back: a hairstyle's footprint covers them,
+    but a close crop grows no hair on their rims."""
+    points = skin[grown]
+    centre = points.mean(axis=0) - np.array([0.0, 0.3 * np.ptp(points[:, 1]), 0.0])
+    radial = (skin - centre) / (np.linalg.norm(skin - centre, axis=1, keepdims=True) + 1e-12)
+    return smoothstep(0.45, 0.75, np.einsum("ij,ij->i", radial, normals))
+
+
+def thin_skin(skin: np.ndarray, normals: np.ndarray, *, depths=(0.05, 0.3), tolerance: float = 0.04) -> np.ndarray:
+    """(N,) bool: skin with skin again close behind it (within ``depths`` (dm) along the
+    inward normal, to ``tolerance``): the ears, thin flaps standing off the head, not the
+    scalp, behind which lies the skull."""
+    from scipy.spatial import cKDTree
+
+    skin = np.asarray(skin, np.float64)
+    tree = cKDTree(skin)
+    thin = np.zeros(len(skin), bool)
+    for d in np.arange(depths[0], depths[1] + 1e-9, 0.015):
+        thin |= np.isfinite(tree.query(skin - d * normals, distance_upper_bound=tolerance)[0])
+    return thin
+
+
+def crop_hairline_height(skin: np.ndarray, normals: np.ndarray, eye_y: float, hairline: list) -> np.ndarray:
+    """(N,) height (dm) of a close crop's hairline over each skin vertex: ``hairline``
+    (``hairline_mm`` of its ``crops:`` entry in ``facsim/data/hair.yaml``), pairs of (azimuth in
+    degrees around the head's vertical axis from the front, height in mm above the eyes'
+    centres ``eye_y``), interpolated (the two sides alike). The axis runs through the middle
+    of the cranium (the skin 3 cm above the eyes). Skin facing in toward the axis and down
+    (under the jaw, where the throat lies behind the axis's front) grows none (infinite)."""
+    skin = np.asarray(skin, np.float64)
+    cranium = skin[skin[:, 1] > eye_y + 0.3]
+    x, z = skin[:, 0] - cranium[:, 0].mean(), skin[:, 2] - cranium[:, 2].mean()
+    azimuth = np.degrees(np.abs(np.arctan2(x, z)))
+    table = np.asarray(hairline, np.float64)
+    height = eye_y + 0.01 * np.interp(azimuth, table[:, 0], table[:, 1])
+    outward = (normals[:, 0] * x + normals[:, 2] * z) / (np.hypot(x, z) + 1e-9)
+    return np.where((outward > -0.2) | (normals[:, 1] > 0.5), height, np.inf)
+
+
+def crop_hairline(skin: np.ndarray, triangles: np.ndarray, inside: np.ndarray, *,
+                  rounding: float = CROP_ROUNDING) -> np.ndarray:
+    """(N,) signed distance (dm) of each skin vertex (``triangles`` (T, 3) over them) from the
+    edge of the region ``inside`` (N,) bool, positive inside, with the edge rounded over
+    ``rounding``.
+
+    The edge is where the region's share of the skin around each vertex (Gaussian weights of
+    sd ``rounding``) crosses one half, traced through the triangles: it runs between the
+    vertices in and out, rounding off the steps a centimetre mesh draws (scalloped temples).
+    The distance from it varies about linearly across the skin's triangles, so the renderer
+    can place a hairline a few millimetres wide anywhere inside them.
+    """
+    from scipy.spatial import cKDTree
+
+    skin = np.asarray(skin, np.float64)
+    triangles = np.asarray(triangles)
+    pairs = cKDTree(skin).query_pairs(3.0 * rounding, output_type="ndarray")
+    i = np.concatenate([pairs[:, 0], pairs[:, 1], np.arange(len(skin))])
+    j = np.concatenate([pairs[:, 1], pairs[:, 0], np.arange(len(skin))])
+    w = np.exp(-np.sum((skin[i] - skin[j]) ** 2, axis=1) / (2.0 * rounding ** 2))
+    share = (np.bincount(i, weights=w * np.asarray(inside, np.float64)[j], minlength=len(skin))
+             / np.bincount(i, weights=w, minlength=len(skin))) - 0.5
+    # The edge: points along the half-share line in every triangle it crosses (each edge it
+    # crosses gives one, and a few between the two of a triangle, so it is sampled densely).
+    edges = np.concatenate([triangles[:, [0, 1]], triangles[:, [1, 2]], triangles[:, [2, 0]]])
+    crossing = np.sign(share[edges[:, 0]]) != np.sign(share[edges[:, 1]])
+    t = share[edges[:, 0]] / np.where(crossing, share[edges[:, 0]] - share[edges[:, 1]], 1.0)
+    points = skin[edges[:, 0]] + np.clip(t, 0.0, 1.0)[:, None] * (skin[edges[:, 1]] - skin[edges[:, 0]])
+    cut = crossing.reshape(3, -1).T                                    # (T, 3) which sides it crosses
+    ends = points.reshape(3, -1, 3).transpose(1, 0, 2)                  # (T, 3 sides, 3)
+    two = cut.sum(axis=1) == 2
+    a = ends[two][cut[two]].reshape(-1, 2, 3)
+    steps = np.linspace(0.0, 1.0, 6)[:, None, None]
+    samples = (a[None, :, 0] * (1.0 - steps) + a[None, :, 1] * steps).reshape(-1, 3)
+    samples = np.concatenate([samples, points[crossing]])
+    if not len(samples):
+        return np.where(share > 0, 1.0, -1.0)
+    distance = cKDTree(samples).query(skin)[0]
+    return np.where(share > 0, distance, -distance)
 
 
 def scalp_layer(head, neutral_geometry: np.ndarray, cards: np.ndarray, card_triangles: np.ndarray,
-                card_uv: np.ndarray, *, eye_y: float, eye_z: float, hairline: dict) -> ScalpLayer | None:
+                card_uv: np.ndarray, *, eye_y: float, eye_z: float, hairline: dict,
+                crop: list | None = None) -> ScalpLayer | None:
     """The scalp hair layer under a hairstyle's cards (``cards`` (P, 3) on the neutral face,
     ``card_triangles`` over them, ``card_uv`` (P, 2)), or None where they cover no skin.
 
     ``eye_y``, ``eye_z``: the eyes' centres' height and depth (the hairline is placed from them).
+    ``crop``: the layer is a close crop (no cards drawn) and this its hairline
+    (:func:`crop_hairline_height`): hair on the skin above it but the ears, its edge rounded
+    off (:func:`crop_hairline`), the density full :data:`CROP_EDGE` inside it. The cards then
+    only lay out the strand coordinates.
     """
     n_skin = head.skin_vertex_count
     skin, tris, normals = outward_skin(head, neutral_geometry)
     density = scalp_density(skin, normals, cards, card_triangles, floor_y=hairline_height(normals, skin[:, 2], eye_y, eye_z, hairline))
-    keep = tris[(density[tris] > 0.0).any(axis=1)]
+    above = None
+    if crop is not None:
+        # The hairline: the table's, on the skin off the ears, rounded off.
+        grown = skin[:, 1] > crop_hairline_height(skin, normals, eye_y, crop)
+        ears = off_the_ears(skin, normals, grown) * ~thin_skin(skin, normals)
+        above = crop_hairline(skin, tris, grown & (ears > 0.5)) / CROP_EDGE
+        # None on the ears' own skin, however near the scalp it lies: their skin faces away from
+        # the skull's centre (the hair ends where it turns, at the ear's root).
+        above = np.clip(np.minimum(above, 10.0 * (ears - 0.5)), -6.0, 6.0).astype(np.float32)
+        density = smoothstep(0.0, 1.0, above).astype(np.float32)
+        keep = tris[(above[tris] > -3.0).any(axis=1)]   # the band, and room for it to wander
+    else:
+        keep = tris[(density[tris] > 0.0).any(axis=1)]
     if not len(keep):
         return None
     vertices = np.unique(keep)
@@ -290,7 +408,8 @@ def scalp_layer(head, neutral_geometry: np.ndarray, cards: np.ndarray, card_tria
     flow = flow_directions(skin[vertices], normals[vertices], cards, card_triangles, card_uv, triangles)
     uv = strand_coordinates(skin[vertices], normals[vertices], flow, triangles) / np.asarray(TILE, np.float32)
     return ScalpLayer(vertices=vertices, triangles=triangles.astype(np.int32), density=density[vertices],
-                      uv=uv.astype(np.float32), normals=normals[vertices].astype(np.float32))
+                      uv=uv.astype(np.float32), normals=normals[vertices].astype(np.float32),
+                      hairline=None if above is None else above[vertices])
 
 
 def card_cover(cards: np.ndarray, skin: np.ndarray, density: np.ndarray, *, reach: float = 0.06) -> np.ndarray:

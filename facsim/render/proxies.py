@@ -80,6 +80,11 @@ class ProxyMesh:
         long styles hang on through where the shoulders are; below ``END_FADE`` over this
         height their strands end one by one at different lengths, tapering, instead of being
         cut by the shoulders or the image's edge. None: the hair is drawn to its cards' ends.
+    hairline : (V,) float, optional
+        A crop's scalp layer: each vertex's distance inside the crop's hairline in widths of the
+        band over which its hair thins (facsim.head.scalp.crop_hairline; linear across the
+        skin's triangles): the shader thins the hair over 0 … 1 per pixel, so the hairline is a
+        smooth, soft curve however coarse the triangles.
     """
 
     name: str
@@ -96,6 +101,7 @@ class ProxyMesh:
     strand_width: float = 0.0
     end_height: float | None = None
     crop: bool = False
+    hairline: np.ndarray | None = None
 
     def __post_init__(self):
         if self.kind not in PROXY_KINDS:
@@ -408,6 +414,8 @@ class ProxyLayer:
             self._buffer[:, 10] = 2.0 * np.asarray(mesh.uv, np.float32)[:, 0] - 1.0
         self._vbo = track(ctx.buffer(reserve=self._buffer.nbytes, dynamic=True))
         cover = np.ones(mesh.vertex_count, np.float32) if mesh.cover is None else np.asarray(mesh.cover, np.float32)
+        if mesh.hairline is not None:  # (the scalp layer has no cards to cover: the slot carries its hairline)
+            cover = np.asarray(mesh.hairline, np.float32)
         # Where each corner was on the neutral face: coily hair's curls are placed in this space
         # (isotropic, so any orientation will do), running on across the cards' edges and the
         # texture's mirrored layout, and moving with the hair.

@@ -110,7 +110,85 @@ float strand_diffuse(vec3 t, vec3 l) {
 }
 
 
+#if defined(KIND_HAIR) && defined(COILY)
+// Coily hair seen as a mass (afro01): light falls off into it. Where the eye looks straight
+// into the mass it sees down between the coils, into their shade; toward the outline it
+// grazes the coils' lit tips, so the mass is darker inside and lighter at its rim, as a
+// volume of fine fibres is, not a shell painted one tone. n: the volume's normal.
+float coily_depth_shade(vec3 n, vec3 v) {
+    float grazing = 1.0 - clamp(dot(n, v), 0.0, 1.0);
+    return mix(0.78, 1.25, grazing * grazing);
+}
+
+// Coils face every way: their highlight is a broad soft sheen where the mass faces the key
+// light, carried by the coils' crowns (clump: 0 crevice ... 1 crown), not the strand lobes of
+// straight hair, which the cards' tangents drew as pale scratches across the mass.
+vec3 coily_sheen(vec3 n, vec3 v, float crown) {
+    vec3 h = normalize(u_key_dir + v);
+    return u_key_col * 0.05 * pow(max(dot(n, h), 0.0), 4.0) * mix(0.4, 1.0, crown);
+}
+#endif
+
 #ifdef KIND_SCALP
+#ifdef CROP
+// A close crop (facsim/head/scalp.py; no cards over it): coily hair a few millimetres long is
+// all the hair there is. v_cover: the distance inside its hairline in widths of the band over
+// which the hair thins (scalp.CROP_EDGE; linear across the skin's triangles, so the hairline
+// is placed per pixel, not along the mesh's edges); v_rest: the neutral head, where the coils lie.
+const mat3 crop_turn = mat3(0.788, 0.418, -0.452, -0.360, 0.908, 0.214, 0.500, -0.017, 0.866);
+
+// The hair's cover (0 bare skin ... 1 solid) at the hairline: it wanders by a few millimetres
+// (tufts grow forward, gaps recede, clump by clump) and thins over the band from solid hair to
+// single hairs with skin between them, never a line.
+float crop_cover() {
+    vec3 p = crop_turn * v_rest;
+    float wander = 0.6 * (value_noise3(p * 9.0 + 1.0) - 0.5) + 0.6 * (value_noise3(p * 40.0 + 2.0) - 0.5);
+    float dens = clamp(v_cover + wander, 0.0, 1.2);
+    // Hairs a fraction of a millimetre apart (their mean where finer than a pixel): each is
+    // there where its rank is under the density, so the band thins hair by hair.
+    float rank = value_noise3(transpose(crop_turn) * v_rest * 160.0 + 4.0);
+    float hairs = smoothstep(rank - 0.3, rank + 0.3, dens);
+    // Inside the band the short hairs hide the skin but for a glimpse between them.
+    return min(hairs * dens * sqrt(dens), 1.0) * 0.96;
+}
+
+vec4 close_crop() {
+    vec3 n = normalize(v_normal);
+    vec3 v = normalize(u_cam_pos - v_pos);
+    float alpha = crop_cover();
+    // Seen at a slant the eye crosses more of the hairs (transmittance to the power 1 / cos):
+    // toward the head's outline they hide the skin ...
+    float facing = abs(dot(n, v));
+    alpha = 1.0 - pow(1.0 - min(alpha, 0.999), 1.0 / max(facing, 0.08));
+    // ... and at the outline itself the coils stand apart against the background: a fuzzy
+    // edge of curls a millimetre or two across, not the layer's smooth cut.
+    vec3 p = crop_turn * v_rest;
+    float curls = 0.65 * lattice_noise3(p * 35.0 + 6.0) + 0.35 * value_noise3(p * 100.0 + 9.0);
+    alpha *= mix(1.0, smoothstep(0.4, 0.6, curls), 1.0 - smoothstep(0.04, 0.16, facing));
+    // Coils a millimetre and a few millimetres across, placed on the neutral head so they are
+    // round and move with the skin, with dark crevices between them: the crop catches the
+    // light unevenly, coil by coil, as the tips of a pile do. (lattices turned against the
+    // head's axes: an axis-aligned one drew a grid of dots)
+    float kink = value_noise3(p * 110.0);
+    float coils = value_noise3(transpose(crop_turn) * v_rest * 35.0 + 5.0);
+    float tips = kink * (0.6 + 0.8 * coils);
+    float kl = clamp(dot(n, u_key_dir) * 0.5 + 0.5, 0.0, 1.0);
+    float dk = kl * kl * 1.25;   // coils face every way: no strand direction
+    float df = clamp(dot(n, u_fill_dir) * 0.5 + 0.5, 0.0, 1.0);
+    vec3 lit = dk * u_key_col + df * u_fill_col + hemisphere(n) * 0.8;
+    // A broad, soft sheen where the pile faces the key light, carried by the coils' tips.
+    vec3 h = normalize(u_key_dir + v);
+    vec3 sheen = u_key_col * 0.1 * u_sheen * pow(max(dot(n, h), 0.0), 6.0) * smoothstep(0.35, 0.8, tips);
+    // Greying: white and pigmented coils mixed clump by clump, placed on the head in 3-D (a
+    // pattern in two of its coordinates ran as streaks along the third, across the temples).
+    vec3 colour = u_color;
+    if (u_grey > 0.0)
+        colour = mix(u_pigment, u_white, clamp(u_grey + 0.35 * (coils - 0.5) + 0.3 * (value_noise3(p * 20.0 + 3.0) - 0.5), 0.0, 1.0));
+    vec3 albedo = colour * (0.55 + 0.9 * tips) * 0.85;
+    return vec4(finish(albedo * lit + sheen).rgb, alpha);
+}
+#endif
+
 // The fine hair growing on the skin under a hairstyle's cards (facsim/head/scalp.py): drawn
 // blended over the skin before the cards, so the scalp between and beyond them is covered by
 // hair of the cards' colour, thinning over a centimetre at the hairline into single hairs with
@@ -121,6 +199,10 @@ void main() {
 #ifdef PASS_OPAQUE
     discard;
 #endif
+#ifdef CROP
+    f_color = close_crop();
+    if (f_color.a < 0.01) discard;
+#else
     // Coily hair grows in small round curls, not long strands: the tile's tufts squashed round.
 #ifdef COILY
     vec2 suv = v_uv * vec2(2.0, 6.0);
@@ -143,60 +225,27 @@ void main() {
     // Where the cover thins, the hairs that are left are finer and fewer: the tuft's own
     // strands (tex.a) show more of the skin between them, so the hairline ends in wisps.
     float alpha = mix(tex.a * tex.a * tex.a, tex.a, smoothstep(0.2, 0.9, dens)) * keep * 0.92;
-#ifdef CROP
-    // A close crop (no cards over it) is all the hair there is: inside its hairline the short
-    // hairs hide the skin but for a glimpse between them.
-    alpha = mix(tex.a * tex.a * tex.a, 1.0, smoothstep(0.3, 0.9, dens)) * keep * 0.95;
-    // Where it stands off the skin (bind_scalp lifts it from half cover up) it is solid: no
-    // background shows through it past the head's outline.
-    alpha = max(alpha, smoothstep(0.5, 0.9, v_depth));
-    // Seen at a slant the eye crosses more of the layer's hairs (transmittance to the power
-    // 1 / cos): edge-on, at the head's outline, they hide what is behind them.
-    float facing = abs(dot(normalize(v_normal), normalize(u_cam_pos - v_pos)));
-    alpha = 1.0 - pow(1.0 - min(alpha, 0.999), 1.0 / max(facing, 0.08));
-#endif
     if (alpha < 0.01) discard;
     vec3 n = normalize(v_normal);
     vec3 t = normalize(v_tangent);
     float kl = clamp(dot(n, u_key_dir) * 0.5 + 0.5, 0.0, 1.0);
-#ifdef CROP
-    float dk = mix(strand_diffuse(t, u_key_dir), 1.0, 0.7) * kl * kl * 1.25;   // coils face every way
-#else
     float dk = mix(strand_diffuse(t, u_key_dir), 1.0, 0.3) * kl * kl * 1.25;
-#endif
     float df = clamp(dot(n, u_fill_dir) * 0.5 + 0.5, 0.0, 1.0);
     vec3 lit = dk * u_key_col + df * u_fill_col + hemisphere(n) * 0.8;
     // The roots under full cover lie in the cards' shadow; the hairline's fine hairs in the open.
     float light_hair = sqrt(clamp(dot(u_color, vec3(0.2126, 0.7152, 0.0722)), 0.0, 1.0));
-#ifdef CROP
-    float shade = 0.85;   // a crop's coils shade only each other
-#else
     float shade = mix(0.9, mix(0.35, 0.7, light_hair), smoothstep(0.3, 1.0, v_depth));
-#endif
     float curl = 1.0;
 #ifdef COILY
     {  // and each curl shows its own light and shade
         vec2 kp = suv * 600.0;
         curl = 0.55 + 0.9 * mix(0.5, value_noise(kp, 0), clamp(1.8 - 1.4 * fwidth(kp.x), 0.0, 1.0));
-#ifdef CROP
-        alpha = min(alpha * mix(1.0, curl, 0.4), 1.0);
-#else
         alpha *= curl * 0.9;
-#endif
     }
 #endif
     vec3 albedo = hair_colour(suv * vec2(8.0, 2.0)) * (0.55 + 0.9 * tex.r) * shade * curl;
-#ifdef CROP
-    {   // Coils a millimetre and a few millimetres across, placed on the neutral head (v_rest) so
-        // they are round, not streaked along the tile's strands, with dark crevices between them.
-        // (lattices turned against the head's axes: an axis-aligned one drew a grid of dots)
-        const mat3 turn = mat3(0.788, 0.418, -0.452, -0.360, 0.908, 0.214, 0.500, -0.017, 0.866);
-        float kink = value_noise3(turn * v_rest * 110.0);
-        float coils = value_noise3(transpose(turn) * v_rest * 35.0 + 5.0);
-        albedo = hair_colour(v_rest.xy * 40.0) * (0.8 + 0.4 * tex.r) * (0.6 + 0.8 * kink) * (0.65 + 0.7 * coils) * shade;
-    }
-#endif
     f_color = vec4(finish(albedo * lit).rgb, alpha);
+#endif
 }
 #elif defined(KIND_WISPS)
 // Loose strands over the hair (facsim/head/wisps.py): thin ribbons turned toward the camera
@@ -228,9 +277,23 @@ void main() {
     f_color = vec4(finish(albedo * lit * 0.75 + spec).rgb, alpha);
 }
 #else
+#if defined(KIND_HAIR) && !defined(COILY)
+// MakeHuman's straight-hair textures fade their strands' tips over the last centimetre or two
+// of a card: where cards end over the skin (a fringe over the forehead, short01's front edge)
+// that fade drew a see-through band of brown film with the skin showing through it. Strands
+// are dense to near their tips: the fade is steepened into the last few millimetres, where
+// the strands end one by one (the fraying below), and the gaps between strands stay open.
+float dense_tips(float alpha) {
+    return smoothstep(0.04, 0.42, alpha);
+}
+#endif
+
 void main() {
     vec4 tex = texture(u_texture, v_uv);
     float alpha = tex.a;
+#if defined(KIND_HAIR) && !defined(COILY)
+    alpha = dense_tips(alpha);
+#endif
 #if defined(KIND_EYEBROWS) || defined(KIND_EYELASHES)
     // Brows and lashes are one thin layer of fine hairs: drawn whole in the blended pass and
     // translucent, so skin shows between the hairs and they read as hair, not paint. Their
@@ -371,6 +434,10 @@ void main() {
         // The cards' thin margins (the blended pass: the hairline, the temples) break into
         // curls with skin between them instead of lying over the skin as a pale glassy film.
         alpha *= mix(1.0, smoothstep(0.4, 0.6, halo), u_coil * (1.0 - smoothstep(0.3, 0.6, alpha)));
+        // A card's own cut edge (where the mass ends over the temples and the forehead) breaks
+        // into curls and clumps of curls ending at different places, so the mass meets the
+        // skin in a ragged fringe of coils, not along a brim.
+        alpha *= 1.0 - u_coil * smoothstep(0.35, 0.8, v_edge + 0.8 * (0.5 - 0.6 * coil_clump - 0.4 * halo) - 0.1);
     }
 #endif
     // Over a thinning hairline (v_cover < 1, see facsim/head/scalp.py) the cards break up into
@@ -419,6 +486,7 @@ void main() {
     float strand = (0.62 + 0.76 * tex.r) * (0.7 + 0.6 * fine) * (0.6 + 0.8 * px) * (0.8 + 0.4 * mid)
                  * (0.9 + 0.2 * clump);
 #ifdef COILY
+    float crown;   // coily clumps: 0 in a crevice ... 1 on a crown
     {
         // Coily hair (both passes: its translucent fringe at the hairline drew a flat light
         // band otherwise): at any distance its curls blend into a fine, even, matte texture. The
@@ -431,13 +499,16 @@ void main() {
         // The clumps' crevices are deep and dark; their crowns catch the light. The crevices
         // run where the clump noise crosses its mean: a connected network around rounded
         // clumps, not dark spots on a light field.
-        float crown = smoothstep(0.0, 0.22, abs(coil_clump - 0.5));
-        strand = mix(strand, (0.88 + 0.24 * tex.r) * (0.6 + 0.8 * kink) * (0.62 + 0.76 * curls)
-                             * mix(0.55, 1.1, crown), u_coil);
+        crown = smoothstep(0.0, 0.22, abs(coil_clump - 0.5));
+        // (the finest curls a pixel across keep little contrast: at full strength they
+        // speckled the mass)
+        strand = mix(strand, (0.88 + 0.24 * tex.r) * (0.8 + 0.4 * kink) * (0.7 + 0.6 * curls)
+                             * mix(0.6, 1.08, crown), u_coil);
         // Greying coily hair mixes white, grey and dark strands curl by curl and clump by
         // clump (placed on the head, not in the cards' mirrored UVs).
-        float white = clamp(u_grey + 0.5 * (value_noise3(v_rest * 22.0 + 4.0) - 0.5) + 0.45 * (kink - 0.5)
-                            + 0.2 * (crown - 0.5), 0.0, 1.0);
+        // (at full strength the mix speckled ngozi's afro grey and white pixel by pixel)
+        float white = clamp(u_grey + 0.4 * (value_noise3(v_rest * 22.0 + 4.0) - 0.5) + 0.2 * (kink - 0.5)
+                            + 0.15 * (crown - 0.5), 0.0, 1.0);
         albedo = (u_grey > 0.0 ? mix(u_pigment, u_white, white) : u_color) * strand;
     }
 #else
@@ -511,6 +582,10 @@ void main() {
                                     + 0.25 * glint * tint * exp2(40.0 * log2(s1)));
 #else
     vec3 spec = vec3(0.0);
+#endif
+#ifdef COILY
+    spec = mix(spec, coily_sheen(n, v, crown), u_coil);
+    self_shadow *= mix(1.0, coily_depth_shade(n, v), u_coil);
 #endif
     vec3 radiance = (albedo * lit + u_sheen * spec) * self_shadow;
 #else
