@@ -173,9 +173,8 @@ class Renderer:
         ``"wisps"``) blended, back to front. ``False`` saves ~10-15 % of a 512² frame on
         llvmpipe but leaves a hard, cut-out hairline. Brows and lashes always get theirs.
     shadows : bool
-        Cast the key light's soft shadows (the nose's on the lip, the brows' and lids' on the
-        eyes, the hair's on the forehead, the chin's on the neck) with a shadow map drawn
-        each frame; ``False`` leaves only the baked occlusion (about 7 % less CPU per 512²
+        Cast the key light's soft shadows (the nose's beside the nostril, the hair's on the
+        forehead and temples, the chin's on the neck) with a shadow map drawn each frame; ``False`` leaves only the baked occlusion (about 7 % less CPU per 512²
         FXAA frame on llvmpipe).
     cull_backfaces : bool
         Skip skin and eyeball triangles facing away (about 1.5x faster). Needs those

@@ -151,6 +151,7 @@ class KeyShadow:
         self._position_format = position_format  # the vertex buffer's layout, position first
         self._track = track
         self.texture = None
+        self.opacity = None
         self._fbo = None
         self.size = 0
         self.texel = SHADOW_TEXEL
@@ -166,6 +167,9 @@ class KeyShadow:
         if size == self.size:
             return
         ctx = self.ctx
+        for old in (self._fbo, self.opacity, self.texture):   # the last size's (the owner's release skips them)
+            if old is not None:
+                old.release()
         self.texture = self._track(ctx.depth_texture((size, size)))
         # Hardware comparison with bilinear filtering: each tap is a 2x2 PCF already.
         self.texture.compare_func = "<="
