@@ -10,7 +10,9 @@ from __future__ import annotations
 
 import os
 import re
+import signal
 import threading
+from contextlib import contextmanager
 from pathlib import Path
 
 
@@ -53,6 +55,33 @@ def _create_context():
 
 
 _SHADER_DIR = Path(__file__).with_name("shaders")
+
+#: The signals the CLI turns into KeyboardInterrupt (facsim.cli._stop_on_signals).
+_STOP_SIGNALS = {getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, name)}
+
+
+@contextmanager
+def _signals_held():
+    """Hold Ctrl-C, SIGTERM and SIGHUP until the block ends, then let them through.
+
+    moderngl builds a program's uniform and attribute objects in C through Python calls; a
+    KeyboardInterrupt raised by a signal handler inside them is not checked for, and the
+    process dies of SIGSEGV instead of cleaning up (tests/test_video.py's SIGTERM test caught
+    it while a video's shaders compiled)."""
+    if not hasattr(signal, "pthread_sigmask"):  # not POSIX
+        yield
+        return
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, _STOP_SIGNALS)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+
+
+def compile_program(ctx, vertex_shader: str, fragment_shader: str):
+    """``ctx.program(...)`` with stop signals held until it returns (:func:`_signals_held`)."""
+    with _signals_held():
+        return ctx.program(vertex_shader=vertex_shader, fragment_shader=fragment_shader)
 
 
 def _shader_source(name: str, defines: dict[str, object]) -> str:

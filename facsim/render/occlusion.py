@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from facsim.render.geometry import sphere_directions, vertex_normals
-from facsim.render.gl import gl_context
+from facsim.render.gl import compile_program, gl_context
 from facsim.head.mesh import RenderTopology
 
 _DEPTH_VS = """
@@ -68,8 +68,7 @@ def bake_occlusion(topology: RenderTopology, positions: np.ndarray, *, direction
     ctx = gl_context()
     objs = []
     try:
-        prog = ctx.program(vertex_shader="#version 330 core\n" + _DEPTH_VS,
-                           fragment_shader="#version 330 core\n" + _DEPTH_FS)
+        prog = compile_program(ctx, "#version 330 core\n" + _DEPTH_VS, "#version 330 core\n" + _DEPTH_FS)
         objs.append(prog)
         vbo = ctx.buffer(p.tobytes()); objs.append(vbo)
         ibo = ctx.buffer(faces.tobytes()); objs.append(ibo)

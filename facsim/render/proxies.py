@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from facsim.render.geometry import normal_operator, vertex_normals
-from facsim.render.gl import _set_uniform, _shader_source
+from facsim.render.gl import _set_uniform, _shader_source, compile_program
 from facsim.render.inputs import srgb_to_linear
 
 PROXY_KINDS = ("hair", "eyebrows", "eyelashes", "scalp", "wisps")
@@ -469,8 +469,8 @@ class ProxyLayer:
         for stage in ("OPAQUE", "BLEND"):
             defines = {f"PASS_{stage}": "", f"KIND_{mesh.kind.upper()}": "", "ALPHA_CUTOFF": f"{ALPHA_CUTOFF:.3f}",
                        **({"COILY": ""} if mesh.coily else {}), **({"CROP": ""} if mesh.crop else {})}
-            prog = track(ctx.program(vertex_shader=_shader_source("proxy.vert.glsl", defines),
-                                     fragment_shader=_shader_source("proxy.frag.glsl", defines)))
+            prog = track(compile_program(ctx, _shader_source("proxy.vert.glsl", defines),
+                                         _shader_source("proxy.frag.glsl", defines)))
             _set_uniform(prog, "u_texture", 1)
             _set_uniform(prog, "u_along_v", self._along_v)
             _set_uniform(prog, "u_strand_width", float(mesh.strand_width))

@@ -51,7 +51,7 @@ from facsim.media.images import write_png
 from facsim.render.geometry import (CREASES_PER_DM, _faces_touching, _orientation, crease_phase, eye_rotation, lash_coordinates,
                               normal_operator, region_components, scattered_normals, smoothing_operator,
                               sphere_centre, sphere_directions, surface_curvature, vertex_normals)
-from facsim.render.gl import RenderError, _set_uniform, _shader_source, gl_context
+from facsim.render.gl import RenderError, _set_uniform, _shader_source, compile_program, gl_context
 from facsim.render.inputs import (COLOR_NAMES, DEFAULT_BROW_UV_FRAME, DEFAULT_COLORS, HM08_BROW_UV_FRAME, REGIONS,
                             Appearance, Lighting, RenderTopology, brow_uv_frame, srgb_to_linear)
 from facsim.render.occlusion import bake_occlusion
@@ -283,9 +283,8 @@ class Renderer:
             defines["USE_PORES"] = ""
         if self.shadows and _group(name) in _SHADOW_RECEIVERS:
             defines["USE_SHADOW"] = ""
-        prog = self._track(ctx.program(
-            vertex_shader=_shader_source("face.vert.glsl", defines),
-            fragment_shader=_shader_source("face.frag.glsl", defines)))
+        prog = self._track(compile_program(ctx, _shader_source("face.vert.glsl", defines),
+                                               _shader_source("face.frag.glsl", defines)))
         vao = self._track(ctx.vertex_array(
             prog, [(self._vbo_dynamic, "3f 3f 1f 1f 1f 3f 1f", "in_pos", "in_normal", "in_wrinkle",
                     "in_occlusion", "in_crease", "in_scatter_normal", "in_curvature"),
@@ -393,10 +392,9 @@ class Renderer:
             defines = {"FACTOR": k}
             if self.background is None:
                 defines["UNPREMULTIPLY"] = ""
-            prog = self._track(ctx.program(
-                vertex_shader=_shader_source("fullscreen.vert.glsl", {}),
-                fragment_shader=_shader_source(f"{'fxaa' if self.aa_method == 'fxaa' else 'downsample'}.frag.glsl",
-                                               defines)))
+            prog = self._track(compile_program(
+                ctx, _shader_source("fullscreen.vert.glsl", {}),
+                _shader_source(f"{'fxaa' if self.aa_method == 'fxaa' else 'downsample'}.frag.glsl", defines)))
             _set_uniform(prog, "u_image", 0)
             self._downsample = self._track(ctx.vertex_array(prog, []))
         self._readback = bytearray(w * h * 4)
@@ -711,7 +709,7 @@ class Renderer:
         """Depth only (colour writes off, a trivial shader) of the culled, closed groups."""
         ctx = self._ctx
         if self._depth_vao is None:
-            prog = self._track(ctx.program(vertex_shader=_DEPTH_VERTEX, fragment_shader=_DEPTH_FRAGMENT))
+            prog = self._track(compile_program(ctx, _DEPTH_VERTEX, _DEPTH_FRAGMENT))
             self._depth_prog = prog
             self._depth_vao = self._track(ctx.vertex_array(
                 prog, [(self._vbo_dynamic, _POSITION_ONLY, "in_pos")], index_buffer=self._ibo, index_element_size=4))

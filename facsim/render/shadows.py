@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from facsim.render.gl import compile_program
 from facsim.render.proxies import ALPHA_CUTOFF, END_FADE
 
 #: World size (decimetres) of one shadow-map texel: 1.6 mm, so the 3-texel filter gives the
@@ -157,8 +158,8 @@ class KeyShadow:
         self.texel = SHADOW_TEXEL
         self.matrix = np.eye(4)
         self.depth_range = 1.0
-        self._program = track(ctx.program(vertex_shader=_CASTER_VERTEX, fragment_shader=_CASTER_FRAGMENT))
-        self._card_program = track(ctx.program(vertex_shader=_CARD_VERTEX, fragment_shader=_CARD_FRAGMENT))
+        self._program = track(compile_program(ctx, _CASTER_VERTEX, _CASTER_FRAGMENT))
+        self._card_program = track(compile_program(ctx, _CARD_VERTEX, _CARD_FRAGMENT))
         self._card_program["u_texture"].value = 1
         self._vao = None
         self._card_vaos: dict = {}
