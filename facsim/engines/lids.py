@@ -187,6 +187,14 @@ def rest_table() -> dict:
     return load_yaml("lids.yaml")["rest"]
 
 
+def _margin_over_pupil(lids: EyeLids, rest: np.ndarray, ahead_degrees: float) -> tuple[np.ndarray, float]:
+    """The upper margin's points over the pupil (within ``ahead_degrees`` of straight ahead; the
+    whole margin if fewer than two are) and their mean height above the eye's centre on ``rest``."""
+    ahead = np.abs(lids.upper_lam) < ahead_degrees
+    upper = lids.upper[ahead] if ahead.sum() >= 2 else lids.upper
+    return upper, float(np.mean(rest[upper, 1])) - float(lids.centre[1])
+
+
 def rest_lid_weight(lids: EyeLids, rest: np.ndarray, closing: np.ndarray, radius: float,
                     spec: dict | None = None) -> float:
     """The share of ``closing`` that lowers this eye's upper lid margin to a relaxed height.
@@ -208,9 +216,7 @@ def rest_lid_weight(lids: EyeLids, rest: np.ndarray, closing: np.ndarray, radius
     spec = spec or rest_table()
     if not lids.ok:
         return 0.0
-    ahead = np.abs(lids.upper_lam) < float(spec["ahead_degrees"])
-    upper = lids.upper[ahead] if ahead.sum() >= 2 else lids.upper
-    height = float(np.mean(rest[upper, 1])) - float(lids.centre[1])
+    upper, height = _margin_over_pupil(lids, rest, float(spec["ahead_degrees"]))
     drop = -float(np.mean(closing[upper, 1]))           # dm per unit share
     target = float(spec["iris_radius"]) * radius - 0.01 * float(spec["cover_mm"])
     if drop <= 1e-9:
@@ -231,9 +237,7 @@ def raise_gain(lids: EyeLids, rest: np.ndarray, raising: np.ndarray, radius: flo
     rest_spec, spec = table["rest"], spec or table["raise"]
     if not lids.ok:
         return 1.0
-    ahead = np.abs(lids.upper_lam) < float(rest_spec["ahead_degrees"])
-    upper = lids.upper[ahead] if ahead.sum() >= 2 else lids.upper
-    height = float(np.mean(rest[upper, 1])) - float(lids.centre[1])
+    upper, height = _margin_over_pupil(lids, rest, float(rest_spec["ahead_degrees"]))
     lift = float(np.mean(raising[upper, 1]))
     iris_top = float(rest_spec["iris_radius"]) * radius
     mm = iris_top / (0.5 * float(rest_spec["iris_mm"]))

@@ -571,11 +571,11 @@ def bind_character_proxies(character, head, base_positions, neutral_geometry, *,
     for kind in ("hair", "eyebrows", "eyelashes"):
         name = chosen[kind]
         if name:
-            crop = (crop_footprint(name) and name) if kind == "hair" else None
-            proxy = library[crop_footprint(name) if crop else name]
+            footprint = crop_footprint(name) if kind == "hair" else None  # a crop binds its footprint's style
+            proxy = library[footprint or name]
             binding = bind_to_frame(proxy, head, base_positions, neutral_geometry, look)
             out.append(BoundProxy(proxy, binding, COLOR_KEY[kind], density[kind],
-                                  binding.positions(neutral_geometry), crop=crop or ""))
+                                  binding.positions(neutral_geometry), crop=name if footprint else ""))
     return out
 
 

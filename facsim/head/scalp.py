@@ -42,7 +42,7 @@ HAIRLINE_WIDTH = 0.06
 #: Height (dm) of the layer over the skin: enough not to fight it in the depth buffer.
 LIFT = 0.004
 #: Bump when the layer a character gets changes (its disk cache is keyed by it).
-VERSION = 12  # 2: afro01's cards stand off the skull (volume_mm in hair.yaml); 3: crops' rounded hairline
+VERSION = 12  # 2: afro01's cards stand off the skull (volume_mm in hair.yaml); 12: crops' anatomical, rounded hairline
 #: Close crops (:func:`crop_hairline`): the radius (dm) over which the hairline is rounded off
 #: (the skin's vertices lie about a centimetre apart: an edge along them runs in steps) ...
 CROP_ROUNDING = 0.07

@@ -174,8 +174,9 @@ class Renderer:
         llvmpipe but leaves a hard, cut-out hairline. Brows and lashes always get theirs.
     shadows : bool
         Cast the key light's soft shadows (the nose's beside the nostril, the hair's on the
-        forehead and temples, the chin's on the neck) with a shadow map drawn each frame; ``False`` leaves only the baked occlusion (about 7 % less CPU per 512²
-        FXAA frame on llvmpipe).
+        forehead and temples, the chin's on the neck) with a shadow map drawn each frame;
+        ``False`` leaves only the baked occlusion (about 7 % less CPU per 512² FXAA frame on
+        llvmpipe).
     cull_backfaces : bool
         Skip skin and eyeball triangles facing away (about 1.5x faster). Needs those
         surfaces closed (cap the neck); the winding is checked on the first frame and
