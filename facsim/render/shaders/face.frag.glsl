@@ -72,6 +72,9 @@ vec3 specular_light(vec3 n, vec3 v, float shininess) {
 uniform sampler2D u_paint;   // R brow hair density, G lips, B eyelids, A cheek blush
 uniform sampler2D u_detail;  // R redness, G beard area, B oiliness, A uneven pigment
 const float FOLD_TEXELS = 3.0;   // a groove's half-width in fold-map texels (~0.8 mm each on the face)
+const float FOLD_RELIEF = 1.6;   // height of the grooves and their rolls, of the map's groove depth
+const vec2 CREVICE_SHADE = vec2(0.12, 0.05);   // shade at the floor: lines (R), under-eye lines (G)
+const float GROOVE_SCATTER = 0.5;   // share of the grooves' slope the scattered light sees
 uniform sampler2D u_folds;   // R forehead lines + crow's feet, G under-eye lines, B fold shade,
                              // A where R and G replace the engine's furrows (facsim.head.skin)
 uniform sampler2D u_tone;    // R darker skin (eyes, mouth, temples), G translucency, B pores, A sun (facsim.head.skin)
@@ -531,8 +534,14 @@ void main() {
 #else
     float line_depth = u_age;
 #endif
-    float lines = folds.r * line_depth, under_eye = folds.g * u_age;
-    float cavity = (1.0 - 0.1 * lines - 0.04 * under_eye) * (1.0 - 0.12 * u_age * folds.b);
+    // Only a crevice's floor, narrower than the groove (its depth profile to the 6th power: ~1.2
+    // mm either side), darkens: light reaches it only from a narrow cone. (Until session 19 the
+    // whole 3-5-mm groove darkened by 10 % of its depth, its lit flank too: under the frontal key
+    // the lines drew as dark brown-red strokes, the reviewer's "painted forehead wrinkles".)
+    vec2 floor_g = folds.rg * folds.rg;
+    floor_g *= floor_g * floor_g;
+    float cavity = (1.0 - CREVICE_SHADE.x * floor_g.x * line_depth - CREVICE_SHADE.y * floor_g.y * u_age)
+                 * (1.0 - 0.12 * u_age * folds.b);
     // Surface frame for bump mapping from screen derivatives (Mikkelsen's surface gradient):
     // a height h tilts the normal to normalize(|det| n - sign(det) (dh/dx r1 + dh/dy r2)).
     vec3 dpdx = dFdx(v_pos), dpdy = dFdy(v_pos);
@@ -547,8 +556,15 @@ void main() {
     vec2 texel = v_uv * vec2(textureSize(u_folds, 0));
     float groove_px = FOLD_TEXELS / max(max(length(dFdx(texel)), length(dFdy(texel))), 1e-6);
     vec2 depth = vec2(-0.018 * line_depth, -0.006 * u_age) * clamp(groove_px - 1.5, 0.0, 1.0);
-    float dh_dx = dot(dFdx(folds.rg), depth), dh_dy = dot(dFdy(folds.rg), depth);
-    n = normalize(abs(det) * n - sign(det) * (dh_dx * r1 + dh_dy * r2));
+    // The skin a groove gathers is pushed up beside it into rolls: the height is the grooves less
+    // the same map blurred over ~4x their width (its mip level two up), so the surface between
+    // two lines bulges into a roll whose lower half faces down, into soft shade, as a compressed
+    // forehead's does, instead of lying flat between sunk grooves.
+    vec2 rolls = texture(u_folds, v_uv, 2.0).rg;
+    vec2 fold_h = FOLD_RELIEF * (folds.rg - rolls);
+    float dh_dx = dot(dFdx(fold_h), depth), dh_dy = dot(dFdy(fold_h), depth);
+    vec3 groove_grad = sign(det) * (dh_dx * r1 + dh_dy * r2);
+    n = normalize(abs(det) * n - groove_grad);
 #ifdef USE_WRINKLE
     // The engine's furrows, except where the fold map draws the lines itself (folds.a).
     Fold fold = crease_fold(v_wrinkle * (1.0 - folds.a) * (1.0 - mucosa), v_crease, v_uv);
@@ -613,6 +629,10 @@ void main() {
     // blue most: folds look soft and warm, not carved in grey (v_scatter_normal is the normal
     // averaged over two rings of neighbours, ~1 cm).
     vec3 n_scatter = normalize(gl_FrontFacing ? v_scatter_normal : -v_scatter_normal);
+    // The drawn grooves and rolls are 3-5 mm across, about as far as red light travels under the
+    // skin, not the centimetre the averaged normal smooths over: the scattered light sees half
+    // their slope. (Seeing none of it, the grooves' shade was all green and blue: red lines.)
+    n_scatter = normalize(abs(det) * n_scatter - GROOVE_SCATTER * groove_grad);
     vec3 softness = SCATTER_SOFTNESS * (1.0 - hair);
     // (The key only: it alone draws the small relief's light and shade; the fill, rim and
     // sky are broad and dim, and a second full evaluation cost ~10 % of a video frame.)
