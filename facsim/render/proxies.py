@@ -61,8 +61,8 @@ class ProxyMesh:
     rest : (V, 3) float, optional
         Hair: vertex positions at rest (the neutral face). Which cards neighbour which is
         read from them once, so a frame's shading never depends on the frames before it.
-        Without them strand directions are not averaged across cards. A close crop's scalp
-        layer: where its coils lie (they move with the skin).
+        Without them strand directions are not averaged across cards. A close crop's or coily
+        hair's scalp layer: where its coils lie (they move with the skin).
     cover : (V,) float, optional
         Hair: the scalp's hair density under each vertex (1 full … 0 bare; default 1).
         Cards over a thinning hairline break up into strands, so they fade into the scalp

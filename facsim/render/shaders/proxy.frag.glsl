@@ -160,12 +160,14 @@ vec3 coily_sheen(vec3 n, vec3 v, float crown) {
 #endif
 
 #ifdef KIND_SCALP
+// Coily hair on the scalp is placed on the neutral head (v_rest) in lattices turned against the
+// head's axes (an axis-aligned one drew a grid of dots).
+const mat3 crop_turn = mat3(0.788, 0.418, -0.452, -0.360, 0.908, 0.214, 0.500, -0.017, 0.866);
 #ifdef CROP
 // A close crop (facsim/head/scalp.py; no cards over it): coily hair a few millimetres long is
 // all the hair there is. v_cover: the distance inside its hairline in widths of the band over
 // which the hair thins (scalp.CROP_EDGE; linear across the skin's triangles, so the hairline
 // is placed per pixel, not along the mesh's edges); v_rest: the neutral head, where the coils lie.
-const mat3 crop_turn = mat3(0.788, 0.418, -0.452, -0.360, 0.908, 0.214, 0.500, -0.017, 0.866);
 
 // The hair's cover (0 bare skin ... 1 solid) at the hairline: it wanders by a few millimetres
 // (tufts grow forward, gaps recede, clump by clump) and thins over the band from solid hair to
@@ -272,15 +274,23 @@ void main() {
     vec3 lit = dk * u_key_col + df * u_fill_col + hemisphere(n) * 0.8;
     // The roots under full cover lie in the cards' shadow; the hairline's fine hairs in the open.
     float light_hair = sqrt(clamp(dot(u_color, vec3(0.2126, 0.7152, 0.0722)), 0.0, 1.0));
-    float shade = mix(0.9, mix(0.35, 0.7, light_hair), smoothstep(0.3, 1.0, v_depth));
     float curl = 1.0;
 #ifdef COILY
-    {  // and each curl shows its own light and shade
-        vec2 kp = suv * 600.0;
-        curl = 0.55 + 0.9 * mix(0.5, value_noise(kp, 0), clamp(1.8 - 1.4 * fwidth(kp.x), 0.0, 1.0));
-        alpha *= curl * 0.9;
+    {
+        // Coily hair at the hairline: curls a millimetre and a few millimetres across, placed on
+        // the head like the cards' and a crop's (the tile's own curls are finer than a pixel at
+        // stimulus sizes and left a smooth pale film along the hairline, a brim under the mass),
+        // with skin between them where the cover thins; the roots under full cover lie in the
+        // mass's shade, darker than straight hair's whatever the colour (the mass is dense).
+        vec3 p = crop_turn * v_rest;
+        float kink = value_noise3(p * 110.0);
+        float coils = value_noise3(transpose(crop_turn) * v_rest * 35.0 + 5.0);
+        curl = (0.55 + 0.9 * kink) * (0.6 + 0.8 * coils);
+        alpha *= smoothstep(0.3, 0.7, 0.55 * coils + 0.45 * kink + 0.35 * (dens - 0.6));
+        light_hair *= 0.4;
     }
 #endif
+    float shade = mix(0.9, mix(0.35, 0.7, light_hair), smoothstep(0.3, 1.0, v_depth));
     vec3 albedo = hair_colour(suv * vec2(8.0, 2.0)) * (0.55 + 0.9 * tex.r) * shade * curl;
     f_color = vec4(finish(albedo * lit).rgb, alpha);
 #endif
