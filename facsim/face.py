@@ -158,7 +158,8 @@ class Face:
         from facsim.render.proxies import ProxyMesh
 
         return [ProxyMesh(b.proxy.name, b.proxy.kind, b.proxy.triangles, b.proxy.corner_vertex, b.proxy.uv,
-                          b.proxy.texture, b.depth, b.neutral if b.proxy.kind in ("hair", "wisps") or b.crop else None,
+                          b.proxy.texture, b.depth,
+                          b.neutral if b.proxy.kind in ("hair", "wisps") or b.crop or b.coil > 0.0 else None,
                           self._card_cover(b) if b.proxy.kind == "hair" else None, b.coil > 0.0,
                           b.strand_points, b.strand_width,
                           self._hair_end_height if b.proxy.kind in ("hair", "wisps") else None, bool(b.crop),

@@ -240,3 +240,37 @@ def test_a_close_crop_grows_on_the_scalp_with_temples_sideburns_and_a_soft_hairl
     length = np.linalg.norm(skin[edges[:, 0]] - skin[edges[:, 1]], axis=1)
     assert len(edges) > 50 and np.all(step <= length * 1.05 + 1e-3)
     assert np.median(step / length) > 0.4
+
+
+def test_coily_hair_at_the_hairline_shows_curls_not_a_smooth_film():
+    """Coily hair's scalp layer (afro01's hairline) seen at a stimulus's scale: curls a pixel or
+    a few across with skin between them, not the tile's curls averaged into a smooth pale film
+    (the brim under ngozi's afro, session 18). The detail finer than 2 px over the layer's mean."""
+    from scipy.ndimage import gaussian_filter
+
+    from facsim.render.camera import frame_camera
+    from facsim.render.proxies import ProxyDraw, ProxyMesh
+    from facsim.render.renderer import DEFAULT_COLORS, REGIONS, Appearance, Renderer, RenderTopology
+
+    points, triangles = _grid(n=24, size=0.6)
+    points -= [0.3, 0.3, 0.0]
+    skin = RenderTopology(faces=triangles, render_to_geo=np.arange(len(points)),
+                          uv=np.zeros((len(points), 2), np.float32),
+                          region=np.full(len(points), REGIONS.index("skin"), np.uint8),
+                          eye_coord=np.zeros((len(points), 3), np.float32))
+    hair = points + [0.0, 0.0, 0.002]
+    layer = ProxyMesh(name="coily_scalp", kind="scalp", triangles=triangles, corner_vertex=np.arange(len(hair)),
+                      uv=(points[:, :2] / 0.3).astype(np.float32), texture=scalp.strand_texture(),
+                      depth=np.ones(len(hair), np.float32), rest=hair, coily=True)
+    camera = frame_camera([-0.3, -0.3, 0.0], [0.3, 0.3, 0.01], view="front")
+    with Renderer(skin, size=160, shadows=False) as renderer:
+        kwargs = dict(appearance=Appearance(DEFAULT_COLORS), camera=camera)
+        bare = renderer.render(points.astype(np.float32), **kwargs).astype(np.float32)
+        drawn = renderer.render(points.astype(np.float32), **kwargs,
+                                proxies=[ProxyDraw(layer, hair.astype(np.float32), (0.12, 0.1, 0.09), coil=1.0)])
+    lum = drawn[..., :3].astype(np.float32) @ np.array([0.2126, 0.7152, 0.0722], np.float32)
+    inside = np.zeros(lum.shape, bool)
+    inside[40:120, 40:120] = True
+    assert np.abs(drawn[..., :3] - bare[..., :3])[inside].mean() > 10   # the layer is there
+    fine = (lum - gaussian_filter(lum, 2.0))[inside].std() / lum[inside].mean()
+    assert fine > 0.15   # (0.095 with the tile's curls, 0.22 with curls placed on the head)

@@ -173,3 +173,48 @@ def test_a_face_shadows_the_side_away_from_the_key_and_the_neck_stays_open(ava):
     neck = (slice(145, 158), slice(70, 90))
     assert on[neck][..., :3].mean() < off[neck][..., :3].mean()
     assert on[neck][..., :3].mean() > 0.45 * off[neck][..., :3].mean()
+
+
+def hair_cylinder(radius: float = 0.5, n_around: int = 96, n_up: int = 24):
+    """A ProxyMesh of hair: a ring of card around the vertical axis, 2 units tall, in front of
+    the face (its front passes between the face and the nose), with a solid texture."""
+    from facsim.render.proxies import ProxyMesh
+
+    phi = np.linspace(-np.pi, np.pi, n_around + 1)
+    y = np.linspace(-1.0, 1.0, n_up + 1)
+    pp, yy = np.meshgrid(phi, y, indexing="ij")
+    points = np.stack([radius * np.sin(pp), yy, radius * np.cos(pp)], -1).reshape(-1, 3)
+    ids = np.arange(len(points)).reshape(n_around + 1, n_up + 1)
+    a, b, c, d = ids[:-1, :-1], ids[1:, :-1], ids[1:, 1:], ids[:-1, 1:]
+    triangles = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3), np.stack([a, c, d], -1).reshape(-1, 3)])
+    uv = np.stack([pp.ravel() / (2 * np.pi) + 0.5, yy.ravel() * 0.5 + 0.5], -1)
+    texture = np.full((16, 16, 4), 200, np.uint8)
+    texture[..., 3] = 255
+    mesh = ProxyMesh(name="ring", kind="hair", triangles=triangles, corner_vertex=np.arange(len(points)),
+                     uv=uv, texture=texture, rest=points)
+    return mesh, points.astype(np.float32)
+
+
+def test_hair_receives_the_key_shadow_of_what_stands_between_it_and_the_key(scene):
+    """Hair in the nose's shadow is darker with shadows on; hair in the open is not (the cards
+    do not shadow themselves)."""
+    from facsim.render.proxies import ProxyDraw
+
+    topology, positions, camera = scene
+    mesh, points = hair_cylinder()
+    draw = ProxyDraw(mesh=mesh, positions=points, color=(0.45, 0.3, 0.2))
+
+    def shot(shadows):
+        with Renderer(topology, size=128, shadows=shadows) as renderer:
+            return renderer.render(positions, appearance=Appearance(DEFAULT_COLORS), camera=camera,
+                                   lighting=Lighting(key_direction=KEY), proxies=[draw])
+
+    lit, shaded = shot(False), shot(True)
+    # Where the nose's shadow falls on the hair's ring (radius 0.5 about the vertical axis).
+    d = np.asarray(KEY, float) / np.linalg.norm(KEY)
+    ts = np.linspace(0.0, 2.0, 4001)
+    ring = NOSE_CENTRE - ts[:, None] * d
+    here = ring[np.argmax(np.hypot(ring[:, 0], ring[:, 2]) <= 0.5)]   # the first crossing, in front
+    open_hair = here * [-1.0, 1.0, 1.0]
+    assert disc_mean(shaded, camera, here, radius_px=2) < 0.8 * disc_mean(lit, camera, here, radius_px=2)
+    assert disc_mean(shaded, camera, open_hair) == pytest.approx(disc_mean(lit, camera, open_hair), abs=2.0)

@@ -28,6 +28,10 @@ from facsim.render.gl import _set_uniform, _shader_source, compile_program
 from facsim.render.inputs import srgb_to_linear
 
 PROXY_KINDS = ("hair", "eyebrows", "eyelashes", "scalp", "wisps")
+#: Proxy kinds shaded with the key light's cast shadow (the hair's mass shadows itself, and
+#: the head and the cards above shadow the scalp's fine hair). Brows, lashes and loose strands
+#: are finer than the shadow map's texels.
+SHADOW_RECEIVERS = ("hair", "scalp")
 #: Alpha at and above which a fragment belongs to the opaque (alpha-tested) pass.
 ALPHA_CUTOFF = 0.5
 
@@ -57,8 +61,8 @@ class ProxyMesh:
     rest : (V, 3) float, optional
         Hair: vertex positions at rest (the neutral face). Which cards neighbour which is
         read from them once, so a frame's shading never depends on the frames before it.
-        Without them strand directions are not averaged across cards. A close crop's scalp
-        layer: where its coils lie (they move with the skin).
+        Without them strand directions are not averaged across cards. A close crop's or coily
+        hair's scalp layer: where its coils lie (they move with the skin).
     cover : (V,) float, optional
         Hair: the scalp's hair density under each vertex (1 full … 0 bare; default 1).
         Cards over a thinning hairline break up into strands, so they fade into the scalp
@@ -395,9 +399,12 @@ def _weld_operator(corner_vertex: np.ndarray):
 class ProxyLayer:
     """GL objects for one :class:`ProxyMesh` (owned and released by a Renderer)."""
 
-    def __init__(self, ctx, mesh: ProxyMesh, track):
+    def __init__(self, ctx, mesh: ProxyMesh, track, *, shadow_units: tuple[int, int] | None = None):
         self.ctx = ctx
         self.mesh = mesh
+        # Hair and the scalp's hair receive the key light's cast shadow (facsim.render.shadows)
+        # when given the texture units of its depth and caster opacity.
+        self.receives_shadow = shadow_units is not None and mesh.kind in SHADOW_RECEIVERS
         self._triangles = np.ascontiguousarray(mesh.triangles, np.uint32)
         self._n_corners = len(mesh.corner_vertex)
         self._normal_op = normal_operator(self._triangles, self._n_corners)
@@ -468,7 +475,8 @@ class ProxyLayer:
         self._ibo["SUBSET"] = track(ctx.buffer(reserve=max(self._triangles.nbytes, 12), dynamic=True))
         for stage in ("OPAQUE", "BLEND"):
             defines = {f"PASS_{stage}": "", f"KIND_{mesh.kind.upper()}": "", "ALPHA_CUTOFF": f"{ALPHA_CUTOFF:.3f}",
-                       **({"COILY": ""} if mesh.coily else {}), **({"CROP": ""} if mesh.crop else {})}
+                       **({"COILY": ""} if mesh.coily else {}), **({"CROP": ""} if mesh.crop else {}),
+                       **({"USE_SHADOW": ""} if self.receives_shadow else {})}
             prog = track(compile_program(ctx, _shader_source("proxy.vert.glsl", defines),
                                          _shader_source("proxy.frag.glsl", defines)))
             _set_uniform(prog, "u_texture", 1)
@@ -476,6 +484,9 @@ class ProxyLayer:
             _set_uniform(prog, "u_strand_width", float(mesh.strand_width))
             _set_uniform(prog, "u_end_height", -1e3 if mesh.end_height is None else float(mesh.end_height))
             _set_uniform(prog, "u_end_fade", END_FADE)
+            if self.receives_shadow:
+                _set_uniform(prog, "u_shadow", shadow_units[0])
+                _set_uniform(prog, "u_shadow_opacity", shadow_units[1])
             self.programs[stage] = prog
             self.vaos[stage] = track(ctx.vertex_array(
                 prog, [(self._vbo, "3f 3f 3f 1f 1f", "in_pos", "in_normal", "in_tangent", "in_depth", "in_edge"),
@@ -590,6 +601,20 @@ class ProxyLayer:
                 pass
             for name, value in lights.items():
                 _set_uniform(prog, name, value)
+
+    def set_shadow_uniforms(self, uniforms: dict) -> None:
+        """This frame's shadow map uniforms (:meth:`facsim.render.shadows.KeyShadow.uniforms`)."""
+        if not self.receives_shadow:
+            return
+        for prog in self.programs.values():
+            for name, value in uniforms.items():
+                if isinstance(value, bytes):
+                    try:
+                        prog[name].write(value)
+                    except KeyError:
+                        pass
+                else:
+                    _set_uniform(prog, name, value)
 
     def caster_vertex_array(self, program):
         """A vertex array of this layer's cards for ``program`` (inputs ``in_pos``, ``in_uv``,

@@ -546,6 +546,10 @@ class Renderer:
         self._lap("proxies")
         self._draw_key_shadow()
         self._lap("shadow")
+        # (after the shadow map: the kept hair pixels are shaded with this frame's)
+        if proxies:
+            self._prepare_hair_layer(self._vp_bytes, self._lights)
+            self._lap("proxies")
         self._draw()
         self._lap("draw")
         self._resolve()
@@ -605,7 +609,9 @@ class Renderer:
             if not isinstance(draw, ProxyDraw):
                 raise TypeError(f"proxies must be ProxyDraw objects, got {type(draw).__name__}")
             if draw.mesh not in self._proxy_layers:
-                self._proxy_layers[draw.mesh] = ProxyLayer(self._ctx, draw.mesh, self._track)
+                self._proxy_layers[draw.mesh] = ProxyLayer(
+                    self._ctx, draw.mesh, self._track,
+                    shadow_units=(_SHADOW_UNIT, _SHADOW_OPACITY_UNIT) if self.shadows else None)
         self._proxy_draws = tuple(proxies)
         if not proxies:
             self._hair_last, self._hair_moving = None, None
@@ -616,7 +622,6 @@ class Renderer:
             layer = self._proxy_layers[draw.mesh]
             layer.update(draw, position)
             layer.set_uniforms(vp_bytes, lights, self._scene_fbo.size)
-        self._prepare_hair_layer(vp_bytes, lights)
 
     @contextmanager
     def sequence(self):
@@ -852,6 +857,9 @@ class Renderer:
         seen = (np.abs(x) <= w) & (np.abs(y) <= w) & (np.abs(z) <= w)
         shadow.draw(self._lights["u_key_dir"], points, self._vbo_dynamic, self._ibo, draws, hair, seen)
         uniforms = shadow.uniforms()
+        shadow.use(_SHADOW_UNIT, _SHADOW_OPACITY_UNIT)
+        for draw in self._proxy_draws:
+            self._proxy_layers[draw.mesh].set_shadow_uniforms(uniforms)
         for name, prog in self._programs.items():
             if _group(name) not in _SHADOW_RECEIVERS:
                 continue

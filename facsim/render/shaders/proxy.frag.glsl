@@ -4,6 +4,7 @@
 // KIND_SCALP, KIND_WISPS; COILY for coily hair (its curls cost llvmpipe time even where a uniform skips them).
 
 #include "common.glsl"
+#include "shadow.glsl"
 
 in vec3 v_pos;
 in vec3 v_normal;
@@ -103,6 +104,35 @@ float pixel_strands(vec3 rest, vec3 along, float cells_per_dm) {
     return mix(0.5, clamp(n, 0.0, 1.0), clamp(2.2 - 1.6 * cells, 0.0, 1.0));
 }
 
+#if defined(USE_SHADOW) && defined(KIND_HAIR)
+// How much of the key reaches p (world; n: the volume's normal) inside the hair's mass, a
+// cheap deep-opacity map: the shadow map holds the depth of the first thing the key meets,
+// and the light a strand gets falls off with the depth of hair between it and that first
+// caster, exp(-depth / free_path) (a strand in the outer layer keeps it all, the under-layers
+// a few millimetres in get less, the hair under the mass of an afro or under the crown's
+// overhang little), down to what the caster lets through (its opacity: hair, less for light
+// hair; skin, none: the head's shadow on the hair). Four hardware comparisons at increasing
+// depths give how much of the footprint has its first caster within each of them.
+const vec4 HAIR_SHADOW_STEPS_MM = vec4(1.5, 4.0, 8.0, 16.0);
+
+float hair_key_visibility(vec3 p, vec3 n, float free_path_mm) {
+    vec3 c = (u_shadow_matrix * vec4(p + n * u_shadow_texel, 1.0)).xyz;
+    float mm = 0.01 / u_shadow_depth_range;   // one millimetre in the map's depth
+    vec4 within = vec4(texture(u_shadow, vec3(c.xy, c.z - HAIR_SHADOW_STEPS_MM.x * mm)),
+                       texture(u_shadow, vec3(c.xy, c.z - HAIR_SHADOW_STEPS_MM.y * mm)),
+                       texture(u_shadow, vec3(c.xy, c.z - HAIR_SHADOW_STEPS_MM.z * mm)),
+                       texture(u_shadow, vec3(c.xy, c.z - HAIR_SHADOW_STEPS_MM.w * mm)));
+    // (the share of the footprint whose first caster lies in each band of depth before p,
+    // and the light through that band's middle)
+    vec4 share = within - vec4(0.0, within.xyz);
+    vec4 through = exp(-vec4(0.0, 2.75, 6.0, 12.0) / free_path_mm);
+    float opacity = texture(u_shadow_opacity, c.xy).r;
+    float stopped = dot(share, 1.0 - through) + (1.0 - within.w);
+    float inside = step(0.0, c.x) * step(c.x, 1.0) * step(0.0, c.y) * step(c.y, 1.0) * step(c.z, 1.0);
+    return 1.0 - stopped * opacity * inside;
+}
+#endif
+
 // Kajiya-Kay: light scattered by a thin cylinder along t.
 float strand_diffuse(vec3 t, vec3 l) {
     float tl = dot(t, l);
@@ -130,12 +160,14 @@ vec3 coily_sheen(vec3 n, vec3 v, float crown) {
 #endif
 
 #ifdef KIND_SCALP
+// Coily hair on the scalp is placed on the neutral head (v_rest) in lattices turned against the
+// head's axes (an axis-aligned one drew a grid of dots).
+const mat3 crop_turn = mat3(0.788, 0.418, -0.452, -0.360, 0.908, 0.214, 0.500, -0.017, 0.866);
 #ifdef CROP
 // A close crop (facsim/head/scalp.py; no cards over it): coily hair a few millimetres long is
 // all the hair there is. v_cover: the distance inside its hairline in widths of the band over
 // which the hair thins (scalp.CROP_EDGE; linear across the skin's triangles, so the hairline
 // is placed per pixel, not along the mesh's edges); v_rest: the neutral head, where the coils lie.
-const mat3 crop_turn = mat3(0.788, 0.418, -0.452, -0.360, 0.908, 0.214, 0.500, -0.017, 0.866);
 
 // The hair's cover (0 bare skin ... 1 solid) at the hairline: it wanders by a few millimetres
 // (tufts grow forward, gaps recede, clump by clump) and thins over the band from solid hair to
@@ -174,11 +206,16 @@ vec4 close_crop() {
     float tips = kink * (0.6 + 0.8 * coils);
     float kl = clamp(dot(n, u_key_dir) * 0.5 + 0.5, 0.0, 1.0);
     float dk = kl * kl * 1.25;   // coils face every way: no strand direction
+#ifdef USE_SHADOW
+    float key_reach = key_visibility(v_pos, n);   // the ears', the head's shadow
+#else
+    float key_reach = 1.0;
+#endif
     float df = clamp(dot(n, u_fill_dir) * 0.5 + 0.5, 0.0, 1.0);
-    vec3 lit = dk * u_key_col + df * u_fill_col + hemisphere(n) * 0.8;
+    vec3 lit = dk * key_reach * u_key_col + df * u_fill_col + hemisphere(n) * 0.8;
     // A broad, soft sheen where the pile faces the key light, carried by the coils' tips.
     vec3 h = normalize(u_key_dir + v);
-    vec3 sheen = u_key_col * 0.1 * u_sheen * pow(max(dot(n, h), 0.0), 6.0) * smoothstep(0.35, 0.8, tips);
+    vec3 sheen = key_reach * u_key_col * 0.1 * u_sheen * pow(max(dot(n, h), 0.0), 6.0) * smoothstep(0.35, 0.8, tips);
     // Greying: white and pigmented coils mixed clump by clump, placed on the head in 3-D (a
     // pattern in two of its coordinates ran as streaks along the third, across the temples).
     vec3 colour = u_color;
@@ -230,19 +267,30 @@ void main() {
     vec3 t = normalize(v_tangent);
     float kl = clamp(dot(n, u_key_dir) * 0.5 + 0.5, 0.0, 1.0);
     float dk = mix(strand_diffuse(t, u_key_dir), 1.0, 0.3) * kl * kl * 1.25;
+#ifdef USE_SHADOW
+    dk *= key_visibility(v_pos, n);   // under the cards' shadow, as the skin it lies on
+#endif
     float df = clamp(dot(n, u_fill_dir) * 0.5 + 0.5, 0.0, 1.0);
     vec3 lit = dk * u_key_col + df * u_fill_col + hemisphere(n) * 0.8;
     // The roots under full cover lie in the cards' shadow; the hairline's fine hairs in the open.
     float light_hair = sqrt(clamp(dot(u_color, vec3(0.2126, 0.7152, 0.0722)), 0.0, 1.0));
-    float shade = mix(0.9, mix(0.35, 0.7, light_hair), smoothstep(0.3, 1.0, v_depth));
     float curl = 1.0;
 #ifdef COILY
-    {  // and each curl shows its own light and shade
-        vec2 kp = suv * 600.0;
-        curl = 0.55 + 0.9 * mix(0.5, value_noise(kp, 0), clamp(1.8 - 1.4 * fwidth(kp.x), 0.0, 1.0));
-        alpha *= curl * 0.9;
+    {
+        // Coily hair at the hairline: curls a millimetre and a few millimetres across, placed on
+        // the head like the cards' and a crop's (the tile's own curls are finer than a pixel at
+        // stimulus sizes and left a smooth pale film along the hairline, a brim under the mass),
+        // with skin between them where the cover thins; the roots under full cover lie in the
+        // mass's shade, darker than straight hair's whatever the colour (the mass is dense).
+        vec3 p = crop_turn * v_rest;
+        float kink = value_noise3(p * 110.0);
+        float coils = value_noise3(transpose(crop_turn) * v_rest * 35.0 + 5.0);
+        curl = (0.55 + 0.9 * kink) * (0.6 + 0.8 * coils);
+        alpha *= smoothstep(0.3, 0.7, 0.55 * coils + 0.45 * kink + 0.35 * (dens - 0.6));
+        light_hair *= 0.4;
     }
 #endif
+    float shade = mix(0.9, mix(0.35, 0.7, light_hair), smoothstep(0.3, 1.0, v_depth));
     vec3 albedo = hair_colour(suv * vec2(8.0, 2.0)) * (0.55 + 0.9 * tex.r) * shade * curl;
     f_color = vec4(finish(albedo * lit).rgb, alpha);
 #endif
@@ -530,6 +578,12 @@ void main() {
     // darken much less than dark hair's (the multiple scattering of Marschner's model).
     // Coily hair is denser: its inner curls stay dark whatever the colour.
     float light_hair = sqrt(clamp(dot(u_color, vec3(0.2126, 0.7152, 0.0722)), 0.0, 1.0)) * (1.0 - 0.6 * u_coil);
+#ifdef USE_SHADOW
+    // The key's cast shadow: the mass's own (light hair lets it further in) and the head's.
+    float key_reach = hair_key_visibility(v_pos, n, mix(3.0, 7.0, light_hair));
+#else
+    float key_reach = 1.0;
+#endif
     float layer = smoothstep(0.0, 0.95, v_depth);
     float self_shadow = mix(mix(0.3, 0.7, light_hair), 1.0, layer * layer * (1.5 - 0.5 * layer))
                       * mix(mix(0.8, 0.92, light_hair), 1.0, clump) * mix(0.8, 1.0, mid)
@@ -544,7 +598,7 @@ void main() {
     float dk = mix(strand_diffuse(t, u_key_dir), 1.0, 0.3) * kl * kl * 1.25;
     float df = clamp(dot(n, u_fill_dir) * 0.5 + 0.5, 0.0, 1.0);
     float dr = clamp(dot(n, u_rim_dir) * 0.5 + 0.5, 0.0, 1.0);
-    vec3 lit = dk * u_key_col + df * u_fill_col + dr * dr * u_rim_col * 0.8 + hemisphere(n) * 0.8;
+    vec3 lit = dk * key_reach * u_key_col + df * u_fill_col + dr * dr * u_rim_col * 0.8 + hemisphere(n) * 0.8;
 #ifdef PASS_OPAQUE
     // Two Kajiya-Kay lobes of the key light, shifted along the normal (Marschner's R and TRT
     // as Scheuermann approximates them): a primary tinted a little toward the hair colour and
@@ -587,7 +641,7 @@ void main() {
     spec = mix(spec, coily_sheen(n, v, crown), u_coil);
     self_shadow *= mix(1.0, coily_depth_shade(n, v), u_coil);
 #endif
-    vec3 radiance = (albedo * lit + u_sheen * spec) * self_shadow;
+    vec3 radiance = (albedo * lit + u_sheen * key_reach * spec) * self_shadow;
 #else
     // Brows and lashes: fine dark hairs, softly lit, little sheen.
     float dk = clamp(dot(n, u_key_dir) * 0.5 + 0.5, 0.0, 1.0);
