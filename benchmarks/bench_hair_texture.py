@@ -14,7 +14,11 @@ count. On their luminance (Rec. 709 weights on the sRGB values) it prints
 - ``ends``: below the jaw (the image's lowest 3/8), of the pixels where the hair covers the
   background at all (alpha over 0.08 with hair, under 0.01 without), the share it covers only
   partly (alpha under 0.92): long hair ending in a translucent film (pale smears and streaks
-  against a light background) gives a high figure, strands ending solid a low one.
+  against a light background) gives a high figure, strands ending solid a low one;
+- ``crown``: on the crown (hair pixels from the top of the image to 4 % of its height below the
+  top of the skin, in the middle 40 % of its width), the standard deviation of the luminance's
+  band-pass down the columns (Gaussian 1.5 px minus 6 px) over the mean: rows of cards drawn
+  as horizontal bands across the crown (long01) give a high figure.
 
     PYTHONPATH=. python3 benchmarks/bench_hair_texture.py [--character liam] [--view front] [--size 512]
 """
@@ -63,6 +67,22 @@ def partial_cover_below_jaw(with_hair: np.ndarray, without_hair: np.ndarray) -> 
     return float(partial.sum() / max(touched.sum(), 1)), int(touched.sum())
 
 
+def crown_banding(image: np.ndarray, mask: np.ndarray, without_hair: np.ndarray) -> tuple[float, int]:
+    """(banding, pixels): the ``crown`` figure (module docstring) of an (H, W, 4) uint8 render
+    with hair, its hair ``mask`` (:func:`hair_mask`) and the render without hair."""
+    from scipy.ndimage import gaussian_filter1d
+
+    h, w = mask.shape
+    skin_rows = np.nonzero((without_hair[..., 3] > 250).any(axis=1))[0]
+    crown = mask.copy()
+    crown[(skin_rows.min() if len(skin_rows) else h) + int(0.04 * h):] = False
+    crown[:, : int(0.3 * w)] = False
+    crown[:, int(0.7 * w):] = False
+    lum = image[..., :3].astype(np.float32) @ np.array([0.2126, 0.7152, 0.0722], np.float32)
+    band = gaussian_filter1d(lum, 1.5, axis=0) - gaussian_filter1d(lum, 6.0, axis=0)
+    return (float(band[crown].std() / lum[crown].mean()) if crown.any() else 0.0), int(crown.sum())
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--character", default="liam")
@@ -80,6 +100,8 @@ def main(argv=None) -> int:
     fine, mass = luminance_variation(images[0], mask)
     print(f"{args.character} {args.view}: fine {fine:.3f}, mass {mass:.3f} over {int(mask.sum())} hair pixels "
           f"({args.size}²)")
+    banding, pixels = crown_banding(images[0], mask, images[1])
+    print(f"crown: {banding:.3f} band-pass down the columns over {pixels} crown pixels")
     share, pixels = partial_cover_below_jaw(*images)
     print(f"ends: {share:.3f} of {pixels} hair pixels over the background below the jaw only partly covered")
     return 0

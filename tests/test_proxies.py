@@ -302,3 +302,29 @@ def test_brows_move_as_one_piece_and_keep_sadness_s_raised_inner_end(face_of, na
     assert moved[upper, 1].mean() > 0.03                                    # the inner end raised >= 3 mm
     assert moved[upper, 0].mean() < -0.015                                  # and drawn in >= 1.5 mm
     assert abs(moved[upper, 1].mean() - (skin_sad - skin_rest)[under, 1].mean()) < 0.01
+
+
+def test_long_hair_s_crown_shows_strands_not_its_rows_of_cards(face_of):
+    """long01's crown: its cards lie in rows across the sideways strands, and strands placed in
+    the cards' coordinates drew each row as a horizontal band across the crown (blind review,
+    session 18). On ava at 256² the luminance's band-pass down the columns over the crown
+    (benchmarks/bench_hair_texture.py's ``crown`` figure) was 0.098; strands placed on the head
+    there give 0.085."""
+    from scipy.ndimage import gaussian_filter1d
+
+    from facsim.face import Face
+
+    face = face_of("ava")
+    with Face(face.character.with_(hair="none")) as bald:
+        without = bald.render(None, size=256, background=None)
+    with_hair = face.render(None, size=256, background=None)
+    hair = (np.abs(with_hair[..., :3].astype(int) - without[..., :3].astype(int)).max(-1) > 38) & (with_hair[..., 3] > 250)
+    top = np.nonzero((without[..., 3] > 250).any(axis=1))[0].min()
+    crown = hair.copy()
+    crown[top + 10:] = False
+    crown[:, :77] = False
+    crown[:, 179:] = False
+    assert crown.sum() > 600
+    lum = with_hair[..., :3].astype(np.float32) @ np.array([0.2126, 0.7152, 0.0722], np.float32)
+    band = gaussian_filter1d(lum, 1.5, axis=0) - gaussian_filter1d(lum, 6.0, axis=0)
+    assert band[crown].std() / lum[crown].mean() < 0.092

@@ -584,7 +584,7 @@ def bind_scalp(hair: BoundProxy, head, neutral_geometry: np.ndarray, *, cache: P
     bound to those skin vertices, or None where the style covers no skin. ``cache``: a
     ``.npy`` file keeping the layer (building it takes a few tenths of a second)."""
     from facsim.head.assets import cached_array
-    from facsim.head.scalp import LIFT, ScalpLayer, scalp_layer, strand_texture
+    from facsim.head.scalp import LIFT, ScalpLayer, scalp_layer, split_edges, strand_texture
     from facsim.head.surface import smoothstep
 
     geo = np.asarray(neutral_geometry, np.float32)
@@ -604,20 +604,32 @@ def bind_scalp(hair: BoundProxy, head, neutral_geometry: np.ndarray, *, cache: P
         return None
     layer = ScalpLayer.from_array(array)
     vertices, normals = layer.vertices, layer.normals
-    density = layer.density
+    density, uv, hairline, triangles = layer.density, layer.uv, layer.hairline, layer.triangles
     # A close crop stands its length off the skin where it grows full, rising from the hairline.
-    lift = (LIFT + 0.01 * crop_length(hair.crop) * smoothstep(0.5, 1.0, density))[:, None]
+    offsets = (LIFT + 0.01 * crop_length(hair.crop) * smoothstep(0.5, 1.0, density))[:, None] * normals
     k = len(vertices)
     weights = np.zeros((k, 3), np.float32)
     weights[:, 0] = 1.0
     ref = np.repeat(vertices[:, None], 3, axis=1).astype(np.int64)
+    if hair.crop:
+        # A crop's outline is its own: its triangles split in four, the new vertices raised onto
+        # the smooth surface (their skin's two vertices halfway, plus the rise), so its
+        # silhouette is round instead of showing the scalp's facets.
+        edges, triangles, bulge = split_edges(triangles, geo[vertices] + offsets, normals)
+        a, b = edges.T
+        ref = np.concatenate([ref, np.stack([vertices[a], vertices[b], vertices[a]], axis=1)])
+        weights = np.concatenate([weights, np.tile(np.float32([0.5, 0.5, 0.0]), (len(edges), 1))])
+        offsets = np.concatenate([offsets, 0.5 * (offsets[a] + offsets[b]) + bulge])
+        density, uv, hairline = (np.concatenate([x, 0.5 * (x[a] + x[b])]).astype(np.float32)
+                                 for x in (density, uv, hairline))
+        k += len(edges)
     proxy = Proxy(name=hair.proxy.name + SCALP_SUFFIX, kind="scalp",
-                  ref=np.asarray(head.base_index)[ref], weights=weights, offsets=lift * normals,
-                  triangles=layer.triangles, corner_vertex=np.arange(k, dtype=np.int32), uv=layer.uv,
+                  ref=np.asarray(head.base_index)[ref], weights=weights, offsets=offsets,
+                  triangles=triangles, corner_vertex=np.arange(k, dtype=np.int32), uv=uv,
                   png=b"", author="facsim", license="CC0", image=strand_texture())
-    binding = FrameBinding(ref=ref, weights=weights, offsets=(lift * normals).astype(np.float32))
+    binding = FrameBinding(ref=ref, weights=weights, offsets=offsets.astype(np.float32))
     return BoundProxy(proxy, binding, "hair", 1.0, binding.positions(geo), shade=density, crop=hair.crop,
-                      hairline=layer.hairline)
+                      hairline=hairline)
 
 
 def bind_wisps(hair: BoundProxy, head, neutral_geometry: np.ndarray) -> BoundProxy | None:

@@ -444,3 +444,34 @@ def card_samples(points: np.ndarray, triangles: np.ndarray, *, k: int = 4) -> np
     keep = a + b <= k
     bary = np.stack([a[keep], b[keep], k - a[keep] - b[keep]], axis=1) / k
     return np.einsum("sk,tkd->tsd", bary, tri).reshape(-1, 3)
+
+
+def split_edges(triangles: np.ndarray, points: np.ndarray, normals: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each triangle split in four at its edges' midpoints, the midpoints raised onto the
+    smooth surface through ``points`` (V, 3) with ``normals`` (V, 3, unit).
+
+    A close crop is a layer over the skin (no cards), so its outline is the head's: hm08's
+    scalp triangles are a centimetre or two across, and the crop's silhouette showed their
+    facets (blind review, session 18). An edge's midpoint is raised ``(b - a)·(n_b - n_a) / 8``
+    along its ends' mean normal (on a sphere of radius r, |b - a|² / 8r: the arc's rise over
+    its chord for short edges), as PN triangles do.
+
+    Returns ``(edges, triangles, bulge)``: the (E, 2) vertex pairs of the new vertices V … V+E-1,
+    the (4T, 3) triangles over the V + E vertices (winding kept), and each new vertex's
+    (E, 3) offset from its edge's midpoint.
+    """
+    t = np.asarray(triangles, np.int64)
+    pairs = np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]])
+    edges, inverse = np.unique(np.sort(pairs, axis=1), axis=0, return_inverse=True)
+    mid = len(points) + inverse.reshape(3, -1).T          # (T, 3): midpoints of edges 01, 12, 20
+    a, b, c = t.T
+    ab, bc, ca = mid.T
+    out = np.concatenate([np.stack([a, ab, ca], 1), np.stack([ab, b, bc], 1), np.stack([ca, bc, c], 1),
+                          np.stack([ab, bc, ca], 1)])
+    p = np.asarray(points, np.float64)
+    n = np.asarray(normals, np.float64)
+    d = p[edges[:, 1]] - p[edges[:, 0]]
+    rise = np.einsum("ij,ij->i", d, n[edges[:, 1]] - n[edges[:, 0]]) / 8.0   # > 0 where convex
+    mean = n[edges[:, 0]] + n[edges[:, 1]]
+    mean /= np.linalg.norm(mean, axis=1, keepdims=True) + 1e-12
+    return edges, out.astype(np.int32), (rise[:, None] * mean).astype(np.float32)

@@ -421,8 +421,17 @@ void main() {
                                            + value_noise3(turn_b * v_rest * 18.0 + 7.0)) - 0.5);
     float px = 0.5;
 #else
-    float px = u_along_v > 0.5 ? pixel_strands_uv(v_uv, vec2(40.0, 1.5), vec2(5.0, 5.0) + 2.0 * phase)
-                               : pixel_strands(v_rest, normalize(v_rest_tangent + vec3(0.0, 1e-4, 0.0)), 60.0);
+    // On the crown, where strands run sideways from the parting (their direction on the neutral
+    // head near horizontal), long01's cards lie in rows across the strands, each row starting
+    // its strands afresh at the same texture coordinates: in the cards' coordinates the strands
+    // drew the rows as horizontal bands across the crown. There they are placed on the head,
+    // running on from row to row; hanging lengths keep the cards' unbroken root-to-tip strands.
+    vec3 along_rest = normalize(v_rest_tangent + vec3(0.0, 1e-4, 0.0));
+    float on_head = mix(1.0, 1.0 - smoothstep(0.55, 0.8, abs(along_rest.y)), u_along_v);
+    float px = on_head > 0.999 ? pixel_strands(v_rest, along_rest, 60.0)
+             : on_head < 0.001 ? pixel_strands_uv(v_uv, vec2(40.0, 1.5), vec2(5.0, 5.0) + 2.0 * phase)
+             : mix(pixel_strands_uv(v_uv, vec2(40.0, 1.5), vec2(5.0, 5.0) + 2.0 * phase),
+                   pixel_strands(v_rest, along_rest, 60.0), on_head);
     // Long hair ends above u_end_height (MakeHuman's long cards hang on through the shoulders)
     // the way a cut bob does: clumps a few millimetres across end at a little different
     // lengths, and within each the strands end one by one over the last few millimetres, so
