@@ -72,7 +72,9 @@ def test_fxaa_filters_the_drawn_box_and_copies_the_rest_exactly(face_of, monkeyp
         monkeypatch.setattr(Renderer, "_screen_box", lambda self, point_sets: None)
         whole = _frame(r, face, "12")
     assert np.array_equal(boxed, whole)
-    assert (boxed[0, :, :3] == 255).all(), "the top row is background: FXAA must not wrap the neck around"
+    # The top row is background, but for the crop's outermost coils grazing it (a level or a few
+    # of 255): FXAA must not wrap the neck's dark skin around into it.
+    assert (boxed[0, :, :3] >= 240).all(), "the top row is background: FXAA must not wrap the neck around"
 
 
 FORKED = textwrap.dedent("""
