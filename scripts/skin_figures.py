@@ -17,6 +17,11 @@ specular S = L1 - D (luminance). Regions are small boxes at landmarks (both side
   chin) where S is over 30 % of L: how much of the face reads as highlight;
 - ``speckle``: over the forehead box, the mean absolute difference of S between neighbouring
   pixels over the mean S: a broad soft sheen is near 0, a glittering film of specks high.
+- ``L*``, ``C*``, ``hue``: the cheeks' colour as displayed (the median over the same boxes'
+  pixels, CIELAB under D65: lightness, chroma, hue angle in degrees). Skin measured in vivo
+  lies near C* 17-23 and hue 50-65 degrees whatever its lightness (light skin about L* 65, a*
+  11, b* 15; dark skin about L* 40, a* 11, b* 18); scikit-image's studio portrait of Eileen
+  Collins (``skimage.data.astronaut()``) shows her cheeks at L* 76-81, C* 19, hue 66-70.
 - ``tone cv`` and ``hue sd``: the skin's own unevenness on the cheeks (larger boxes): the
   diffuse light D over D blurred by 8 px (the shading's slow change removed), its standard
   deviation (per cent); and the standard deviation of the diffuse light's hue,
@@ -95,6 +100,16 @@ def _box(camera, points, r):
     return mask
 
 
+def lab(rgb):
+    """CIELAB (D65) of display-sRGB colours (0-255), (..., 3)."""
+    xyz = srgb_to_linear(np.asarray(rgb, float) / 255) @ np.array([[0.4124, 0.2126, 0.0193],
+                                                                  [0.3576, 0.7152, 0.1192],
+                                                                  [0.1805, 0.0722, 0.9505]])
+    t = xyz / np.array([0.95047, 1.0, 1.08883])
+    f = np.where(t > (6 / 29) ** 3, np.cbrt(t), t / (3 * (6 / 29) ** 2) + 4 / 29)
+    return np.stack([116 * f[..., 1] - 16, 500 * (f[..., 0] - f[..., 1]), 200 * (f[..., 1] - f[..., 2])], -1)
+
+
 def _hsv(rgb):
     rgb = rgb / 255.0
     v = rgb.max(-1)
@@ -135,6 +150,9 @@ def figures(name, expression=""):
         diffuse_rgb = np.clip(2 * (radiance(image) - radiance(half)), 1e-4, None)
         cheeks = _box(camera, [pt("cheek_left") + [-0.1, 0.02, 0.1], pt("cheek_right") + [0.1, 0.02, 0.1]], 14)
         d = diffuse_rgb @ LUMINANCE
+        cheek_lab = np.median(lab(image[regions["cheek"]]), axis=0)
+        out["L*"], out["C*"] = float(cheek_lab[0]), float(np.hypot(cheek_lab[1], cheek_lab[2]))
+        out["hue"] = float(np.degrees(np.arctan2(cheek_lab[2], cheek_lab[1])))
         out["tone cv"] = float(100 * np.std((d / np.maximum(gaussian_filter(d, 8), 1e-6))[cheeks]))
         r, g = diffuse_rgb[..., 0][cheeks], diffuse_rgb[..., 1][cheeks]
         out["hue sd"] = float(100 * np.std((r - g) / (r + g)))

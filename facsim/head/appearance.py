@@ -136,11 +136,15 @@ class Appearance:
 
 #: Young-adult colours per ethnicity (sRGB). Sources: typical values of the
 #: Fitzpatrick II / IV / V–VI skin types; brows and irises the commonest shade.
+#: The skins' chroma is skin's as measured in vivo (CIELAB C* ~16-18, hue 56-62 degrees): the
+#: studio key's warmth, blood and scattering add the rest. (Until session 19 they were at C* 22-26,
+#: hue 50-63, and drew at 27-35 on the cheeks: peach and copper, the reviewers' waxy skin;
+#: ``python3 scripts/skin_figures.py``, column C*.)
 #: Scleras are warmer where the conjunctiva holds more melanin (darker skin types).
 ETHNIC_COLORS = {
-    "caucasian": {"skin": "#e6b8a2", "brows": "#5c4332", "iris": "#5b7088", "sclera": "#ede6df"},
-    "asian": {"skin": "#dfb698", "brows": "#211b17", "iris": "#4a321f", "sclera": "#ebe3d8"},
-    "african": {"skin": "#774a36", "brows": "#161210", "iris": "#3d2617", "sclera": "#dacdba"},
+    "caucasian": {"skin": "#dbbaa8", "brows": "#5c4332", "iris": "#5b7088", "sclera": "#ede6df"},
+    "asian": {"skin": "#d9b8a1", "brows": "#211b17", "iris": "#4a321f", "sclera": "#ebe3d8"},
+    "african": {"skin": "#6b4f3e", "brows": "#161210", "iris": "#3d2617", "sclera": "#dacdba"},
 }
 FIXED_COLORS = {
     "lashes": "#1b1511",
