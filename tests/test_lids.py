@@ -67,19 +67,21 @@ def test_5_widens_and_43_closes_from_the_relaxed_rest(face_of, engine):
     assert np.abs(gap).max() < 2.0, gap                # closed: the margins meet over the eye (degrees of arc)
 
 
-@pytest.mark.parametrize("name", ["ava", "mei", "kwame", "george"])
+@pytest.mark.parametrize("name", ["ava", "mei", "amara", "kwame", "george"])
 def test_5E_bares_the_sclera_above_the_iris_on_every_preset(face_of, name):
     """FACS 5 at E shows white above the iris. Session 18: AU 5's targets lift every lid about
     5 mm from where it rests, so kwame's and george's (which cover 5 mm of the iris at rest) bared
     none (their margin 0.3 and -0.5 mm over the iris's top) and mei's, over a smaller eye, rose 3.9
-    iris-mm over it; lids.yaml's `raise` fits the factor per character (3.5 iris-mm: ava 3.5,
-    mei 3.5; the skin guard, which will not let the lid's skin fold under the hood, holds kwame's
-    at 2.3 and george's at 1.4)."""
+    iris-mm over it; lids.yaml's `raise` fits the factor per character (the skin guard, which will
+    not let the lid's skin fold under the hood, holds kwame's at 2.5 and george's at 1.6).
+    Session 19: fitted to 3.5 iris-mm, ava's, mei's and amara's margins stood 3.3-3.5 mm over the
+    iris and the wide-open eyes read as bulging; open lids rise to 2.5 mm (2.3-2.6), hooded ones
+    keep 3.5 (their fold hides the margin)."""
     face = face_of(name)
     centre, radius = face.head.eye_pivot(face.base_positions, "left")
     iris_mm = 100.0 * float(rest_table()["iris_radius"]) * radius / (0.5 * float(rest_table()["iris_mm"]))
     over_iris = -_cover_mm(face, face.deform("5E").positions) / iris_mm
-    assert 1.2 < over_iris < 3.7
+    assert 1.2 < over_iris < 3.0
     assert -_cover_mm(face, face.neutral) < 0.0                 # at rest the lid covers the iris's top
 
 

@@ -548,3 +548,30 @@ def test_4_furrows_the_glabella_upright_and_leaves_the_nose_to_9(face_of, head, 
     design = np.c_[skin[glabella, :2], np.ones(glabella.sum())]
     (per_x, per_y, _), *_ = np.linalg.lstsq(design, phase[glabella], rcond=None)
     assert abs(per_x) > 1.2 * abs(per_y), (per_x, per_y)
+
+
+@pytest.mark.parametrize("name", ["ava", "kwame"])
+def test_15_lowers_the_corners_without_furrowing_the_chin_boss(face_of, name):
+    """FACS 15 pulls the lip corners down, with some pouching below them; wrinkling the chin boss
+    is 17's. Session 19: mouthFrown past its authored 1.0 (1.3) dragged the skin under the corners
+    and the chin's top down onto its lower half, and the crease field drew rows of furrows across
+    the chin (mean crease strength there 0.055 on ava, 0.049 on kwame): a blind reviewer saw a
+    swollen, rubbery chin boss in every strong sad face (1+4+15). Now 0.037 and 0.030, the corners
+    still 6 mm down."""
+    from facsim.head.landmarks import landmarks
+
+    face = face_of(name)
+    marks = landmarks(face.head)
+    rest = np.asarray(face.neutral)
+    deformation = face.deform("15E")
+    moved = np.asarray(deformation.positions)
+    strength = np.asarray(deformation.creases()[0])
+    skin = rest[: face.head.skin_vertex_count]
+    lower_lip, chin = rest[marks["lower_lip"]], rest[marks["chin"]]
+    half_width = 1.1 * abs(rest[marks["lip_corner_left"], X])
+    boss = np.flatnonzero((skin[:, Y] < lower_lip[Y] - 0.03) & (skin[:, Y] > chin[Y] - 0.05)
+                          & (np.abs(skin[:, X]) < half_width) & (skin[:, Z] > chin[Z] - 0.25))
+    assert len(boss) > 50
+    corner = marks["lip_corner_left"]
+    assert moved[corner, Y] - rest[corner, Y] < -0.05            # the corners come down over 5 mm
+    assert strength[boss].mean() < 0.045, strength[boss].mean()

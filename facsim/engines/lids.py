@@ -231,7 +231,8 @@ def raise_gain(lids: EyeLids, rest: np.ndarray, raising: np.ndarray, radius: flo
     The margin over the pupil (as in :func:`rest_lid_weight`) on the sculpted skin ``rest``
     (N, 3) rises by ``raising`` (N, 3), AU 5's targets at E, times the factor; heights change
     linearly with it, so it is solved directly and clipped to ``gain`` (``lids.yaml``,
-    ``raise``). 1 where the eye has no upper margin to measure.
+    ``raise``). A lid sculpted low over the iris (hooded) takes :func:`bare_mm`'s larger height:
+    its fold overhangs the margin. 1 where the eye has no upper margin to measure.
     """
     table = load_yaml("lids.yaml")
     rest_spec, spec = table["rest"], spec or table["raise"]
@@ -244,7 +245,25 @@ def raise_gain(lids: EyeLids, rest: np.ndarray, raising: np.ndarray, radius: flo
     low, high = (float(g) for g in spec["gain"])
     if lift <= 1e-9:
         return 1.0
-    return float(np.clip((iris_top + float(spec["bare_mm"]) * mm - height) / lift, low, high))
+    bare = bare_mm((iris_top - height) / mm, spec)
+    return float(np.clip((iris_top + bare * mm - height) / lift, low, high))
+
+
+def bare_mm(cover_mm: float, spec: dict) -> float:
+    """How high (iris-mm) AU 5 at E lifts the upper margin over the iris's top, for a lid whose
+    sculpted margin covers ``cover_mm`` of the iris: ``spec["bare_mm"]``, rising to
+    ``spec["hooded"]["bare_mm"]`` as the cover grows over ``spec["hooded"]["cover_mm"]``
+    (``lids.yaml`` ``raise``).
+
+    >>> spec = {"bare_mm": 2.5, "hooded": {"bare_mm": 3.5, "cover_mm": [2.5, 4.0]}}
+    >>> [round(bare_mm(c, spec), 2) for c in (1.0, 3.25, 5.0)]
+    [2.5, 3.0, 3.5]
+    """
+    hooded = spec.get("hooded")
+    if not hooded:
+        return float(spec["bare_mm"])
+    share = float(smoothstep(*(float(c) for c in hooded["cover_mm"]), cover_mm))
+    return float(spec["bare_mm"]) + share * (float(hooded["bare_mm"]) - float(spec["bare_mm"]))
 
 
 @dataclass(frozen=True)
