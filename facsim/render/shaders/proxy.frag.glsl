@@ -111,23 +111,17 @@ float pixel_strands(vec3 rest, vec3 along, float cells_per_dm) {
 // caster, exp(-depth / free_path) (a strand in the outer layer keeps it all, the under-layers
 // a few millimetres in get less, the hair under the mass of an afro or under the crown's
 // overhang little), down to what the caster lets through (its opacity: hair, less for light
-// hair; skin, none: the head's shadow on the hair). Four hardware comparisons at increasing
-// depths give how much of the footprint has its first caster within each of them.
-const vec4 HAIR_SHADOW_STEPS_MM = vec4(1.5, 4.0, 8.0, 16.0);
-
+// hair; skin, none: the head's shadow on the hair). Two hardware comparisons (each a 2x2 PCF)
+// give how much of the footprint has its first caster within 2 mm (the strand's own card)
+// and within 10 mm before p.
 float hair_key_visibility(vec3 p, vec3 n, float free_path_mm) {
     vec3 c = (u_shadow_matrix * vec4(p + n * u_shadow_texel, 1.0)).xyz;
     float mm = 0.01 / u_shadow_depth_range;   // one millimetre in the map's depth
-    vec4 within = vec4(texture(u_shadow, vec3(c.xy, c.z - HAIR_SHADOW_STEPS_MM.x * mm)),
-                       texture(u_shadow, vec3(c.xy, c.z - HAIR_SHADOW_STEPS_MM.y * mm)),
-                       texture(u_shadow, vec3(c.xy, c.z - HAIR_SHADOW_STEPS_MM.z * mm)),
-                       texture(u_shadow, vec3(c.xy, c.z - HAIR_SHADOW_STEPS_MM.w * mm)));
-    // (the share of the footprint whose first caster lies in each band of depth before p,
-    // and the light through that band's middle)
-    vec4 share = within - vec4(0.0, within.xyz);
-    vec4 through = exp(-vec4(0.0, 2.75, 6.0, 12.0) / free_path_mm);
+    float own = texture(u_shadow, vec3(c.xy, c.z - 2.0 * mm));
+    float near = texture(u_shadow, vec3(c.xy, c.z - 10.0 * mm));
+    // (a caster 2-10 mm before p: the light through the hair between, taken at 6 mm; further: all it stops)
+    float stopped = (near - own) * (1.0 - exp(-6.0 / free_path_mm)) + (1.0 - near);
     float opacity = texture(u_shadow_opacity, c.xy).r;
-    float stopped = dot(share, 1.0 - through) + (1.0 - within.w);
     float inside = step(0.0, c.x) * step(c.x, 1.0) * step(0.0, c.y) * step(c.y, 1.0) * step(c.z, 1.0);
     return 1.0 - stopped * opacity * inside;
 }
