@@ -63,8 +63,8 @@ def _lower_sag_mm(face, positions, side="left") -> float:
 def test_the_lower_lid_rests_on_the_iris_s_bottom(face_of, name):
     """Session 19: the hooded presets' sculpted lower lids sagged 0.5-1.1 mm below the iris (white
     under it at rest, more at 5E: the iris floated in white, a bulging eye in fear and surprise).
-    The relaxed lower lid touches the iris's bottom; 5 does not pull it back down; 6 and 7, which
-    lift it with the same target, take the rest share over (it is not added twice)."""
+    The relaxed lower lid touches the iris's bottom; 5 does not pull it back down; 7, which lifts
+    it with the same target at full weight, takes the rest share over (it is not added twice)."""
     face = face_of(name)
     assert _lower_sag_mm(face, face.engine.sculpted) > 0.3
     assert face.engine.rest_lids.lower_weights["left"] > 0.1
