@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import Callable
 
@@ -224,6 +224,31 @@ def rest_lid_weight(lids: EyeLids, rest: np.ndarray, closing: np.ndarray, radius
     return float(np.clip((height - target) / drop, 0.0, float(spec["max_weight"])))
 
 
+def rest_lower_weight(lids: EyeLids, rest: np.ndarray, raising: np.ndarray, radius: float,
+                      spec: dict | None = None) -> float:
+    """The share of ``raising`` (N, 3), a target that lifts the lower lid, that brings this eye's
+    lower margin over the pupil up to ``cover_mm`` above the iris's bottom (``lids.yaml``,
+    ``rest: lower``): 0 where the sculpted lid already covers that much, at most ``max_weight``.
+
+    The margin is measured as the upper one is (:func:`rest_lid_weight`): its points within
+    ``ahead_degrees`` of straight ahead, on the sculpted skin ``rest`` (N, 3).
+    """
+    table = rest_table()
+    spec = spec or table["lower"]
+    if not lids.ok:
+        return 0.0
+    lam, _ = spherical(rest[lids.lower], lids.centre)
+    ahead = np.abs(lam) < float(table["ahead_degrees"])
+    lower = lids.lower[ahead] if ahead.sum() >= 2 else lids.lower
+    height = float(np.mean(rest[lower, 1])) - float(lids.centre[1])
+    rise = float(np.mean(raising[lower, 1]))            # dm per unit share
+    iris_bottom = -float(table["iris_radius"]) * radius
+    mm = float(table["iris_radius"]) * radius / (0.5 * float(table["iris_mm"]))
+    if rise <= 1e-9:
+        return 0.0
+    return float(np.clip((iris_bottom + float(spec["cover_mm"]) * mm - height) / rise, 0.0, float(spec["max_weight"])))
+
+
 def raise_gain(lids: EyeLids, rest: np.ndarray, raising: np.ndarray, radius: float,
                spec: dict | None = None) -> float:
     """The factor on AU 5's targets that lifts this eye's upper margin ``bare_mm`` above the iris.
@@ -268,49 +293,76 @@ def bare_mm(cover_mm: float, spec: dict) -> float:
 
 @dataclass(frozen=True)
 class RestLids:
-    """The relaxed upper lids of one character: a share of each eye's closing target.
+    """The relaxed lids of one character: a share of each eye's closing target (the upper lid)
+    and of a target that lifts the lower lid.
 
-    ``weights`` maps side to the share at rest; :meth:`share` is what is left of it under
-    an expression (the ``fades_with`` AUs take it over); :meth:`offsets` the motion it
-    adds to the sculpted positions.
+    ``weights`` maps side to the closing target's share at rest, ``lower_weights`` to the
+    lower lid's; :meth:`share` and :meth:`lower_share` are what is left of them under an
+    expression (the ``fades_with`` and ``lower_fades_with`` AUs take them over); :meth:`offsets`
+    the motion they add to the sculpted positions.
     """
 
     weights: dict
     columns: dict                    # side -> (N, 3) float32 offsets of the closing target
     fades_with: tuple
+    lower_weights: dict = field(default_factory=lambda: {side: 0.0 for side in SIDES})
+    lower_columns: dict = field(default_factory=dict)   # side -> (N, 3) offsets of the lower lid's target
+    lower_fades_with: tuple = ()
 
     @classmethod
     def measure(cls, rest: np.ndarray, column: Callable[[str], np.ndarray], eye: Callable[[str], tuple],
-                margin: Callable[[str], np.ndarray]) -> "RestLids":
+                margin: Callable[[str], np.ndarray],
+                lower_column: Callable[[str], np.ndarray] | None = None) -> "RestLids":
         """Measure both eyes on the sculpted neutral positions ``rest`` (N, 3).
 
         ``column(side)`` gives the closing target's offsets (N, 3), ``eye(side)`` the
-        eyeball's (centre, radius), ``margin(side)`` the vertices along its lid margins.
+        eyeball's (centre, radius), ``margin(side)`` the vertices along its lid margins,
+        ``lower_column(side)`` the lower lid's target (``rest: lower`` in ``lids.yaml``; none
+        without it).
         """
         spec = rest_table()
-        weights, columns = {}, {}
+        weights, columns, lower_weights, lower_columns = {}, {}, {}, {}
         for side in SIDES:
             centre, radius = eye(side)
             closing = np.asarray(column(side), np.float32)
             lids = EyeLids(rest, closing, centre, radius, margin(side))
             weights[side] = rest_lid_weight(lids, np.asarray(rest, float), closing, radius, spec)
             columns[side] = closing
+            if lower_column is not None:
+                lower_columns[side] = np.asarray(lower_column(side), np.float32)
+                lower_weights[side] = rest_lower_weight(lids, np.asarray(rest, float), lower_columns[side], radius)
+            else:
+                lower_weights[side] = 0.0
         # Faces are symmetric at rest: both eyes take the mean (the sculpted eyes differ by a hair).
         mean = 0.5 * (weights["left"] + weights["right"])
-        return cls({side: mean for side in SIDES}, columns, tuple(int(c) for c in spec["fades_with"]))
+        lower_mean = 0.5 * (lower_weights["left"] + lower_weights["right"])
+        return cls({side: mean for side in SIDES}, columns, tuple(int(c) for c in spec["fades_with"]),
+                   {side: lower_mean for side in SIDES}, lower_columns,
+                   tuple(int(c) for c in spec["lower"]["fades_with"]))
+
+    @staticmethod
+    def _left(weight: float, act, side: str, fades_with: tuple) -> float:
+        taken = max((act[code, side] for code in fades_with), default=0.0)
+        return weight * (1.0 - min(max(taken, 0.0), 1.0))
 
     def share(self, act, side: str) -> float:
-        """The rest share left on ``side`` under activations ``act``."""
-        taken = max((act[code, side] for code in self.fades_with), default=0.0)
-        return self.weights[side] * (1.0 - min(max(taken, 0.0), 1.0))
+        """The closing target's rest share left on ``side`` under activations ``act``."""
+        return self._left(self.weights[side], act, side, self.fades_with)
+
+    def lower_share(self, act, side: str) -> float:
+        """The lower lid's rest share left on ``side`` under activations ``act``."""
+        return self._left(self.lower_weights[side], act, side, self.lower_fades_with)
 
     def offsets(self, act, count: int | None = None) -> np.ndarray:
         """The rest lids' motion (N, 3) (or its first ``count`` rows) under ``act``."""
         out = None
         for side in SIDES:
-            s = self.share(act, side)
-            column = self.columns[side] if count is None else self.columns[side][:count]
-            out = s * column if out is None else out + s * column
+            parts = [(self.share(act, side), self.columns[side])]
+            if side in self.lower_columns:
+                parts.append((self.lower_share(act, side), self.lower_columns[side]))
+            for s, column in parts:
+                column = column if count is None else column[:count]
+                out = s * column if out is None else out + s * column
         return out.astype(np.float32)
 
 

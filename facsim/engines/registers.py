@@ -259,7 +259,7 @@ class RegisterEngine:
 
     @cached_property
     def rest_lids(self):
-        """The relaxed upper lids at rest (:class:`~facsim.engines.lids.RestLids`, ``lids.yaml``)."""
+        """The relaxed lids at rest (:class:`~facsim.engines.lids.RestLids`, ``lids.yaml``)."""
         from facsim.engines.lids import RestLids, lid_margin, rest_table
 
         skin = self.head.skin_vertex_count
@@ -271,7 +271,9 @@ class RegisterEngine:
         def margin(side):
             return lid_margin(self.head, self.sculpted, *eye(side))
 
-        return RestLids.measure(self.sculpted[:skin], lambda side: self.column(Column(pattern, side))[:skin], eye, margin)
+        lower = rest_table()["lower"]["target"]
+        return RestLids.measure(self.sculpted[:skin], lambda side: self.column(Column(pattern, side))[:skin], eye, margin,
+                                lambda side: self.column(Column(lower, side))[:skin])
 
     @cached_property
     def lid_raise(self) -> tuple[frozenset, float]:
@@ -316,7 +318,7 @@ class RegisterEngine:
     def weights(self, act: Activations) -> dict[Column, float]:
         """Column weights of ``act`` (Eq. 1), each side's by the character's gain there (its natural
         asymmetry) and AU 5's lid-raising targets by :attr:`lid_raise`, AU 4's push on the lid
-        fitted (:attr:`brow_push`), plus the relaxed lids' share of the closing target."""
+        fitted (:attr:`brow_push`), plus the relaxed lids' shares of the closing and the lower lid's targets."""
         from facsim.engines.lids import rest_table
 
         raising, raise_gain = self.lid_raise
@@ -324,10 +326,11 @@ class RegisterEngine:
                    * (raise_gain if col.pattern in raising else 1.0)
                    for col, w in register_weights(act, self.brow_push).items()}
         for side in ("left", "right"):
-            share = self.rest_lids.share(act, side)
-            if share:
-                col = Column(rest_table()["target"], side)
-                weights[col] = weights.get(col, 0.0) + share
+            for pattern, share in ((rest_table()["target"], self.rest_lids.share(act, side)),
+                                   (rest_table()["lower"]["target"], self.rest_lids.lower_share(act, side))):
+                if share:
+                    col = Column(pattern, side)
+                    weights[col] = weights.get(col, 0.0) + share
         return weights
 
     def deform(self, act: Activations) -> Deformation:

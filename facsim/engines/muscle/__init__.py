@@ -202,8 +202,13 @@ class MuscleEngine:
         from facsim.engines.lids import RestLids
 
         net = self.model.net
+        from facsim.engines.lids import closing_column, rest_table
+
+        lower = rest_table()["lower"]["target"]
         return RestLids.measure(self.sculpted[:net.count], self._closing_columns.__getitem__,
-                                lambda side: (net.eye_centre[SIDES.index(side)], net.eye_radius), self._margin)
+                                lambda side: (net.eye_centre[SIDES.index(side)], net.eye_radius), self._margin,
+                                lambda side: closing_column(self.head, self.data, self.base_positions, lower, side)
+                                [: net.count])
 
     @cached_property
     def eyelids(self) -> dict:
