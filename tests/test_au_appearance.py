@@ -89,7 +89,7 @@ def test_4_lowers_the_brows_and_draws_them_together_with_glabellar_furrows(solve
 
 def test_6_raises_the_cheeks_narrows_the_eye_from_below_with_crows_feet(solved, marks, rest):
     d = _moved(solved, "6")
-    assert d[marks["cheek_left"], Y] > 0.01
+    assert d[marks["cheek_left"], Y] > 0.025          # session 18: 1.2 mm on noah in the muscle engine (registers 10)
     assert d[marks["lower_lid_left"], Y] > 0.015
     assert d[marks["inner_brow_left"], Y] > -0.01                            # not a frown: the inner brow stays
     assert _creases(solved, "6", rest, CROWS_FEET) > 0.3

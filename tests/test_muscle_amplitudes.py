@@ -14,7 +14,7 @@ from facsim.facs.activations import activations
 from facsim.facs.notation import parse
 
 MM = 100.0
-EXPRESSIONS = ["25", "26", "27", "2", "1+2", "1+4", "4"]
+EXPRESSIONS = ["25", "26", "27", "2", "1+2", "1+4", "4", "6"]
 
 
 @pytest.fixture(scope="module")
@@ -44,6 +44,8 @@ def _figures(positions, rest, marks, gauge) -> dict[str, float]:
         "inner_brow": rise("inner_brow"),
         "outer_brow": rise("outer_brow"),
         "brows_apart": MM * (spread(p) - spread(r)),
+        "cheek": rise("cheek"),
+        "lower_lid": rise("lower_lid"),
     }
 
 
@@ -123,6 +125,16 @@ def test_oblique_brows_rise_inside_and_come_together(muscle):
     assert f["inner_brow"] > 4.5
     assert f["inner_brow"] > f["outer_brow"] + 3.0
     assert f["brows_apart"] < -2.0
+
+
+def test_cheek_raiser_lifts_the_cheek_and_the_lower_lid_without_lowering_the_brows(muscle):
+    """6: the cheek rises and pushes the lower lid up (session 18: cheek 1.5 mm on ava, lid 2.1, the
+    register engine 10 and 3.6), the lateral brow comes down only a little (2.5 mm before: the
+    orbital arc's free lateral end ran toward the nose). Session 18's outer arc alone lifted the
+    cheek 3.5 mm but the lid only 0.3 on noah."""
+    f = muscle["6"][0]
+    assert f["cheek"] > 3.0 and f["lower_lid"] > 2.5
+    assert f["outer_brow"] > -1.5 and abs(f["inner_brow"]) < 1.0
 
 
 def test_brow_lowerer_lowers_and_knits(muscle):

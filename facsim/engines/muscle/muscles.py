@@ -348,24 +348,36 @@ def _linear(b: _Builder, m: dict, index: int, side: str):
 
 
 def _sphincter(b: _Builder, m: dict, index: int, side: str, midline: bool):
-    """A ring or an anchored chain of muscle points under tension."""
-    anchors = m.get("anchors", [])
-    if "ring" in m:
-        ring = m["ring"]
-        cx, cy = ring["centre"]
-        a, r = ring["radii"]
-        count = ring["count"]
-        if "arc" in ring:  # part of the ellipse, from one angle to another (degrees, 0 = lateral, 90 = up)
-            angles = np.radians(np.linspace(*ring["arc"], count))
-            closed = False
-        else:
-            angles = 2 * np.pi * np.arange(count) / count
-            closed = ring.get("closed", True)
-        sels = [{"front": [cx + a * np.cos(t), cy + r * np.sin(t)]} for t in angles]
-        radius = ring.get("radius", 0.04)
+    """A ring or an anchored chain of muscle points under tension. ``rings`` (concentric arcs of
+    one muscle, e.g. the inner and outer fibres of orbicularis oculi's orbital part) gives a chain
+    per arc, each shortening as a fiber of its own under the muscle's tension."""
+    if "rings" in m:
+        for ring in m["rings"]:
+            _sphincter_chain(b, m, index, side, *_ring_selectors(ring))
+    elif "ring" in m:
+        _sphincter_chain(b, m, index, side, *_ring_selectors(m["ring"]))
     else:
-        sels, radius, closed = m["chain"], m.get("radius", 0.03), False
-    # The anchored ends are bone points; the rest are muscle points under skin heads.
+        _sphincter_chain(b, m, index, side, m["chain"], m.get("radius", 0.03), False)
+
+
+def _ring_selectors(ring: dict) -> tuple[list[dict], float, bool]:
+    """A ring's (or an arc's) skin selectors, the radius of their heads, and whether it closes."""
+    cx, cy = ring["centre"]
+    a, r = ring["radii"]
+    count = ring["count"]
+    if "arc" in ring:  # part of the ellipse, from one angle to another (degrees, 0 = lateral, 90 = up)
+        angles = np.radians(np.linspace(*ring["arc"], count))
+        closed = False
+    else:
+        angles = 2 * np.pi * np.arange(count) / count
+        closed = ring.get("closed", True)
+    sels = [{"front": [cx + a * np.cos(t), cy + r * np.sin(t)]} for t in angles]
+    return sels, ring.get("radius", 0.04), closed
+
+
+def _sphincter_chain(b: _Builder, m: dict, index: int, side: str, sels: list[dict], radius: float, closed: bool):
+    """One chain of a sphincter's muscle points; its anchored ends are bone points."""
+    anchors = m.get("anchors", [])
     fixed = set()
     if "first" in anchors:
         fixed.add(0)
