@@ -439,3 +439,57 @@ def test_open_and_stretched_lips_keep_their_red(face_of, expression):
     # their red stays full (at least 70 % of the closed lip's height as seen).
     face = face_of("george")
     assert _upper_lip_red_px(face, expression) >= 0.7 * _upper_lip_red_px(face, "0")
+
+
+def _lips_and_opening(face, expression, size=384):
+    """The lips' pixels (recoloured lips against the plain render) and the opening between
+    them: what lies inside the lips' row and column spans and is not lip."""
+    from scipy import ndimage
+
+    from facsim import Face
+
+    deformation = face.deform(expression)
+    renders = []
+    for colour in ("#00ff00", "#0000ff"):
+        with Face(face.character.with_(colors={"lips": colour})) as marked:
+            renders.append(marked.render(deformation=deformation, size=size, antialias=1)[..., :3].astype(float))
+    lips = np.abs(renders[0] - renders[1]).sum(axis=-1) > 60
+    labels, _ = ndimage.label(lips)
+    counts = np.bincount(labels.ravel())
+    counts[0] = 0
+    lips = (counts > 50)[labels]   # both lips, without specks
+
+    def spans(mask):
+        out = np.zeros_like(mask)
+        for row, line in zip(out, mask):
+            on = np.flatnonzero(line)
+            if on.size:
+                row[on[0]: on[-1] + 1] = True
+        return out
+
+    return lips, spans(lips) & spans(lips.T).T & ~lips
+
+
+@pytest.mark.parametrize("character", ["ava", "george"])
+def test_fears_stretched_opening_has_blunt_ends(face_of, character):
+    # Session 18's blind reviewer: fear's wide mouth (20+26) "grotesquely stretched", a lens
+    # between two full, everted lips whose ends met in points (at 80 % of the way from the
+    # middle to a corner the opening was 0.37 of its height at the middle on ava, 0.31 on
+    # george). Lips stretched apart part along their length and flatten against the teeth:
+    # a wide slot with blunt ends (registers.yaml, the 20 with 25/26/27 rule: 0.47, 0.41).
+    _, opening = _lips_and_opening(face_of(character), "1+2+4+5+20+26")
+    height = opening.sum(axis=0).astype(float)
+    columns = np.flatnonzero(height)
+    middle, half = 0.5 * (columns[0] + columns[-1]), 0.5 * (columns[-1] - columns[0])
+    near_ends = [height[int(round(middle + sign * 0.8 * half))] for sign in (-1, 1)]
+    assert np.mean(near_ends) >= 0.39 * height[int(round(middle))]
+
+
+def test_stretched_closed_lips_stay_closed(face_of):
+    # 20's lateral parting acts only on parted lips (with 25, 26 or 27): alone, 20 stretches
+    # the closed lips sideways without parting them.
+    from facsim.speech.mouth import mouth_shape
+
+    face = face_of("ava")
+    assert mouth_shape(face, "20").gap - mouth_shape(face, "0").gap < 1.0
+    assert mouth_shape(face, "20+25").gap - mouth_shape(face, "0").gap > 5.0

@@ -575,3 +575,23 @@ def test_15_lowers_the_corners_without_furrowing_the_chin_boss(face_of, name):
     corner = marks["lip_corner_left"]
     assert moved[corner, Y] - rest[corner, Y] < -0.05            # the corners come down over 5 mm
     assert strength[boss].mean() < 0.045, strength[boss].mean()
+
+
+@pytest.mark.parametrize("code", ["10", "9"])
+def test_the_raised_upper_lip_bends_up_at_its_centre(face_of, code):
+    """FACS 10 (and 9's raise of the upper lip): the upper lip's centre is drawn straight up and
+    its outer parts less, an angular bend. Session 18's lip rose evenly over the canines (ARKit's
+    mouthUpperUp), its centre 4.8 mm and halfway to the corners 5.1 mm on noah: a flat-topped,
+    squared mouth (a blind reviewer). Now the centre rises most (6.1 / 5.6 mm in 10)."""
+    face = face_of("noah")
+    rim = face._mouth_rim.upper
+    rest = np.asarray(face.neutral, float)
+    rise = np.asarray(face.deform(code).positions, float)[rim, 1] - rest[rim, 1]
+    x = rest[rim, 0]
+    order = np.argsort(x)
+    half = np.abs(x).max()
+
+    def at(share):
+        return 0.5 * sum(np.interp(sign * share * half, x[order], rise[order]) for sign in (-1, 1))
+
+    assert at(0.0) > at(0.5) + 0.0025 > at(0.8) + 0.01     # 0.25 mm above halfway, 1 mm above the ends
