@@ -235,8 +235,11 @@ def character_colors(character: Character) -> dict[str, tuple[float, float, floa
     colors = {
         "skin": skin,
         # Women's lips are redder and more contrasted against the skin than men's (a cue
-        # observers use to tell the sexes apart); both fade a little with age.
-        "lips": skin * (female * np.array([0.80, 0.44, 0.47]) + (1 - female) * np.array([0.78, 0.53, 0.54]))
+        # observers use to tell the sexes apart); both fade a little with age. Lips are darker
+        # than the skin and a rose red, bluer than the skin's own hue, and only moderately
+        # saturated (measured lips: CIELAB L* 50-57, C* 18-24, hue 25-35 degrees on light skin);
+        # until session 20 a paler, orange salmon (ava's lower lip rendered L* 62, C* 35, hue 36).
+        "lips": skin * (female * np.array([0.60, 0.40, 0.46]) + (1 - female) * np.array([0.66, 0.49, 0.53]))
         * (1.0 - 0.1 * older),
         "eyelid": skin * (female * np.array([0.86, 0.74, 0.74]) + (1 - female) * np.array([0.92, 0.80, 0.80])),
         "cheek": skin * np.array([1.0, 0.70, 0.70]),

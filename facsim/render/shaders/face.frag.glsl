@@ -111,6 +111,10 @@ vec2 spots(vec2 p, float prob, float radius, int salt) {
 const vec3 SCATTER_SOFTNESS = vec3(0.6, 0.3, 0.12);
 // The lips' wet film is smoother than the skin's oil: their tight lobe's roughness.
 const float LIP_ROUGHNESS = 0.38;
+// The lips' colour fades into the skin's over the lip mask blurred to this mip level of the paint
+// texture (level 3.5: ~11 of its 2048 rows, ~2 mm on hm08's lips), this share of it.
+const float LIP_BORDER_LOD = 4.5;
+const float LIP_BORDER_SOFTNESS = 0.6;
 
 // Skin's specular (Fresnel F0 = SKIN_F0) from one light, in its two lobes (broad, tight):
 // GGX distributions of the given roughness (by region: skin_lobes in skin_light.glsl, the tight
@@ -510,7 +514,12 @@ void main() {
     // Toward the vermilion border the red thins into the skin's own colour (a painted-on
     // colour with an even edge read as a rubber mask).
     lip_col = mix(mix(albedo, u_lips, 0.6), lip_col, lip_core);
-    albedo = mix(albedo, lip_col, smoothstep(0.0, 1.0, lips));
+    // The vermilion border is a soft edge: the red fades into the skin over a millimetre or two
+    // (the mask blurred: its mip LIP_BORDER_LOD); just inside it the red is a little paler.
+    // (Until session 20 the red stopped within the mask's own ~0.5 mm: at 448 px a cut-out,
+    // "a separate salmon-coloured object" on the face.)
+    float lips_soft = textureLod(u_paint, v_uv, LIP_BORDER_LOD).g;
+    albedo = mix(albedo, lip_col, smoothstep(0.0, 1.0, mix(lips, lips_soft, LIP_BORDER_SOFTNESS)));
     albedo *= 1.0 + 0.03 * border * (1.0 - u_age);   // (faint: a bright rim outlined the lips)
     albedo = mix(albedo, mix(u_lips, MUCOSA, 0.8) * (0.9 + 0.2 * blotch), mucosa);
 #ifdef USE_BROWS
