@@ -362,6 +362,38 @@ def test_tightened_lips_keep_their_corners(engine, marks):
     assert delta[marks["upper_lip"], 1] - delta[marks["lower_lip"], 1] < -0.04     # red narrowed >= 4 mm
 
 
+@pytest.mark.parametrize("preset", ["ava", "kwame", "george"])
+def test_tightened_lips_do_not_widen_the_mouth(face_of, marks, preset):
+    """FACS 23 tightens and thins the red; it does not stretch the mouth as 20 does. With ARKit's
+    mouthPress at 0.6 the corners moved 7.7 mm apart at 23E and anger (4+5+7+23) wore a
+    stretched slot (session 20)."""
+    engine = face_of(preset).engine
+    corners = [marks["lip_corner_left"], marks["lip_corner_right"]]
+
+    def width(positions):
+        return float(np.linalg.norm(positions[corners[0]] - positions[corners[1]]))
+
+    assert width(engine.deform(activations(parse("23"))).positions) - width(engine.neutral) < 0.01   # 1 mm
+
+
+def test_16_pulls_the_lower_lip_down_not_the_chin(engine, marks):
+    """Depressor labii inferioris runs from the lower lip to the mandible: 16 moves the lip down off
+    the lower teeth and leaves the chin boss. ARKit's mouthLowerDown past 1.0 dragged the chin
+    6.2 mm down with a 4.0 mm drop of the lip, the lip a flat-bottomed slab (session 20)."""
+    delta = _moved(engine, "16")
+    lip, chin = -delta[marks["lower_lip"], 1], -delta[marks["chin"], 1]
+    assert lip > 0.04 and chin < 0.5 * lip
+
+
+def test_15_lowers_the_corners_without_pushing_the_lower_lip_up(engine, marks):
+    """Depressor anguli oris pulls the corners down; pushing the lower lip and the chin boss up is
+    mentalis's (17). MakeHuman's mouth-depression unit in 15 raised the lower lip 1.0 mm and the
+    chin 0.6 mm, the thick boxed lower lip over a chin bulge of the sad faces (session 20)."""
+    delta = _moved(engine, "15")
+    assert delta[marks["lip_corner_left"], 1] < -0.04
+    assert delta[marks["lower_lip"], 1] < 0.003 and delta[marks["chin"], 1] < 0.003
+
+
 def _emotion_moved(engine, name, level=1.0, table="facsim"):
     from facsim.facs.emotions import emotion
 
