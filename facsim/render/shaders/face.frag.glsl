@@ -17,7 +17,7 @@ in vec2 v_uv;
 #endif
 #if defined(REGION_SKIN) || defined(REGION_TONGUE)
 in vec3 v_scatter_normal;   // the normal averaged over a few millimetres (Renderer: scattered_normals)
-in float v_curvature;       // 1 / radius (dm^-1), Renderer: surface_curvature
+in float v_curvature;       // signed 1 / radius (dm^-1; < 0 in hollows), Renderer: surface_curvature
 #endif
 #ifdef USE_EYE
 in vec3 v_eye;
@@ -115,6 +115,12 @@ const float LIP_ROUGHNESS = 0.38;
 // texture (level 3.5: ~11 of its 2048 rows, ~2 mm on hm08's lips), this share of it.
 const float LIP_BORDER_LOD = 4.5;
 const float LIP_BORDER_SOFTNESS = 0.6;
+// Ambient occlusion of the skin's hollows (see main): none where the surface curves inward less
+// than CONCAVE_FROM dm^-1 (a 2-dm radius), CONCAVE_SHADE of the contact light lost at CONCAVE_FULL
+// (a 2.5-cm radius: an eye socket's side, a nasolabial fold) and beyond.
+const float CONCAVE_SHADE = 0.6;
+const float CONCAVE_FROM = 0.5;
+const float CONCAVE_FULL = 4.0;
 // Melanin's tan over the skin (multipliers, linear): freckles and age spots are brown, a little
 // darker than the skin and of about its hue - not the orange of (0.80, 0.66, 0.55), which the key's
 // warmth and the skin's scattering turned into red dots (session 19's "rash" on george).
@@ -637,7 +643,11 @@ void main() {
     // Contact shadows: the baked visibility is close to 1 on the open face and falls only in
     // the nostrils, the lip line, the eye sockets and under the jaw; squaring it deepens
     // those small shadows (a soft studio key still reaches into them partly).
-    float contact = occ * occ;
+    // Hollows shade themselves too, at a scale the baked visibility is too coarse for: where the
+    // surface curves inward (v_curvature < 0) it sees less of the room and the softbox, so the
+    // eye sockets beside the nose, the nasolabial folds, the mouth's corners and the hollow under
+    // the lower lip keep their depth under the frontal key (CONCAVE_SHADE; issue 13: "flat").
+    float contact = occ * occ * (1.0 - CONCAVE_SHADE * smoothstep(CONCAVE_FROM, CONCAVE_FULL, -v_curvature));
     // Subsurface look: light wraps past the terminator, red furthest, so the shadow edge is
     // soft and warm (less with age: thinner skin); only a little, as skin scatters light a
     // few millimetres and too much wrap is what looks waxy. Red scatters furthest under the
