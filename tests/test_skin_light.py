@@ -89,15 +89,18 @@ def test_the_oily_t_zone_shines_more_than_the_dry_cheeks():
     assert oily[rim][..., :3].mean() == pytest.approx(dry[rim][..., :3].mean(), abs=3)
 
 
-def render_sheet(profile):
+def render_sheet(profile, *, mirrored=False):
     """A 1.2-dm square skin sheet facing the camera whose height (dm) across x is ``profile(x)``,
-    96² orthographic, lit by a frontal key and a faint sky only: (image, pixel column of x)."""
+    96² orthographic, lit by a frontal key and a faint sky only: (image, pixel column of x).
+    ``mirrored``: its triangles wound the other way (as a mirrored mesh's are)."""
     xs = np.linspace(-0.6, 0.6, 61)
     x, y = np.meshgrid(xs, xs)
     p = np.stack([x, y, profile(x)], -1).reshape(-1, 3).astype(np.float32)
     ids = np.arange(len(p)).reshape(61, 61)
     faces = np.concatenate([np.stack([ids[:-1, :-1], ids[:-1, 1:], ids[1:, 1:]], -1).reshape(-1, 3),
                             np.stack([ids[:-1, :-1], ids[1:, 1:], ids[1:, :-1]], -1).reshape(-1, 3)])
+    if mirrored:
+        faces = faces[:, ::-1]
     topology = RenderTopology(faces=faces, render_to_geo=np.arange(len(p)), uv=np.full((len(p), 2), 0.5, np.float32),
                               region=np.full(len(p), REGIONS.index("skin"), np.uint8),
                               eye_coord=np.zeros((len(p), 3), np.float32))
@@ -109,14 +112,15 @@ def render_sheet(profile):
     return image[..., :3].astype(float), lambda at: int(round((at + 0.6) / 1.2 * 95))
 
 
-def test_hollows_are_shaded_under_a_frontal_key_bulges_are_not():
+@pytest.mark.parametrize("mirrored", [False, True])
+def test_hollows_are_shaded_under_a_frontal_key_bulges_are_not(mirrored):
     """A groove's floor and a ridge's crest face the frontal key as the flat skin beside them does;
     the groove (a 1-cm-wide hollow, like a nasolabial fold's or an eye socket's side) sees less of the
     light around it and is darker, the ridge is not (until session 20 both were as bright as the
     flat: creases and sockets lost their depth under the studio key)."""
     def bumps(x):
         return 0.03 * (np.exp(-((x + 0.25) / 0.1) ** 2) - np.exp(-((x - 0.25) / 0.1) ** 2))
-    image, column = render_sheet(bumps)
+    image, column = render_sheet(bumps, mirrored=mirrored)
     rows = slice(40, 56)
 
     def at(x):

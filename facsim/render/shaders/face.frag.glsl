@@ -647,7 +647,10 @@ void main() {
     // surface curves inward (v_curvature < 0) it sees less of the room and the softbox, so the
     // eye sockets beside the nose, the nasolabial folds, the mouth's corners and the hollow under
     // the lower lip keep their depth under the frontal key (CONCAVE_SHADE; issue 13: "flat").
-    float contact = occ * occ * (1.0 - CONCAVE_SHADE * smoothstep(CONCAVE_FROM, CONCAVE_FULL, -v_curvature));
+    // (The curvature's sign is the mesh normal's, which surface_normal() turns toward the viewer on
+    // back faces (a mirrored mesh's winding): turned with it, a hollow is a hollow either way.)
+    float hollow = gl_FrontFacing ? -v_curvature : v_curvature;
+    float contact = occ * occ * (1.0 - CONCAVE_SHADE * smoothstep(CONCAVE_FROM, CONCAVE_FULL, hollow));
     // Subsurface look: light wraps past the terminator, red furthest, so the shadow edge is
     // soft and warm (less with age: thinner skin); only a little, as skin scatters light a
     // few millimetres and too much wrap is what looks waxy. Red scatters furthest under the
