@@ -494,3 +494,38 @@ def test_lips_fade_into_the_skin_in_a_muted_rose_not_a_salmon_cut_out(face_of, m
     chroma, hue = np.hypot(lip[1], lip[2]), np.degrees(np.arctan2(lip[2], lip[1]))
     assert chroma < 30, (lip, chroma)
     assert 20 < hue < 45, (lip, hue)
+
+
+def _forehead_and_cheek(face, marks, size):
+    """(the forehead's CIELAB pixels around its middle (51 x 81 px), the key-side cheek's median
+    CIELAB, the forehead's) in a front view at ``size`` px."""
+    camera = face.camera(size=(size, size))
+    image = face.renderer(size=size, body="none").render(face.neutral, appearance=face.appearance, camera=camera,
+                                                         occlusion=face.shading_occlusion)[..., :3]
+    lab = _cielab(image.reshape(-1, 3)).reshape(size, size, 3)
+    forehead = face.neutral[marks["glabella"]] + np.array([0.0, 0.25, -0.03])
+    cheek = face.neutral[marks["cheek_right"]] + np.array([0.08, 0.05, 0.1])
+    (fx, fy), (cx, cy) = project(camera, [forehead, cheek], size)[0].astype(int)
+    return (lab[fy - 25:fy + 26, fx - 40:fx + 41], np.median(lab[cy - 6:cy + 7, cx - 6:cx + 7].reshape(-1, 3), axis=0),
+            np.median(lab[fy - 10:fy + 11, fx - 10:fx + 11].reshape(-1, 3), axis=0))
+
+
+def test_age_spots_and_freckles_are_tan_patches_not_a_rash_of_red_dots(face_of, marks):
+    """Older, sun-exposed skin shows sparse tan lentigines and freckles, about the skin's own hue:
+    few pixels of george's forehead at 448 px are redder (CIELAB a*) than their surround blurred over
+    3 px. (Session 19's main: 3.7 % of them, a rash of small red-brown dots; the blind reviewer's
+    "blotchy".)"""
+    from scipy.ndimage import gaussian_filter
+
+    forehead, _, _ = _forehead_and_cheek(face_of("george"), marks, 448)
+    redder = forehead[..., 1] - gaussian_filter(forehead[..., 1], 3)
+    assert np.mean(redder > 2.5) < 0.02, np.mean(redder > 2.5)
+
+
+def test_the_cheeks_flush_is_faint(face_of, marks):
+    """A woman's cheeks without make-up are a shade redder than her forehead, not pink: at 448 px
+    mei's cheek's CIELAB chroma exceeds her forehead's by less than 5.5. (Session 19's main: 6.4,
+    the cheek at C* 28, above the 17-23 of skin measured in vivo.)"""
+    _, cheek, forehead = _forehead_and_cheek(face_of("mei"), marks, 448)
+    excess = np.hypot(*cheek[1:]) - np.hypot(*forehead[1:])
+    assert excess < 5.5, (cheek, forehead)

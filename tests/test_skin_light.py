@@ -28,12 +28,14 @@ def sphere(n_lat: int = 40, n_lon: int = 60):
 
 
 @pytest.mark.parametrize("radius", [0.05, 0.5, 2.0])
-def test_surface_curvature_is_one_over_the_radius(radius):
+def test_surface_curvature_is_one_over_the_radius_positive_on_a_bulge_negative_in_a_hollow(radius):
     points, faces = sphere()
     p = points * radius
     op = smoothing_operator(faces, len(p))
-    curvature = surface_curvature(p, vertex_normals(p, faces), op)
-    assert np.median(curvature) == pytest.approx(1.0 / radius, rel=0.05)
+    normals = vertex_normals(p, faces)
+    outward = normals * np.sign(np.einsum("ij,ij->i", normals, p))[:, None]
+    assert np.median(surface_curvature(p, outward, op)) == pytest.approx(1.0 / radius, rel=0.05)
+    assert np.median(surface_curvature(p, -outward, op)) == pytest.approx(-1.0 / radius, rel=0.05)   # seen from inside
 
 
 def test_a_plane_has_no_curvature_however_fine_its_mesh():
@@ -85,3 +87,44 @@ def test_the_oily_t_zone_shines_more_than_the_dry_cheeks():
     assert oily[highlight][..., :3].mean() > dry[highlight][..., :3].mean() + 4
     rim = (slice(44, 52), slice(84, 90))   # facing away from the key's reflection
     assert oily[rim][..., :3].mean() == pytest.approx(dry[rim][..., :3].mean(), abs=3)
+
+
+def render_sheet(profile, *, mirrored=False):
+    """A 1.2-dm square skin sheet facing the camera whose height (dm) across x is ``profile(x)``,
+    96² orthographic, lit by a frontal key and a faint sky only: (image, pixel column of x).
+    ``mirrored``: its triangles wound the other way (as a mirrored mesh's are)."""
+    xs = np.linspace(-0.6, 0.6, 61)
+    x, y = np.meshgrid(xs, xs)
+    p = np.stack([x, y, profile(x)], -1).reshape(-1, 3).astype(np.float32)
+    ids = np.arange(len(p)).reshape(61, 61)
+    faces = np.concatenate([np.stack([ids[:-1, :-1], ids[:-1, 1:], ids[1:, 1:]], -1).reshape(-1, 3),
+                            np.stack([ids[:-1, :-1], ids[1:, 1:], ids[1:, :-1]], -1).reshape(-1, 3)])
+    if mirrored:
+        faces = faces[:, ::-1]
+    topology = RenderTopology(faces=faces, render_to_geo=np.arange(len(p)), uv=np.full((len(p), 2), 0.5, np.float32),
+                              region=np.full(len(p), REGIONS.index("skin"), np.uint8),
+                              eye_coord=np.zeros((len(p), 3), np.float32))
+    lighting = Lighting(key_direction=(0.0, 0.0, 1.0), fill_color=(0, 0, 0), rim_color=(0, 0, 0),
+                        sky=(0.05, 0.05, 0.05), ground=(0.05, 0.05, 0.05))
+    camera = frame_camera(np.array([-0.6, -0.6, -0.1]), np.array([0.6, 0.6, 0.1]), view="front", projection="orthographic")
+    with Renderer(topology, size=96, antialias=1, shadows=False) as renderer:
+        image = renderer.render(p, appearance=Appearance(DEFAULT_COLORS), camera=camera, lighting=lighting)
+    return image[..., :3].astype(float), lambda at: int(round((at + 0.6) / 1.2 * 95))
+
+
+@pytest.mark.parametrize("mirrored", [False, True])
+def test_hollows_are_shaded_under_a_frontal_key_bulges_are_not(mirrored):
+    """A groove's floor and a ridge's crest face the frontal key as the flat skin beside them does;
+    the groove (a 1-cm-wide hollow, like a nasolabial fold's or an eye socket's side) sees less of the
+    light around it and is darker, the ridge is not (until session 20 both were as bright as the
+    flat: creases and sockets lost their depth under the studio key)."""
+    def bumps(x):
+        return 0.03 * (np.exp(-((x + 0.25) / 0.1) ** 2) - np.exp(-((x - 0.25) / 0.1) ** 2))
+    image, column = render_sheet(bumps, mirrored=mirrored)
+    rows = slice(40, 56)
+
+    def at(x):
+        return image[rows, column(x) - 1:column(x) + 2].mean()
+    flat, groove, ridge = at(0.0), at(0.25), at(-0.25)
+    assert groove < 0.9 * flat, (groove, flat)
+    assert ridge == pytest.approx(flat, rel=0.03), (ridge, flat)

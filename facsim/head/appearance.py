@@ -241,8 +241,10 @@ def character_colors(character: Character) -> dict[str, tuple[float, float, floa
         # until session 20 a paler, orange salmon (ava's lower lip rendered L* 62, C* 35, hue 36).
         "lips": skin * (female * np.array([0.60, 0.40, 0.46]) + (1 - female) * np.array([0.66, 0.49, 0.53]))
         * (1.0 - 0.1 * older),
-        "eyelid": skin * (female * np.array([0.86, 0.74, 0.74]) + (1 - female) * np.array([0.92, 0.80, 0.80])),
-        "cheek": skin * np.array([1.0, 0.70, 0.70]),
+        # The lids: thin skin over vessels, a little darker and cooler than the face, not pink (until
+        # session 20 0.86/0.74/0.74 and 0.92/0.80/0.80: a sore pink ring round george's eyes).
+        "eyelid": skin * (female * np.array([0.84, 0.76, 0.78]) + (1 - female) * np.array([0.89, 0.82, 0.84])),
+        "cheek": skin * np.array([1.0, 0.76, 0.76]),   # (0.70 until session 20)
         # Brows a shade darker than the scalp hair (their hairs are drawn translucent over
         # the skin, which lightens them); they grey later and less than the scalp.
         "brows": (1 - 0.5 * older) * 0.7 * blend("brows") + 0.5 * older * srgb_to_linear(hex_to_rgb(GREY_HAIR)),
@@ -268,7 +270,9 @@ def character_appearance(character: Character, head, *, blush: float | None = No
     ``painted_brows=False`` leaves the brows out of the paint (a brow proxy draws them).
     """
     if blush is None:
-        blush = 0.35 * (1.0 - character.gender) + 0.12
+        # A faint flush on the cheeks' apples, more on women (until session 20 0.35 and 0.12 of a
+        # redder colour: session 19 measured the cheeks above in-vivo skin's chroma, mei C* 28).
+        blush = 0.2 * (1.0 - character.gender) + 0.06
     colors = {k: v for k, v in character_colors(character).items() if k in COLOR_NAMES}
     # A shaved beard shows as a faint blue-grey shadow on men; age lines from about 35.
     beard = float(np.clip((character.gender - 0.5) * 2, 0, 1) * np.clip((character.age - 16) / 6, 0, 1)) * 0.8

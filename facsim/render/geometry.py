@@ -107,17 +107,19 @@ def scattered_normals(normals: np.ndarray, operator: sp.csr_matrix, passes: int 
 
 
 def surface_curvature(positions: np.ndarray, normals: np.ndarray, operator: sp.csr_matrix) -> np.ndarray:
-    """(N,) float32 unsigned curvature (1 / radius, per world unit) per vertex: how far each
+    """(N,) float32 signed curvature (1 / radius, per world unit) per vertex: how far each
     vertex stands off its one-ring's mean along its normal, over the ring's spread (``operator``:
-    :func:`smoothing_operator`), averaged once more over the ring. On a sphere of radius R
-    about 1 / R; on a plane 0; the same whatever the mesh's density (for a ring of k neighbours
-    at distance e the lift is k e² / (2 R (k + 1)) and the spread k e² / (k + 1)).
+    :func:`smoothing_operator`), averaged once more over the ring. Positive where the surface
+    bulges toward its normal (on a sphere of radius R with outward normals about 1 / R),
+    negative in hollows and creases (the shader shades those as ambient occlusion); on a plane
+    0; the same whatever the mesh's density (for a ring of k neighbours at distance e the lift
+    is k e² / (2 R (k + 1)) and the spread k e² / (k + 1)).
     """
     p = np.asarray(positions, np.float32)
     n = np.asarray(normals, np.float32)
     mean = operator @ p
     spread = operator @ np.einsum("ij,ij->i", p, p) - np.einsum("ij,ij->i", mean, mean)
-    lift = np.abs(np.einsum("ij,ij->i", p - mean, n))
+    lift = np.einsum("ij,ij->i", p - mean, n)
     curvature = 2.0 * lift / np.maximum(spread, 1e-12)
     return np.asarray(operator @ np.where(spread > 1e-12, curvature, 0.0), np.float32)
 

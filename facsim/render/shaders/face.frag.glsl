@@ -17,7 +17,7 @@ in vec2 v_uv;
 #endif
 #if defined(REGION_SKIN) || defined(REGION_TONGUE)
 in vec3 v_scatter_normal;   // the normal averaged over a few millimetres (Renderer: scattered_normals)
-in float v_curvature;       // 1 / radius (dm^-1), Renderer: surface_curvature
+in float v_curvature;       // signed 1 / radius (dm^-1; < 0 in hollows), Renderer: surface_curvature
 #endif
 #ifdef USE_EYE
 in vec3 v_eye;
@@ -115,6 +115,17 @@ const float LIP_ROUGHNESS = 0.38;
 // texture (level 3.5: ~11 of its 2048 rows, ~2 mm on hm08's lips), this share of it.
 const float LIP_BORDER_LOD = 4.5;
 const float LIP_BORDER_SOFTNESS = 0.6;
+// Ambient occlusion of the skin's hollows (see main): none where the surface curves inward less
+// than CONCAVE_FROM dm^-1 (a 2-dm radius), CONCAVE_SHADE of the contact light lost at CONCAVE_FULL
+// (a 2.5-cm radius: an eye socket's side, a nasolabial fold) and beyond.
+const float CONCAVE_SHADE = 0.6;
+const float CONCAVE_FROM = 0.5;
+const float CONCAVE_FULL = 4.0;
+// Melanin's tan over the skin (multipliers, linear): freckles and age spots are brown, a little
+// darker than the skin and of about its hue - not the orange of (0.80, 0.66, 0.55), which the key's
+// warmth and the skin's scattering turned into red dots (session 19's "rash" on george).
+const vec3 FRECKLE = vec3(0.86, 0.78, 0.69);
+const vec3 AGE_SPOT = vec3(0.88, 0.81, 0.72);
 
 // Skin's specular (Fresnel F0 = SKIN_F0) from one light, in its two lobes (broad, tight):
 // GGX distributions of the given roughness (by region: skin_lobes in skin_light.glsl, the tight
@@ -470,22 +481,27 @@ void main() {
     // nose tip read as painted); melanin veils much of it in dark skin.
     float veil = mix(0.45, 1.0, smoothstep(0.03, 0.3, dot(u_skin, vec3(0.2126, 0.7152, 0.0722))));
     float red = u_redness * detail.r * veil * mix(0.6, 1.25, smoothstep(0.2, 0.8, 0.55 * blotch + 0.45 * patches));
-    albedo *= mix(vec3(1.0), vec3(1.03, 0.84, 0.83), min((0.75 + 0.3 * u_age) * red, 1.0));   // older: broken veins
+    // (Older: broken veins, a little more. Until session 20 (1.03, 0.84, 0.83) at up to 1.05x the
+    // map: george's nose and cheeks read as flushed, a sore red.)
+    albedo *= mix(vec3(1.0), vec3(1.02, 0.87, 0.87), min((0.75 + 0.15 * u_age) * red, 1.0));
     albedo *= mix(vec3(1.0), vec3(0.78, 0.70, 0.75), tone.r * (0.6 + 0.5 * u_age));
     // The same darker areas (tone.r: around the eyes and the mouth, temples, hairline, the
     // jaw's sides) hold more pigment in melanin-rich skin: darker still, unevenly (a dark
     // face of one even brown read as a plastic mask).
     albedo *= 1.0 - tone.r * mix(0.6, 1.3, patches) * 0.3 * melanin_rich * vec3(0.85, 1.0, 1.15);
     albedo = mix(albedo, albedo * vec3(0.70, 0.72, 0.78), u_beard * detail.g * (1.0 - paint.g));
-    // Age spots: sparse, soft tan patches where the sun reaches, growing with age.
-    float spot = smoothstep(0.72, 0.9, blotch) * tone.a * u_age;
-    albedo *= mix(vec3(1.0), vec3(0.86, 0.76, 0.66), spot);
+    // Age spots (solar lentigines): sparse, soft tan patches a few millimetres to a centimetre
+    // across where the sun reaches, growing with age. (Until session 20 they were the peaks of the
+    // few-mm blotches, an orange multiplier: on george's forehead a rash of small red-brown dots.)
+    float lentigo = 0.7 * value_noise(skin_uv * vec2(60.0, 120.0) + 41.0, 0) + 0.3 * blotch;
+    float spot = smoothstep(0.74, 0.92, lentigo) * tone.a * u_age;
+    albedo *= mix(vec3(1.0), AGE_SPOT, spot);
     // Freckles (cells ~2.5 mm, spots ~1 mm, denser where the sun reaches) and a few moles and
     // small red marks anywhere on the face (cells ~12 mm): no real skin is without them,
     // and they are what makes one person's skin their own.
     float sun = tone.a * (1.0 - paint.g);
     vec2 freckle = spots(skin_uv * vec2(140.0, 280.0), u_freckles * smoothstep(0.05, 0.6, sun), 0.3, 1);
-    albedo *= mix(vec3(1.0), vec3(0.80, 0.66, 0.55), freckle.x * (0.35 + 0.45 * freckle.y));
+    albedo *= mix(vec3(1.0), FRECKLE, freckle.x * (0.3 + 0.4 * freckle.y));
     vec2 mark = spots(skin_uv * vec2(30.0, 60.0), 0.06 * (1.0 - paint.g) * (1.0 - paint.b), 0.09, 2);
     albedo *= mix(vec3(1.0), mix(vec3(0.55, 0.42, 0.36), vec3(1.0, 0.78, 0.76), step(0.55, mark.y)), mark.x);
     albedo = mix(albedo, u_cheek, paint.a);
@@ -627,7 +643,14 @@ void main() {
     // Contact shadows: the baked visibility is close to 1 on the open face and falls only in
     // the nostrils, the lip line, the eye sockets and under the jaw; squaring it deepens
     // those small shadows (a soft studio key still reaches into them partly).
-    float contact = occ * occ;
+    // Hollows shade themselves too, at a scale the baked visibility is too coarse for: where the
+    // surface curves inward (v_curvature < 0) it sees less of the room and the softbox, so the
+    // eye sockets beside the nose, the nasolabial folds, the mouth's corners and the hollow under
+    // the lower lip keep their depth under the frontal key (CONCAVE_SHADE; issue 13: "flat").
+    // (The curvature's sign is the mesh normal's, which surface_normal() turns toward the viewer on
+    // back faces (a mirrored mesh's winding): turned with it, a hollow is a hollow either way.)
+    float hollow = gl_FrontFacing ? -v_curvature : v_curvature;
+    float contact = occ * occ * (1.0 - CONCAVE_SHADE * smoothstep(CONCAVE_FROM, CONCAVE_FULL, hollow));
     // Subsurface look: light wraps past the terminator, red furthest, so the shadow edge is
     // soft and warm (less with age: thinner skin); only a little, as skin scatters light a
     // few millimetres and too much wrap is what looks waxy. Red scatters furthest under the

@@ -23,7 +23,7 @@ out float v_lash;
 #if defined(REGION_SKIN) || defined(REGION_TONGUE)
 in vec3 in_scatter_normal;  // the normal averaged over a few millimetres (subsurface light sees it)
 out vec3 v_scatter_normal;
-in float in_curvature;      // 1 / radius of the surface (dm^-1), render.geometry.surface_curvature
+in float in_curvature;      // signed 1 / radius of the surface (dm^-1), render.geometry.surface_curvature
 out float v_curvature;
 #endif
 #ifdef USE_UV

@@ -6,12 +6,12 @@
 // surface curves tightly within that distance (the nose, the lips, the lids, the ears) the
 // shading wraps past the terminator, warm; where it is broad (the forehead, the cheeks) the
 // falloff is nearly a hard surface's. One wrap everywhere softened the broad planes' modelling
-// too: an even, waxy face. ``curvature``: 1 / radius in dm^-1 (a nose tip ~15, a cheek ~2);
+// too: an even, waxy face. ``curvature``: 1 / radius in dm^-1 (a nose tip ~15, a cheek ~2; its sign, hollow or bulge, does not matter here);
 // returns the share of the full wrap (SCATTER_WRAP) the surface gets.
 const float SCATTER_CURVATURE = 12.0;   // dm^-1 (a radius of ~8 mm) at which the wrap is full
 const float BROAD_WRAP = 0.35;          // the share left on broad, flat skin
 float scatter_reach(float curvature) {
-    return clamp(BROAD_WRAP + (1.0 - BROAD_WRAP) * curvature / SCATTER_CURVATURE, BROAD_WRAP, 1.2);
+    return clamp(BROAD_WRAP + (1.0 - BROAD_WRAP) * abs(curvature) / SCATTER_CURVATURE, BROAD_WRAP, 1.2);
 }
 
 // The skin's two specular lobes (broad, tight) by region: the T-zone (``oil``: oil_density in
