@@ -362,18 +362,19 @@ def test_tightened_lips_keep_their_corners(engine, marks):
     assert delta[marks["upper_lip"], 1] - delta[marks["lower_lip"], 1] < -0.04     # red narrowed >= 4 mm
 
 
+@pytest.mark.parametrize("code", ["23", "24"])
 @pytest.mark.parametrize("preset", ["ava", "kwame", "george"])
-def test_tightened_lips_do_not_widen_the_mouth(face_of, marks, preset):
-    """FACS 23 tightens and thins the red; it does not stretch the mouth as 20 does. With ARKit's
-    mouthPress at 0.6 the corners moved 7.7 mm apart at 23E and anger (4+5+7+23) wore a
-    stretched slot (session 20)."""
+def test_tightened_and_pressed_lips_do_not_widen_the_mouth(face_of, marks, preset, code):
+    """FACS 23 tightens and thins the red, 24 presses the lips together; neither stretches the mouth
+    as 20 does. With ARKit's mouthPress the corners moved 7.7 mm apart at 23E (0.6) and 4.2 mm at 24E
+    (0.25), and anger (4+5+7+23) wore a stretched slot (session 20)."""
     engine = face_of(preset).engine
     corners = [marks["lip_corner_left"], marks["lip_corner_right"]]
 
     def width(positions):
         return float(np.linalg.norm(positions[corners[0]] - positions[corners[1]]))
 
-    assert width(engine.deform(activations(parse("23"))).positions) - width(engine.neutral) < 0.01   # 1 mm
+    assert width(engine.deform(activations(parse(code))).positions) - width(engine.neutral) < 0.01   # 1 mm
 
 
 def test_16_pulls_the_lower_lip_down_not_the_chin(engine, marks):
