@@ -191,6 +191,40 @@ def combination_scales(act: Activations, code: int, side: str) -> dict[str, floa
     return out
 
 
+def mandible_spec() -> dict:
+    """The table's ``mandible``: the jaw's target, its hinge joint and the landmark that turns with the bone."""
+    return register_table().get("mandible") or {}
+
+
+def turning_angles(offsets: np.ndarray, positions: np.ndarray, hinge: np.ndarray) -> np.ndarray:
+    """How far (radians, + opening the jaw: the front moving down) each offset (N, 3) turns its
+    point of ``positions`` (N, 3) about the left-right axis through ``hinge`` (3,).
+
+    >>> turning_angles(np.array([[0.0, -0.1, 0.0]]), np.array([[0.0, 0.0, 1.0]]), np.zeros(3)).round(3)
+    array([0.1])
+    """
+    radial = np.asarray(positions, np.float64)[:, 1:] - np.asarray(hinge, np.float64)[1:]
+    tangent = np.stack([-radial[:, 1], radial[:, 0]], axis=1)  # (y, z) -> (-z, y): the front turns down
+    return (np.asarray(offsets, np.float64)[:, 1:] * tangent).sum(axis=1) / np.maximum((radial ** 2).sum(axis=1), 1e-12)
+
+
+def turn_no_further_than(offsets: np.ndarray, positions: np.ndarray, hinge: np.ndarray, reference: int) -> np.ndarray:
+    """A jaw target's ``offsets`` (N, 3) with no point turning about ``hinge`` further than the point
+    ``reference`` (an index: the chin) does: the offsets of points that turn further are scaled
+    down to its angle. The lower lip lies on the mandible and drops with it.
+
+    >>> pos = np.array([[0.0, 0.0, 1.0], [0.0, -0.2, 1.0]])
+    >>> off = np.array([[0.0, -0.1, 0.0], [0.0, -0.15, -0.03]])
+    >>> turn_no_further_than(off, pos, np.zeros(3), 0).round(3)
+    array([[ 0.  , -0.1 ,  0.  ],
+           [ 0.  , -0.1 , -0.02]])
+    """
+    angles = turning_angles(offsets, positions, hinge)
+    limit = float(angles[reference])
+    scale = np.where(angles > limit, limit / np.maximum(angles, 1e-12), 1.0)
+    return (np.asarray(offsets) * scale[:, None]).astype(np.asarray(offsets).dtype)
+
+
 class RegisterEngine:
     """The register engine (an :class:`~facsim.engines.base.Engine`): Activations → :class:`Deformation`.
 
@@ -238,9 +272,24 @@ class RegisterEngine:
                 geo = self.head.geo_of_base[idx]
                 keep = geo >= 0
                 offsets[geo[keep]] += weight * delta[keep]
+            if col.pattern == mandible_spec().get("target"):
+                offsets = self._on_the_mandible(offsets)
             offsets *= (self._reach if col.sided else self._half)[:, None]
             self._columns[col] = offsets
         return self._columns[col]
+
+    def _on_the_mandible(self, offsets: np.ndarray) -> np.ndarray:
+        """The jaw target's ``offsets`` (N_base_geo, 3), no skin point turning further about the jaw's
+        hinge than the chin does (:func:`turn_no_further_than`, ``mandible`` in the table)."""
+        from facsim.head.landmarks import landmarks
+
+        spec = mandible_spec()
+        positions = self.base_positions[self.head.base_index]
+        skin = self.head.skin_vertex_count
+        out = np.array(offsets, copy=True)
+        out[:skin] = turn_no_further_than(offsets[:skin], positions[:skin], self.head.joint(self.base_positions, spec["hinge"]),
+                                          landmarks(self.head)[spec["reference"]])
+        return out
 
     @cached_property
     def lids(self) -> dict:
