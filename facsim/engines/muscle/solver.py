@@ -847,8 +847,13 @@ def _precondition(model: Model, r: np.ndarray) -> np.ndarray:
 
 def _per_config(a, b) -> np.ndarray:
     """Inner product of two fields per configuration: (3, B, N) × (3, B, N) → (B,), each summed
-    alike whatever the batch's width."""
-    return np.array([np.dot(a[:, k].ravel(), b[:, k].ravel()) for k in range(a.shape[1])])
+    alike whatever the batch's width and however many threads BLAS runs.
+
+    (numpy's pairwise sum, not ``np.dot``: OpenBLAS splits a long dot product over its threads,
+    so its last bits changed with ``OMP_NUM_THREADS`` or a ``threadpool_limits`` left by other
+    code, and a held 1+2+12 on noah ended 2.6 mm from the static solve on one thread, 4.9 on two.)
+    """
+    return np.array([np.add.reduce((a[:, k] * b[:, k]).ravel()) for k in range(a.shape[1])])
 
 
 def minimise(model: Model, x: np.ndarray, ld: Loads, iterations: int, *, tolerance: float = 1e-7,
