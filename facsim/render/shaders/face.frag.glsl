@@ -112,7 +112,8 @@ const vec3 SCATTER_SOFTNESS = vec3(0.6, 0.3, 0.12);
 // The lips' wet film is smoother than the skin's oil: their tight lobe's roughness.
 const float LIP_ROUGHNESS = 0.38;
 // The lips' colour fades into the skin's over the lip mask blurred to this mip level of the paint
-// texture (level 3.5: ~11 of its 2048 rows, ~2 mm on hm08's lips), this share of it.
+// texture (level 4.5: a blur over ~23 of its 2048 rows), this share of it - the red fades over ~2 mm
+// at the border on hm08's lips.
 const float LIP_BORDER_LOD = 4.5;
 const float LIP_BORDER_SOFTNESS = 0.6;
 // Ambient occlusion of the skin's hollows (see main): none where the surface curves inward less
