@@ -43,6 +43,7 @@ import argparse
 import dataclasses
 
 import numpy as np
+from skimage.color import rgb2lab
 
 from facsim import Face
 from facsim.head.character import preset
@@ -100,16 +101,6 @@ def _box(camera, points, r):
     return mask
 
 
-def lab(rgb):
-    """CIELAB (D65) of display-sRGB colours (0-255), (..., 3)."""
-    xyz = srgb_to_linear(np.asarray(rgb, float) / 255) @ np.array([[0.4124, 0.2126, 0.0193],
-                                                                  [0.3576, 0.7152, 0.1192],
-                                                                  [0.1805, 0.0722, 0.9505]])
-    t = xyz / np.array([0.95047, 1.0, 1.08883])
-    f = np.where(t > (6 / 29) ** 3, np.cbrt(t), t / (3 * (6 / 29) ** 2) + 4 / 29)
-    return np.stack([116 * f[..., 1] - 16, 500 * (f[..., 0] - f[..., 1]), 200 * (f[..., 1] - f[..., 2])], -1)
-
-
 def _hsv(rgb):
     rgb = rgb / 255.0
     v = rgb.max(-1)
@@ -150,7 +141,7 @@ def figures(name, expression=""):
         diffuse_rgb = np.clip(2 * (radiance(image) - radiance(half)), 1e-4, None)
         cheeks = _box(camera, [pt("cheek_left") + [-0.1, 0.02, 0.1], pt("cheek_right") + [0.1, 0.02, 0.1]], 14)
         d = diffuse_rgb @ LUMINANCE
-        cheek_lab = np.median(lab(image[regions["cheek"]]), axis=0)
+        cheek_lab = np.median(rgb2lab(image[regions["cheek"]] / 255.0), axis=0)
         out["L*"], out["C*"] = float(cheek_lab[0]), float(np.hypot(cheek_lab[1], cheek_lab[2]))
         out["hue"] = float(np.degrees(np.arctan2(cheek_lab[2], cheek_lab[1])))
         out["tone cv"] = float(100 * np.std((d / np.maximum(gaussian_filter(d, 8), 1e-6))[cheeks]))

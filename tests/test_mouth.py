@@ -407,19 +407,26 @@ def test_a_stretched_open_mouths_back_teeth_are_not_black_wedges(face_of, charac
     assert red > 1.2 * green and red > blue           # warm, lit by the red lining
 
 
-def _upper_lip_red_px(face, expression, size=512):
-    """Pixels of the upper lip's red down the 5 columns at the face's midline (median): from
-    the red's top to where it ends or, on closed lips, to where the lips meet (halfway between
-    the rims' midline vertices)."""
+def _lip_pixels(face, deformation, size):
+    """The lips' pixels under ``deformation``: where renders with the lips painted two different
+    colours differ."""
     from facsim import Face
-    from facsim.render.camera import project
 
-    deformation = face.deform(expression)
     renders = []
     for colour in ("#00ff00", "#0000ff"):
         with Face(face.character.with_(colors={"lips": colour})) as marked:
             renders.append(marked.render(deformation=deformation, size=size, antialias=1)[..., :3].astype(float))
-    lips = np.abs(renders[0] - renders[1]).sum(axis=-1) > 60
+    return np.abs(renders[0] - renders[1]).sum(axis=-1) > 60
+
+
+def _upper_lip_red_px(face, expression, size=512):
+    """Pixels of the upper lip's red down the 5 columns at the face's midline (median): from
+    the red's top to where it ends or, on closed lips, to where the lips meet (halfway between
+    the rims' midline vertices)."""
+    from facsim.render.camera import project
+
+    deformation = face.deform(expression)
+    lips = _lip_pixels(face, deformation, size)
     positions = np.asarray(deformation.positions)
     rim = face._mouth_rim
     meeting = positions[[side[np.argmin(np.abs(positions[side, 0]))] for side in (rim.upper, rim.lower)]].mean(axis=0)
@@ -446,14 +453,7 @@ def _lips_and_opening(face, expression, size=384):
     them: what lies inside the lips' row and column spans and is not lip."""
     from scipy import ndimage
 
-    from facsim import Face
-
-    deformation = face.deform(expression)
-    renders = []
-    for colour in ("#00ff00", "#0000ff"):
-        with Face(face.character.with_(colors={"lips": colour})) as marked:
-            renders.append(marked.render(deformation=deformation, size=size, antialias=1)[..., :3].astype(float))
-    lips = np.abs(renders[0] - renders[1]).sum(axis=-1) > 60
+    lips = _lip_pixels(face, face.deform(expression), size)
     labels, _ = ndimage.label(lips)
     counts = np.bincount(labels.ravel())
     counts[0] = 0

@@ -187,12 +187,21 @@ def rest_table() -> dict:
     return load_yaml("lids.yaml")["rest"]
 
 
-def _margin_over_pupil(lids: EyeLids, rest: np.ndarray, ahead_degrees: float) -> tuple[np.ndarray, float]:
-    """The upper margin's points over the pupil (within ``ahead_degrees`` of straight ahead; the
-    whole margin if fewer than two are) and their mean height above the eye's centre on ``rest``."""
-    ahead = np.abs(lids.upper_lam) < ahead_degrees
-    upper = lids.upper[ahead] if ahead.sum() >= 2 else lids.upper
-    return upper, float(np.mean(rest[upper, 1])) - float(lids.centre[1])
+def _margin_over_pupil(lids: EyeLids, rest: np.ndarray, ahead_degrees: float,
+                       lower: bool = False) -> tuple[np.ndarray, float]:
+    """The upper (or ``lower``) margin's points over the pupil (within ``ahead_degrees`` of straight
+    ahead; the whole margin if fewer than two are) and their mean height above the eye's centre
+    on ``rest``."""
+    points = lids.lower if lower else lids.upper
+    lam = spherical(rest[points], lids.centre)[0] if lower else lids.upper_lam
+    ahead = np.abs(lam) < ahead_degrees
+    points = points[ahead] if ahead.sum() >= 2 else points
+    return points, float(np.mean(rest[points, 1])) - float(lids.centre[1])
+
+
+def _rest_mm(radius: float, table: dict) -> float:
+    """One millimetre of the iris (``iris_mm`` across, ``iris_radius`` eyeball radii) in world units."""
+    return float(table["iris_radius"]) * radius / (0.5 * float(table["iris_mm"]))
 
 
 def rest_lid_weight(lids: EyeLids, rest: np.ndarray, closing: np.ndarray, radius: float,
@@ -237,13 +246,10 @@ def rest_lower_weight(lids: EyeLids, rest: np.ndarray, raising: np.ndarray, radi
     spec = spec or table["lower"]
     if not lids.ok:
         return 0.0
-    lam, _ = spherical(rest[lids.lower], lids.centre)
-    ahead = np.abs(lam) < float(table["ahead_degrees"])
-    lower = lids.lower[ahead] if ahead.sum() >= 2 else lids.lower
-    height = float(np.mean(rest[lower, 1])) - float(lids.centre[1])
+    lower, height = _margin_over_pupil(lids, rest, float(table["ahead_degrees"]), lower=True)
     rise = float(np.mean(raising[lower, 1]))            # dm per unit share
     iris_bottom = -float(table["iris_radius"]) * radius
-    mm = float(table["iris_radius"]) * radius / (0.5 * float(table["iris_mm"]))
+    mm = _rest_mm(radius, table)
     if rise <= 1e-9:
         return 0.0
     return float(np.clip((iris_bottom + float(spec["cover_mm"]) * mm - height) / rise, 0.0, float(spec["max_weight"])))
@@ -266,7 +272,7 @@ def raise_gain(lids: EyeLids, rest: np.ndarray, raising: np.ndarray, radius: flo
     upper, height = _margin_over_pupil(lids, rest, float(rest_spec["ahead_degrees"]))
     lift = float(np.mean(raising[upper, 1]))
     iris_top = float(rest_spec["iris_radius"]) * radius
-    mm = iris_top / (0.5 * float(rest_spec["iris_mm"]))
+    mm = _rest_mm(radius, rest_spec)
     low, high = (float(g) for g in spec["gain"])
     if lift <= 1e-9:
         return 1.0

@@ -199,11 +199,9 @@ class MuscleEngine:
 
     def _measure_rest_lids(self):
         """The relaxed lids (:class:`~facsim.engines.lids.RestLids`) measured on the sculpted skin."""
-        from facsim.engines.lids import RestLids
+        from facsim.engines.lids import RestLids, closing_column, rest_table
 
         net = self.model.net
-        from facsim.engines.lids import closing_column, rest_table
-
         lower = rest_table()["lower"]["target"]
         return RestLids.measure(self.sculpted[:net.count], self._closing_columns.__getitem__,
                                 lambda side: (net.eye_centre[SIDES.index(side)], net.eye_radius), self._margin,
