@@ -265,6 +265,22 @@ LIP_RING_VISIBILITY = (0.5, 0.65, 0.8)
 LINING_RING_VISIBILITY = (0.9, 0.7)
 #: The lips have parted over this range of gap (dm) at a given x: 0.5 mm -> 4 mm.
 LIP_PARTING = (0.005, 0.04)
+#: Where the lips touch, their inner surface (the rings of :data:`LIP_RING_VISIBILITY`)
+#: keeps this fraction of its open visibility: the closed lips' meeting line is a soft,
+#: dark red shade, as in photographs. The bake on the closed mouth buries it (visibility
+#: ~0), which drew a black outline, 1-2 px at 1024 px, round the lips' parting line.
+CLOSED_LIP_VISIBILITY = 0.6
+#: Teeth seen through a slit between the lips (parted in the mouth's middle by less than
+#: :data:`SLIT_GAP` beyond where their rims sit at rest) lie in the dark the slit lets in:
+#: every tooth's height below the lip's edge (-0.5 .. 0.1 dm) is shifted down by this
+#: (dm) × how closed the slit is, and the shader draws heights under -0.7 darker than the
+#: lip's shadow (the teeth's ``CLOSED_LIPS_DARK``). Lit as under a raised lip, the teeth
+#: behind the closed lips' corners showed as grey slivers outlined in black. (All the
+#: teeth shift alike: their heights interpolate across the band's 8-mm triangles.)
+SLIT_SHIFT = 1.5
+#: The slit between the lips opens the teeth to the light as they part this far (dm):
+#: 0.5 mm -> 2.5 mm.
+SLIT_GAP = (0.005, 0.025)
 #: The tongue lies in the dark behind the teeth until the lips part this far (dm) at the
 #: midline, and takes the light the mouth lets in when they have parted this far.
 TONGUE_LIT_GAP = (0.003, 0.025)
@@ -456,18 +472,22 @@ def mouth_light(rim: MouthRim, positions: np.ndarray, occlusion: np.ndarray) -> 
     """
     plane, upper_edge, lower_edge, middle = _lips(rim, positions)
     lo, hi = LIP_PARTING
-    for ring, visibility, rest_gap in zip(rim.rings + rim.lining_rings, LIP_RING_VISIBILITY + LINING_RING_VISIBILITY,
-                                          rim.rest_gap + rim.lining_rest_gap):
+    for ring_index, (ring, visibility, rest_gap) in enumerate(zip(
+            rim.rings + rim.lining_rings, LIP_RING_VISIBILITY + LINING_RING_VISIBILITY, rim.rest_gap + rim.lining_rest_gap)):
         x, _ = plane(ring)
         # Parted beyond where the lips' inner rims sit at rest (they touch in front of them).
         parted = np.clip((upper_edge(x) - lower_edge(x) - rest_gap - lo) / (hi - lo), 0.0, 1.0)
         parted = parted * parted * (3.0 - 2.0 * parted)
-        occlusion[ring] = np.maximum(occlusion[ring], visibility * parted)
+        closed = CLOSED_LIP_VISIBILITY if ring_index < len(rim.rings) else 0.0
+        occlusion[ring] = np.maximum(occlusion[ring], visibility * (closed + (1.0 - closed) * parted))
     lo, hi = TONGUE_LIT_GAP
     lit = np.clip((upper_edge(middle) - lower_edge(middle) - rim.rest_gap_middle - lo) / (hi - lo), 0.0, 1.0)
     occlusion[rim.tongue] = lit * lit * (3.0 - 2.0 * lit)
     lip_x, lip_y = plane(rim.upper_lip)
     corners = plane(rim.upper)[0][[0, -1]]
+    lo, hi = SLIT_GAP
+    parted = np.clip((upper_edge(middle) - lower_edge(middle) - rim.rest_gap_middle - lo) / (hi - lo), 0.0, 1.0)
+    closed = 1.0 - parted * parted * (3.0 - 2.0 * parted)
     for teeth in (rim.upper_teeth, rim.lower_teeth):
         x, y = plane(teeth)
         # The upper lip's lowest point within a tooth column's reach of x.
@@ -475,4 +495,4 @@ def mouth_light(rim: MouthRim, positions: np.ndarray, occlusion: np.ndarray) -> 
         edge = np.where(over.any(axis=1), np.where(over, lip_y[None], np.inf).min(axis=1), upper_edge(x))
         from_corner = np.minimum(x - corners.min(), corners.max() - x)
         slope, offset = COMMISSURE_SHADE
-        occlusion[teeth] = np.minimum(edge - y, slope * from_corner - offset)
+        occlusion[teeth] = np.minimum(edge - y, slope * from_corner - offset) - SLIT_SHIFT * closed
