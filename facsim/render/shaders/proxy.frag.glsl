@@ -135,6 +135,8 @@ float strand_diffuse(vec3 t, vec3 l) {
 
 
 #if defined(KIND_HAIR) && defined(COILY)
+// The share of the pixels coily hair's cap (the cards under the mass) covers with curls.
+const float COILY_CAP_COVER = 0.62;
 // Coily hair seen as a mass (afro01): light falls off into it. Where the eye looks straight
 // into the mass it sees down between the coils, into their shade; toward the outline it
 // grazes the coils' lit tips, so the mass is darker inside and lighter at its rim, as a
@@ -378,7 +380,9 @@ void main() {
     // Fraying below only ever lowers alpha: fragments the texture alone settles are dropped
     // before the noise is computed (most of the blended pass's fragments are cards under the
     // outer layer, seen through its frayed gaps, that belong to the alpha-tested pass).
-#ifdef PASS_OPAQUE
+#if defined(PASS_OPAQUE) && defined(COILY)
+    if (alpha < 0.02) discard;   // coily hair's thin cover turns into solid curls (below)
+#elif defined(PASS_OPAQUE)
     if (alpha < ALPHA_CUTOFF) discard;
 #else
     if (alpha < 0.02 || (alpha >= ALPHA_CUTOFF && v_edge < 0.1 && v_cover > 0.999 && dot(n, v) >= 0.28)) discard;
@@ -477,14 +481,25 @@ void main() {
         // Coily hair's outline breaks up in curls (placed on the neutral face, see below):
         // the volume's edge is a halo of curls with the background between them, not a rim.
         float halo = value_noise3(v_rest * 70.0 + 2.0);
+        // Coily hair is opaque curls with skin or background between them, never a film: the
+        // texture's partial cover (its mipmapped tufts, the cards' thin margins at the
+        // hairline and the temples) is the share of the pixels its curls cover, each curl
+        // there where its rank is under that share (curls ~1.5 mm and clumps of them ~5 mm
+        // across, placed on the neutral head). The cap under the mass (v_depth near 0) toward
+        // its cards' outline, where it shows in the open at the temples, is thinner: the scalp shows between its coils
+        // as it does where real hair thins toward the face, instead of a dark smooth sheet
+        // ending in the cards' straight edge. Where the curls are finer than a pixel, the
+        // share itself.
+        float curl_detail = clamp(2.0 - 1.4 * length(fwidth(v_rest * 70.0)), 0.0, 1.0);
+        float curl_rank = clamp(0.5 + 2.2 * (0.6 * halo + 0.4 * coil_clump - 0.5), 0.02, 0.98);
+        float share = alpha * mix(1.0, COILY_CAP_COVER, smoothstep(0.05, 0.4, v_edge) * (1.0 - smoothstep(0.1, 0.45, v_depth)));
+        float curl_w = 0.04 + fwidth(curl_rank);
+        alpha = mix(alpha, mix(share, smoothstep(curl_rank - curl_w, curl_rank + curl_w, share), curl_detail), u_coil);
         alpha *= 1.0 - u_coil * outline * (1.0 - smoothstep(0.35, 0.65, halo)) * 0.95;
         // and a wider band of the outline goes in and out with the clumps, so the mass's
         // silhouette is lumpy, not a smooth dome.
         float lumps = 1.0 - smoothstep(0.05, 0.45, dot(n, v));
         alpha *= 1.0 - u_coil * lumps * (1.0 - smoothstep(0.3, 0.6, coil_clump));
-        // The cards' thin margins (the blended pass: the hairline, the temples) break into
-        // curls with skin between them instead of lying over the skin as a pale glassy film.
-        alpha *= mix(1.0, smoothstep(0.4, 0.6, halo), u_coil * (1.0 - smoothstep(0.3, 0.6, alpha)));
         // A card's own cut edge (where the mass ends over the temples and the forehead) breaks
         // into curls and clumps of curls ending at different places, so the mass meets the
         // skin in a ragged fringe of coils, not along a brim.
@@ -553,13 +568,15 @@ void main() {
         crown = smoothstep(0.0, 0.22, abs(coil_clump - 0.5));
         // (the finest curls a pixel across keep little contrast: at full strength they
         // speckled the mass)
-        strand = mix(strand, (0.88 + 0.24 * tex.r) * (0.8 + 0.4 * kink) * (0.7 + 0.6 * curls)
-                             * mix(0.6, 1.08, crown), u_coil);
+        strand = mix(strand, (0.88 + 0.24 * tex.r) * (0.75 + 0.5 * kink) * (0.8 + 0.4 * curls)
+                             * mix(0.66, 1.06, crown), u_coil);
         // Greying coily hair mixes white, grey and dark strands curl by curl and clump by
         // clump (placed on the head, not in the cards' mirrored UVs).
         // (at full strength the mix speckled ngozi's afro grey and white pixel by pixel)
-        float white = clamp(u_grey + 0.4 * (value_noise3(v_rest * 22.0 + 4.0) - 0.5) + 0.2 * (kink - 0.5)
-                            + 0.15 * (crown - 0.5), 0.0, 1.0);
+        // (clumps of white and dark a few millimetres across, at 0.4, drew grey afros as
+        // blotchy cloud or cauliflower, blind review session 20: the mix is finer, curl by curl)
+        float white = clamp(u_grey + 0.15 * (value_noise3(v_rest * 22.0 + 4.0) - 0.5) + 0.45 * (kink - 0.5)
+                            + 0.1 * (crown - 0.5), 0.0, 1.0);
         albedo = (u_grey > 0.0 ? mix(u_pigment, u_white, white) : u_color) * strand;
     }
 #else
