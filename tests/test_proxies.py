@@ -351,3 +351,28 @@ def test_coily_hair_is_solid_curls_not_a_cut_out_film(face_of, name):
     specks and pinholes of at most 3 pixels; now 6 each."""
     alpha = face_of(name).render(None, size=256, background=None)[..., 3].astype(np.float32) / 255.0
     assert _specks_and_pinholes(alpha) <= 12
+
+
+def _crown_banding(face, size: int = 256) -> float:
+    """benchmarks/bench_hair_texture.py's ``crown`` figure of ``face``'s neutral front view."""
+    import sys
+    from pathlib import Path
+
+    from facsim.face import Face
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+    from bench_hair_texture import crown_banding, hair_mask
+
+    with Face(face.character.with_(hair="none")) as bald:
+        without = bald.render(None, size=size, background=None)
+    with_hair = face.render(None, size=size, background=None)
+    return crown_banding(with_hair, hair_mask(with_hair, without), without)[0]
+
+
+def test_the_strand_highlight_is_one_band_across_the_crown_not_patches_of_cards(face_of):
+    """The highlight's lobes follow the hair's flow down and out from the crown over the volume
+    (u_hair_apex), not each card's own tangent: with the cards' tangents, long01's crown lit some
+    cards of a row and not their neighbours (blind review, session 20: "highlight patches").
+    On mei (black long01, where the highlight shows most) at 256² the crown figure was 0.178;
+    along the flow 0.112 (ava: 0.085 -> 0.067)."""
+    assert _crown_banding(face_of("mei")) < 0.14

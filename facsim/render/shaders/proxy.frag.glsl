@@ -27,6 +27,9 @@ uniform vec3 u_white;         // ... its white strands' ...
 uniform float u_grey;         // ... and the fraction of white strands (u_color is their mean)
 uniform float u_end_height;   // hair, wisps: where long hair ends (y on the neutral face, dm) ...
 uniform float u_end_fade;     // ... its strands ending one by one over this height above it
+uniform vec3 u_hair_apex;     // hair: a point above the crown the strands flow down and out from (world)
+// How much the strand highlight follows the hair's flow over the volume rather than each card's tangent.
+const float HIGHLIGHT_FLOW = 0.7;
 
 out vec4 f_color;
 
@@ -630,16 +633,29 @@ void main() {
     // two sides' different strand directions do not draw a line along a parting.
     // Where a card's corner tangents disagree (opposite signs), the interpolated tangent
     // shrinks and its direction means nothing: no highlight there (else a bright outline).
-    float gate = smoothstep(0.3, 0.6, kl) * mix(0.2, 1.0, smoothstep(0.2, 0.8, v_depth))
-               * smoothstep(0.6, 0.9, length(v_tangent));
-    float th1 = dot(normalize(t + (0.06 + jitter) * n), h);
-    float th2 = dot(normalize(t + (-0.1 + jitter) * n), h);
+    // The lobes follow the hair's flow over the volume (down and out from the crown along its
+    // surface, u_hair_apex) more than each card's own tangent: cards of a row are tilted and
+    // turned each its own way, and with their tangents the highlight lit some cards and not
+    // their neighbours, a patchwork of bright blocks on long01's crown (blind review, session
+    // 20: "highlight patches"); along the flow it is one soft band across the head, broken
+    // into strands by the jitter below, as a photographed head of hair shows it.
+    vec3 from_apex = v_pos - u_hair_apex;
+    vec3 flow = from_apex - dot(from_apex, n) * n;
+    float flow_len = length(flow);
+    vec3 ts = normalize(mix(t, flow / max(flow_len, 1e-6), HIGHLIGHT_FLOW * smoothstep(0.02, 0.1, flow_len)));
+    // (the under-layers' gate is soft: per card, it drew the cards' outlines into the band)
+    float gate = smoothstep(0.3, 0.6, kl) * mix(0.45, 1.0, smoothstep(0.2, 0.8, v_depth))
+               * mix(smoothstep(0.6, 0.9, length(v_tangent)), 1.0, HIGHLIGHT_FLOW);
+    float th1 = dot(normalize(ts + (0.06 + jitter) * n), h);
+    float th2 = dot(normalize(ts + (-0.1 + jitter) * n), h);
     float s1 = max(1.0 - th1 * th1, 1e-6);   // sin^2
     float s2 = max(1.0 - th2 * th2, 1e-6);
     // (The finer UV scales fade to their means at stimulus sizes: they only modulate, and the
     // pixel-scale strands px break the band, so it reads at 512² as strands catching the light.)
+    // (The texture's own strands and the cards' clumps keep only part of their say: they stop at
+    // each card's edge, and at full strength they cut the band into the cards' shapes.)
     float strands = mix(0.55, 1.0, smoothstep(0.25, 0.7, fine) * smoothstep(0.2, 0.7, mid))
-                  * smoothstep(0.3, 0.65, tex.r) * mix(0.5, 1.0, clump) * smoothstep(0.3, 0.75, px) * 1.5;
+                  * mix(0.45, 1.0, smoothstep(0.3, 0.65, tex.r)) * mix(0.7, 1.0, clump) * smoothstep(0.3, 0.75, px) * 1.4;
     float sparkle = smoothstep(0.45, 0.75, fine) * smoothstep(0.4, 0.7, mid) * smoothstep(0.4, 0.75, px);
     vec3 tint = mix(vec3(1.0), u_color / max(max(u_color.r, u_color.g), max(u_color.b, 1e-4)), 0.5);
     // Light hair's own diffuse is bright already: a full-strength white lobe on it reads as
