@@ -284,6 +284,15 @@ def volume_normals(points: np.ndarray, card_normals: np.ndarray, *, card_weight:
     return (n / (np.linalg.norm(n, axis=1, keepdims=True) + 1e-12)).astype(np.float32)
 
 
+def hair_apex(points: np.ndarray) -> np.ndarray:
+    """(3,) a point a quarter of :data:`VOLUME_RADIUS` above the crown of hair ``points``
+    (N, 3), on the axis of :func:`volume_normals`' volume: strands flow down and out from it
+    over the volume's surface (the shader's strand highlight follows that flow)."""
+    y = points[:, 1]
+    axis = points[y >= np.percentile(y, 90)].mean(axis=0)
+    return np.array([axis[0], float(y.max()) + 0.25 * VOLUME_RADIUS, axis[2]], np.float32)
+
+
 def along_volume(tangents: np.ndarray, normals: np.ndarray) -> np.ndarray:
     """Unit strand directions (N, 3) laid into the hair volume's surface (``normals`` (N, 3):
     :func:`volume_normals` with no card weight): each card keeps its strands' direction
@@ -525,6 +534,10 @@ class ProxyLayer:
                 and np.array_equal(self._last[1], positions)):
             return
         self._last = (camera_position.copy(), positions.copy())
+        if self.mesh.kind == "hair":
+            apex = tuple(float(x) for x in hair_apex(positions))
+            for prog in self.programs.values():
+                _set_uniform(prog, "u_hair_apex", apex)
         p = positions[self.mesh.corner_vertex]
         buf = self._buffer
         buf[:, 0:3] = p

@@ -27,6 +27,9 @@ uniform vec3 u_white;         // ... its white strands' ...
 uniform float u_grey;         // ... and the fraction of white strands (u_color is their mean)
 uniform float u_end_height;   // hair, wisps: where long hair ends (y on the neutral face, dm) ...
 uniform float u_end_fade;     // ... its strands ending one by one over this height above it
+uniform vec3 u_hair_apex;     // hair: a point above the crown the strands flow down and out from (world)
+// How much the strand highlight follows the hair's flow over the volume rather than each card's tangent.
+const float HIGHLIGHT_FLOW = 0.7;
 
 out vec4 f_color;
 
@@ -135,6 +138,8 @@ float strand_diffuse(vec3 t, vec3 l) {
 
 
 #if defined(KIND_HAIR) && defined(COILY)
+// The share of the pixels coily hair's cap (the cards under the mass) covers with curls.
+const float COILY_CAP_COVER = 0.62;
 // Coily hair seen as a mass (afro01): light falls off into it. Where the eye looks straight
 // into the mass it sees down between the coils, into their shade; toward the outline it
 // grazes the coils' lit tips, so the mass is darker inside and lighter at its rim, as a
@@ -378,7 +383,9 @@ void main() {
     // Fraying below only ever lowers alpha: fragments the texture alone settles are dropped
     // before the noise is computed (most of the blended pass's fragments are cards under the
     // outer layer, seen through its frayed gaps, that belong to the alpha-tested pass).
-#ifdef PASS_OPAQUE
+#if defined(PASS_OPAQUE) && defined(COILY)
+    if (alpha < 0.02) discard;   // coily hair's thin cover turns into solid curls (below)
+#elif defined(PASS_OPAQUE)
     if (alpha < ALPHA_CUTOFF) discard;
 #else
     if (alpha < 0.02 || (alpha >= ALPHA_CUTOFF && v_edge < 0.1 && v_cover > 0.999 && dot(n, v) >= 0.28)) discard;
@@ -477,14 +484,25 @@ void main() {
         // Coily hair's outline breaks up in curls (placed on the neutral face, see below):
         // the volume's edge is a halo of curls with the background between them, not a rim.
         float halo = value_noise3(v_rest * 70.0 + 2.0);
+        // Coily hair is opaque curls with skin or background between them, never a film: the
+        // texture's partial cover (its mipmapped tufts, the cards' thin margins at the
+        // hairline and the temples) is the share of the pixels its curls cover, each curl
+        // there where its rank is under that share (curls ~1.5 mm and clumps of them ~5 mm
+        // across, placed on the neutral head). The cap under the mass (v_depth near 0) toward
+        // its cards' outline, where it shows in the open at the temples, is thinner: the scalp shows between its coils
+        // as it does where real hair thins toward the face, instead of a dark smooth sheet
+        // ending in the cards' straight edge. Where the curls are finer than a pixel, the
+        // share itself.
+        float curl_detail = clamp(2.0 - 1.4 * length(fwidth(v_rest * 70.0)), 0.0, 1.0);
+        float curl_rank = clamp(0.5 + 2.2 * (0.6 * halo + 0.4 * coil_clump - 0.5), 0.02, 0.98);
+        float share = alpha * mix(1.0, COILY_CAP_COVER, smoothstep(0.05, 0.4, v_edge) * (1.0 - smoothstep(0.1, 0.45, v_depth)));
+        float curl_w = 0.04 + fwidth(curl_rank);
+        alpha = mix(alpha, mix(share, smoothstep(curl_rank - curl_w, curl_rank + curl_w, share), curl_detail), u_coil);
         alpha *= 1.0 - u_coil * outline * (1.0 - smoothstep(0.35, 0.65, halo)) * 0.95;
         // and a wider band of the outline goes in and out with the clumps, so the mass's
         // silhouette is lumpy, not a smooth dome.
         float lumps = 1.0 - smoothstep(0.05, 0.45, dot(n, v));
         alpha *= 1.0 - u_coil * lumps * (1.0 - smoothstep(0.3, 0.6, coil_clump));
-        // The cards' thin margins (the blended pass: the hairline, the temples) break into
-        // curls with skin between them instead of lying over the skin as a pale glassy film.
-        alpha *= mix(1.0, smoothstep(0.4, 0.6, halo), u_coil * (1.0 - smoothstep(0.3, 0.6, alpha)));
         // A card's own cut edge (where the mass ends over the temples and the forehead) breaks
         // into curls and clumps of curls ending at different places, so the mass meets the
         // skin in a ragged fringe of coils, not along a brim.
@@ -553,13 +571,15 @@ void main() {
         crown = smoothstep(0.0, 0.22, abs(coil_clump - 0.5));
         // (the finest curls a pixel across keep little contrast: at full strength they
         // speckled the mass)
-        strand = mix(strand, (0.88 + 0.24 * tex.r) * (0.8 + 0.4 * kink) * (0.7 + 0.6 * curls)
-                             * mix(0.6, 1.08, crown), u_coil);
+        strand = mix(strand, (0.88 + 0.24 * tex.r) * (0.75 + 0.5 * kink) * (0.8 + 0.4 * curls)
+                             * mix(0.66, 1.06, crown), u_coil);
         // Greying coily hair mixes white, grey and dark strands curl by curl and clump by
         // clump (placed on the head, not in the cards' mirrored UVs).
         // (at full strength the mix speckled ngozi's afro grey and white pixel by pixel)
-        float white = clamp(u_grey + 0.4 * (value_noise3(v_rest * 22.0 + 4.0) - 0.5) + 0.2 * (kink - 0.5)
-                            + 0.15 * (crown - 0.5), 0.0, 1.0);
+        // (clumps of white and dark a few millimetres across, at 0.4, drew grey afros as
+        // blotchy cloud or cauliflower, blind review session 20: the mix is finer, curl by curl)
+        float white = clamp(u_grey + 0.15 * (value_noise3(v_rest * 22.0 + 4.0) - 0.5) + 0.45 * (kink - 0.5)
+                            + 0.1 * (crown - 0.5), 0.0, 1.0);
         albedo = (u_grey > 0.0 ? mix(u_pigment, u_white, white) : u_color) * strand;
     }
 #else
@@ -613,16 +633,29 @@ void main() {
     // two sides' different strand directions do not draw a line along a parting.
     // Where a card's corner tangents disagree (opposite signs), the interpolated tangent
     // shrinks and its direction means nothing: no highlight there (else a bright outline).
-    float gate = smoothstep(0.3, 0.6, kl) * mix(0.2, 1.0, smoothstep(0.2, 0.8, v_depth))
-               * smoothstep(0.6, 0.9, length(v_tangent));
-    float th1 = dot(normalize(t + (0.06 + jitter) * n), h);
-    float th2 = dot(normalize(t + (-0.1 + jitter) * n), h);
+    // The lobes follow the hair's flow over the volume (down and out from the crown along its
+    // surface, u_hair_apex) more than each card's own tangent: cards of a row are tilted and
+    // turned each its own way, and with their tangents the highlight lit some cards and not
+    // their neighbours, a patchwork of bright blocks on long01's crown (blind review, session
+    // 20: "highlight patches"); along the flow it is one soft band across the head, broken
+    // into strands by the jitter below, as a photographed head of hair shows it.
+    vec3 from_apex = v_pos - u_hair_apex;
+    vec3 flow = from_apex - dot(from_apex, n) * n;
+    float flow_len = length(flow);
+    vec3 ts = normalize(mix(t, flow / max(flow_len, 1e-6), HIGHLIGHT_FLOW * smoothstep(0.02, 0.1, flow_len)));
+    // (the under-layers' gate is soft: per card, it drew the cards' outlines into the band)
+    float gate = smoothstep(0.3, 0.6, kl) * mix(0.45, 1.0, smoothstep(0.2, 0.8, v_depth))
+               * mix(smoothstep(0.6, 0.9, length(v_tangent)), 1.0, HIGHLIGHT_FLOW);
+    float th1 = dot(normalize(ts + (0.06 + jitter) * n), h);
+    float th2 = dot(normalize(ts + (-0.1 + jitter) * n), h);
     float s1 = max(1.0 - th1 * th1, 1e-6);   // sin^2
     float s2 = max(1.0 - th2 * th2, 1e-6);
     // (The finer UV scales fade to their means at stimulus sizes: they only modulate, and the
     // pixel-scale strands px break the band, so it reads at 512² as strands catching the light.)
+    // (The texture's own strands and the cards' clumps keep only part of their say: they stop at
+    // each card's edge, and at full strength they cut the band into the cards' shapes.)
     float strands = mix(0.55, 1.0, smoothstep(0.25, 0.7, fine) * smoothstep(0.2, 0.7, mid))
-                  * smoothstep(0.3, 0.65, tex.r) * mix(0.5, 1.0, clump) * smoothstep(0.3, 0.75, px) * 1.5;
+                  * mix(0.45, 1.0, smoothstep(0.3, 0.65, tex.r)) * mix(0.7, 1.0, clump) * smoothstep(0.3, 0.75, px) * 1.4;
     float sparkle = smoothstep(0.45, 0.75, fine) * smoothstep(0.4, 0.7, mid) * smoothstep(0.4, 0.75, px);
     vec3 tint = mix(vec3(1.0), u_color / max(max(u_color.r, u_color.g), max(u_color.b, 1e-4)), 0.5);
     // Light hair's own diffuse is bright already: a full-strength white lobe on it reads as
