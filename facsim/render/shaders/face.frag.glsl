@@ -356,8 +356,15 @@ vec3 tongue_depth_light(float along) {
 // (tongue_depth_light). (A greyed dark, 0.18 of the lining's colour half desaturated, drew
 // the lining seen past the teeth at a wide mouth's corners as grey wedges, and the floor of
 // the mouth under the tongue's tip as a black diamond in the muscle engine's 27.)
-vec3 cavity_deep_colour(vec3 lining) {
-    return 0.4 * lining * vec3(1.0, 0.9, 0.9);
+// That scattered light itself fades toward the throat: ``visibility`` (mouth_depth_visibility,
+// exp(-depth / 1.2 cm)) takes it from 0.4 of the lining's colour just inside the lips down to
+// CAVITY_BACK of that at the back of the mouth (~5 cm: 0.5 left at 1 cm, 0.3 at 3 cm), so the
+// back of an open mouth is near-black, as in photographs; uniform, the palate and the back
+// wall were one flat dark red ("mouth interior flat").
+const float CAVITY_BACK = 0.15;
+const float ROOF_LIGHT = 0.35;
+vec3 cavity_deep_colour(vec3 lining, float visibility) {
+    return 0.4 * lining * vec3(1.0, 0.9, 0.9) * mix(CAVITY_BACK, 1.0, sqrt(visibility));
 }
 #endif
 #ifdef REGION_TEETH
@@ -396,6 +403,20 @@ const float CLOSED_LIPS_DARK = 0.15;
 // row's back teeth and the inside of its arch, which a stretched open mouth (20+26) shows in
 // its corners, were pure black wedges with straight edges (issue 13: "molar wedges").
 const float DEEP_TEETH_LIGHT = 0.04;
+// The lips and cheeks round the opening hide much of the room from the teeth: the fill and
+// the sky reach them with this visibility (the key with KEY_OCCLUSION of the loss). Lit as
+// fully as the face (visibility 1, plus a glow of 0.16 for the enamel's scattering), a
+// smile's teeth stood 1.3 times the cheek's L* (~82 against 63 at 512 px): a white strip
+// "inserted" in the face. In photographs the teeth in the mouth are about as light as the
+// lit skin beside it.
+const float TEETH_AMBIENT = 0.75;
+const float ENAMEL_GLOW = 0.1;
+// What light reaches the enamel inside the mouth has partly bounced off the lips, gums and
+// tongue: warm. (Dimmed without it, the crowns turned grey, not ivory: C* ~11 at L* ~73.)
+const vec3 INSIDE_WARMTH = vec3(1.0, 0.96, 0.88);
+// How far the biting edge's translucent band turns to the blue-grey of the dark behind it
+// (0.65 drew the upper laterals and canines, whose edges are cut back, as grey-blue slabs).
+const float INCISAL_TRANSLUCENCY = 0.4;
 const vec3 DEEP_TEETH_BOUNCE = vec3(1.0, 0.42, 0.38);
 // Where two crowns touch they leave a soft shadow (an embrasure) ``to_gap`` (dm) from the
 // contact, darkest at the biting edge where they part and a thin shade up the crowns to the
@@ -976,7 +997,7 @@ void main() {
     enamel *= 0.96 + 0.08 * mix(0.5, streak, clamp(1.5 - 20.0 * fwidth(v_uv.x), 0.0, 1.0));
     float edge_h = max(h, lingual) - notch;                 // band units above the edge
     float incisal = (1.0 - smoothstep(0.025, 0.1, edge_h)) * (kind <= 2 ? 1.0 : 0.5) * mix(1.0, 0.6, lower);
-    enamel = mix(enamel, dot(u_albedo, vec3(0.33)) * vec3(0.86, 0.92, 1.0), 0.65 * incisal);
+    enamel = mix(enamel, dot(u_albedo, vec3(0.33)) * vec3(0.86, 0.92, 1.0), INCISAL_TRANSLUCENCY * incisal);
     float halo_w = max(0.012, fwidth(edge_h));
     enamel *= 1.0 + 0.22 * exp(-edge_h * edge_h / (halo_w * halo_w)) * (0.012 / halo_w) * float(shaped);
     enamel *= mix(vec3(1.0), vec3(1.0, 0.93, 0.8), smoothstep(0.3, gum_edge, h));
@@ -1016,7 +1037,8 @@ void main() {
     float wet = specular_light(n, v, 120.0).r * 0.35 + specular_light(n, v, 30.0).r * 0.05;
     vec3 spec = vec3(wet) * (1.0 - 0.6 * gum) * schlick(0.05, max(dot(n, v), 0.0)) * 3.0;
     // Enamel scatters light inside the tooth: a little of its own brightness beyond the lighting.
-    radiance = ((diffuse_light(n, vec3(0.3, 0.25, 0.2), 1.0) * 0.9 + 0.16) * albedo + spec) * mouth_shade;
+    radiance = ((diffuse_light(n, vec3(0.3, 0.25, 0.2), TEETH_AMBIENT) * 0.9 + ENAMEL_GLOW) * albedo * mix(INSIDE_WARMTH, vec3(1.0), gum)
+                + spec) * mouth_shade;
     // What light reaches the back teeth has bounced off the cheeks' red lining: warm, not grey.
     // So does what reaches the inside of the arch.
     radiance *= mix(vec3(1.0, 0.6, 0.5), vec3(1.0), depth_shade * (1.0 - 0.8 * smoothstep(0.0, 0.3, lingual)));
@@ -1062,10 +1084,13 @@ void main() {
     // saturated red (seen through the gaps between the teeth, red read as braces' bands).
     // Just inside the lips the lining is their mucosa going on, lit through the opening as
     // the lips part (mouth_light lifts occ there): the lips' red and wet film, not the dark.
-    float mouth_shade = occ * occ;
     float lip_side = smoothstep(0.6, 0.9, occ);
+    // The palate faces down, away from what light the opening lets in, in the shade of the
+    // upper teeth and lip: lit only by what the tongue bounces up (ROOF_LIGHT). Lit as the
+    // floor, it was a flat red shelf under the upper teeth.
+    float mouth_shade = occ * occ * mix(ROOF_LIGHT, 1.0, max(smoothstep(-0.7, 0.0, n.y), lip_side));
     vec3 spec = specular_light(n, v, 30.0) * mix(0.04, 0.3, lip_side);
-    vec3 deep = cavity_deep_colour(u_albedo);
+    vec3 deep = cavity_deep_colour(u_albedo, occ);
     vec3 albedo = mix(u_albedo * 0.45, MUCOSA * 0.8, lip_side);
     radiance = (diffuse_light(n, vec3(0.3, 0.1, 0.1), 1.0) * albedo + spec) * mouth_shade
              + deep * (1.0 - mouth_shade);
