@@ -508,7 +508,10 @@ void main() {
         // ending in the cards' straight edge. Where the curls are finer than a pixel, the
         // share itself.
         float curl_detail = clamp(2.0 - 1.4 * length(fwidth(v_rest * 70.0)), 0.0, 1.0);
-        float curl_rank = clamp(0.5 + 2.2 * (0.6 * halo + 0.4 * coil_clump - 0.5), 0.02, 0.98);
+        // (single curls keep their say only where they are a couple of pixels across: at 448²
+        // a curl a pixel across dithered the mass's edges into dark and light specks)
+        float curl_weight = 0.6 * clamp(1.6 - 1.4 * length(fwidth(v_rest * 70.0)), 0.0, 1.0);
+        float curl_rank = clamp(0.5 + 2.2 * (curl_weight * halo + (1.0 - curl_weight) * coil_clump - 0.5), 0.02, 0.98);
         float share = alpha * mix(1.0, COILY_CAP_COVER, smoothstep(0.05, 0.4, v_edge) * (1.0 - smoothstep(0.1, 0.45, v_depth)));
         float curl_w = 0.04 + fwidth(curl_rank);
         alpha = mix(alpha, mix(share, smoothstep(curl_rank - curl_w, curl_rank + curl_w, share), curl_detail), u_coil);
