@@ -86,9 +86,8 @@ float pixel_strands_uv(vec2 uv, vec2 base, vec2 offset) {
 // nears or leaves the camera. Noise of fixed frequency fades to its mean at stimulus sizes (a
 // flat, clay-like mass); this keeps strand-level variation in every image. [0, 1], mean 0.5.
 float smeared_noise(vec3 p, vec3 step) {
-    // (unevenly spaced: evenly spaced samples beat against the lattice into a woven grid)
-    return (lattice_noise3(p - 1.93 * step) + lattice_noise3(p - 0.81 * step) + lattice_noise3(p)
-            + lattice_noise3(p + 1.07 * step) + lattice_noise3(p + 2.29 * step)) * 0.2;
+    return (lattice_noise3(p - 2.0 * step) + lattice_noise3(p - step) + lattice_noise3(p)
+            + lattice_noise3(p + step) + lattice_noise3(p + 2.0 * step)) * 0.2;
 }
 
 float pixel_strands(vec3 rest, vec3 along, float cells_per_dm) {
@@ -100,8 +99,8 @@ float pixel_strands(vec3 rest, vec3 along, float cells_per_dm) {
     // llvmpipe twenty-four hashes); elsewhere one is taken.
     float f = smoothstep(0.35, 0.65, clamp(level - k, 0.0, 1.0)) * step(k, 1.5);
     float s0 = exp2(k);
-    float n0 = f < 0.999 ? smeared_noise(p * s0 + 3.0, 1.3 * along) : 0.5;
-    float n1 = f > 0.001 ? smeared_noise(p * (2.0 * s0) + 11.0, 1.3 * along) : 0.5;
+    float n0 = f < 0.999 ? smeared_noise(p * s0 + 3.0, 1.2 * along) : 0.5;
+    float n1 = f > 0.001 ? smeared_noise(p * (2.0 * s0) + 11.0, 1.2 * along) : 0.5;
     // (a mean of three samples along a few cells varies ~1/1.5 as much as one; most of that
     // is given back, not all, so the darkest strands do not stand out as dots)
     float n = 0.5 + 1.35 * (mix(n0, n1, f) - 0.5) / sqrt(f * f + (1.0 - f) * (1.0 - f));
