@@ -347,7 +347,7 @@ def test_coily_hair_is_solid_curls_not_a_cut_out_film(face_of, name):
     outline) is drawn as opaque curls with skin or background between them, each curl there
     where its rank is under the cover, not as a translucent film whose alpha test cut it into
     single-pixel specks and pinholes (blind review, session 20: "cut-out edges", "cloud-like
-    hair"). At 256² on a transparent background the silhouette had 20 (amara) and 28 (ngozi)
+    hair"). At 256² on a transparent background the silhouette had 29 (amara) and 34 (ngozi)
     specks and pinholes of at most 3 pixels; now 6 each."""
     alpha = face_of(name).render(None, size=256, background=None)[..., 3].astype(np.float32) / 255.0
     assert _specks_and_pinholes(alpha) <= 12

@@ -86,7 +86,8 @@ float pixel_strands_uv(vec2 uv, vec2 base, vec2 offset) {
 // nears or leaves the camera. Noise of fixed frequency fades to its mean at stimulus sizes (a
 // flat, clay-like mass); this keeps strand-level variation in every image. [0, 1], mean 0.5.
 float smeared_noise(vec3 p, vec3 step) {
-    return (lattice_noise3(p - step) + lattice_noise3(p) + lattice_noise3(p + step)) * (1.0 / 3.0);
+    return (lattice_noise3(p - 2.0 * step) + lattice_noise3(p - step) + lattice_noise3(p)
+            + lattice_noise3(p + step) + lattice_noise3(p + 2.0 * step)) * 0.2;
 }
 
 float pixel_strands(vec3 rest, vec3 along, float cells_per_dm) {
@@ -98,11 +99,11 @@ float pixel_strands(vec3 rest, vec3 along, float cells_per_dm) {
     // llvmpipe twenty-four hashes); elsewhere one is taken.
     float f = smoothstep(0.35, 0.65, clamp(level - k, 0.0, 1.0)) * step(k, 1.5);
     float s0 = exp2(k);
-    float n0 = f < 0.999 ? smeared_noise(p * s0 + 3.0, 1.1 * along) : 0.5;
-    float n1 = f > 0.001 ? smeared_noise(p * (2.0 * s0) + 11.0, 1.1 * along) : 0.5;
+    float n0 = f < 0.999 ? smeared_noise(p * s0 + 3.0, 1.2 * along) : 0.5;
+    float n1 = f > 0.001 ? smeared_noise(p * (2.0 * s0) + 11.0, 1.2 * along) : 0.5;
     // (a mean of three samples along a few cells varies ~1/1.5 as much as one; most of that
     // is given back, not all, so the darkest strands do not stand out as dots)
-    float n = 0.5 + 1.3 * (mix(n0, n1, f) - 0.5) / sqrt(f * f + (1.0 - f) * (1.0 - f));
+    float n = 0.5 + 1.35 * (mix(n0, n1, f) - 0.5) / sqrt(f * f + (1.0 - f) * (1.0 - f));
     // Where even the coarsest octave is finer than a pixel, its mean.
     return mix(0.5, clamp(n, 0.0, 1.0), clamp(2.2 - 1.6 * cells, 0.0, 1.0));
 }
@@ -255,12 +256,24 @@ void main() {
     float wander = value_noise(v_uv * vec2(2.5, 0.8) + 11.0, 0) - 0.5;
     float dens = v_depth * 1.08 - 0.04 + 1.3 * wander * v_depth * (1.0 - v_depth);
     float keep = smoothstep(tex.g - w, tex.g + w, dens);
-    // Tufts finer than a pixel (texels of the tile per pixel across the strands) show only
-    // as their mean cover.
-    keep = mix(keep, clamp(dens, 0.0, 1.0), smoothstep(16.0, 40.0, fwidth(suv.x) * 256.0));
     // Where the cover thins, the hairs that are left are finer and fewer: the tuft's own
     // strands (tex.a) show more of the skin between them, so the hairline ends in wisps.
-    float alpha = mix(tex.a * tex.a * tex.a, tex.a, smoothstep(0.2, 0.9, dens)) * keep * 0.92;
+    float alpha = mix(tex.a * tex.a * tex.a, tex.a, smoothstep(0.2, 0.9, dens));
+#ifndef COILY
+    // Tufts finer than a pixel (texels of the tile per pixel across the strands; 448-512²
+    // stimuli): their mean cover drew the hairline as an even translucent film of the hair's
+    // colour over the forehead, a brim under the cards. Strands and clumps a few pixels across
+    // along the flow (pixel_strands_uv) take their place: each there where its rank is under
+    // the density, so the band thins into streaks of hair with skin between them.
+    float sub = smoothstep(16.0, 40.0, fwidth(suv.x) * 256.0);
+    float streak = clamp(0.5 + 2.2 * (pixel_strands_uv(suv, vec2(4.0, 1.5), vec2(3.0, 7.0)) - 0.5), 0.02, 0.98);
+    keep = mix(keep, smoothstep(streak - 0.1, streak + 0.1, dens), sub);
+    alpha = mix(alpha, mix(0.6, 1.0, smoothstep(0.3, 0.9, dens)), sub);
+#else
+    // Tufts finer than a pixel show only as their mean cover (the coils below break it up).
+    keep = mix(keep, clamp(dens, 0.0, 1.0), smoothstep(16.0, 40.0, fwidth(suv.x) * 256.0));
+#endif
+    alpha *= keep * 0.92;
     if (alpha < 0.01) discard;
     vec3 n = normalize(v_normal);
     vec3 t = normalize(v_tangent);
@@ -494,7 +507,10 @@ void main() {
         // ending in the cards' straight edge. Where the curls are finer than a pixel, the
         // share itself.
         float curl_detail = clamp(2.0 - 1.4 * length(fwidth(v_rest * 70.0)), 0.0, 1.0);
-        float curl_rank = clamp(0.5 + 2.2 * (0.6 * halo + 0.4 * coil_clump - 0.5), 0.02, 0.98);
+        // (single curls keep their say only where they are a couple of pixels across: at 448²
+        // a curl a pixel across dithered the mass's edges into dark and light specks)
+        float curl_weight = 0.6 * clamp(1.6 - 1.4 * length(fwidth(v_rest * 70.0)), 0.0, 1.0);
+        float curl_rank = clamp(0.5 + 2.2 * (curl_weight * halo + (1.0 - curl_weight) * coil_clump - 0.5), 0.02, 0.98);
         float share = alpha * mix(1.0, COILY_CAP_COVER, smoothstep(0.05, 0.4, v_edge) * (1.0 - smoothstep(0.1, 0.45, v_depth)));
         float curl_w = 0.04 + fwidth(curl_rank);
         alpha = mix(alpha, mix(share, smoothstep(curl_rank - curl_w, curl_rank + curl_w, share), curl_detail), u_coil);
@@ -587,7 +603,7 @@ void main() {
     // Greying hair: white, grey and dark strands side by side at the pixel scale too (the
     // clump-scale mix above fades to one flat grey at stimulus sizes).
     if (u_grey > 0.0)
-        albedo = mix(albedo, mix(u_pigment, u_white, clamp(u_grey + 0.9 * (px_full - 0.5), 0.0, 1.0)) * strand, 0.7);
+        albedo = mix(albedo, mix(u_pigment, u_white, clamp(u_grey + 0.45 * (px_full - 0.5), 0.0, 1.0)) * strand, 0.7);
     // Strands differ in pigment, not only in brightness: lighter ones warmer (less eumelanin:
     // pheomelanin's red-gold shows), darker ones cooler, clump by clump and strand by strand
     // (white strands have none to vary); and long hair's tips, older and weathered, are a
