@@ -670,3 +670,22 @@ def test_the_dropped_jaw_leaves_the_skin_over_the_maxilla(face_of, marks, charac
         assert -moved[marks["chin"], 1] > 0.15, text    # the jaw still drops (15 mm at least)
         for side in ("left", "right"):
             assert abs(moved[marks[f"nasolabial_fold_{side}"], 1]) < 0.015, (text, side)
+
+
+@pytest.mark.parametrize("character", ["ava", "george", "kwame"])
+def test_15_pulls_the_corners_down_not_the_cheeks_and_jowls(face_of, marks, character):
+    """Session 21: depressor anguli oris pulls the lip corner down toward its origin on the mandible;
+    the skin around the corner follows less with distance. ARKit's mouthFrown moved a slab of cheek and
+    jowl from the nasolabial fold (3.9 mm down on liam) to the jaw line as one piece, with a U-shaped
+    pouch under the mouth where it met the still chin ("rubbery chin", a blind reviewer, liam's sadness)."""
+    face = face_of(character)
+    rest = np.asarray(face.neutral, np.float64)
+    skin = face.head.skin_vertex_count
+    moved = np.asarray(face.deform("15E").positions, np.float64)[:skin] - rest[:skin]
+    corners = rest[[marks["lip_corner_left"], marks["lip_corner_right"]]]
+    assert -moved[[marks["lip_corner_left"], marks["lip_corner_right"]], 1].min() > 0.04   # corners 4 mm down
+    distance = np.linalg.norm(rest[:skin, None] - corners[None], axis=2).min(axis=1)
+    far = distance > 0.25
+    assert np.linalg.norm(moved[far], axis=1).max() < 0.01   # nothing 25 mm from the corners moves 1 mm
+    for side in ("left", "right"):
+        assert abs(moved[marks[f"nasolabial_fold_{side}"], 1]) < 0.015, side

@@ -285,6 +285,9 @@ class RegisterEngine:
                 offsets[geo[keep]] += weight * delta[keep]
             if col.pattern == mandible_spec().get("target"):
                 offsets = self._on_the_mandible(offsets)
+            reach = (register_table().get("corner_reach") or {}).get(col.pattern)
+            if reach:
+                offsets = self._near_the_corner(offsets, col.side, reach)
             offsets *= (self._reach if col.sided else self._half)[:, None]
             self._columns[col] = offsets
         return self._columns[col]
@@ -307,6 +310,17 @@ class RegisterEngine:
             band = (float(held["free_below_mm"]) / 100.0, float(held["held_above_mm"]) / 100.0)
             out[:skin] *= mandible_share(positions[:skin, 1], lip_line, band)[:, None].astype(out.dtype)
         return out
+
+    def _near_the_corner(self, offsets: np.ndarray, side: str, reach: Mapping[str, float]) -> np.ndarray:
+        """A lip-corner target's ``offsets`` (N_base_geo, 3) kept in full within ``reach["full_mm"]`` of the
+        ``side`` lip corner and fading out by ``reach["none_mm"]`` (``corner_reach`` in the table)."""
+        from facsim.head.landmarks import landmarks
+
+        positions = self.base_positions[self.head.base_index]
+        corner = positions[landmarks(self.head)[f"lip_corner_{side}"]]
+        distance = np.linalg.norm(positions - corner, axis=1)
+        share = smoothstep(float(reach["none_mm"]) / 100.0, float(reach["full_mm"]) / 100.0, distance)
+        return (offsets * share[:, None]).astype(offsets.dtype)
 
     @cached_property
     def lids(self) -> dict:
