@@ -689,3 +689,19 @@ def test_15_pulls_the_corners_down_not_the_cheeks_and_jowls(face_of, marks, char
     assert np.linalg.norm(moved[far], axis=1).max() < 0.01   # nothing 25 mm from the corners moves 1 mm
     for side in ("left", "right"):
         assert abs(moved[marks[f"nasolabial_fold_{side}"], 1]) < 0.015, side
+
+
+@pytest.mark.parametrize("character", ["ava", "george", "kwame"])
+def test_20_stretches_the_lips_not_the_cheeks(face_of, marks, character):
+    """Session 21: risorius stretches the lip corners out; ARKit's mouthStretch slid the cheeks beside the
+    mouth out with them down to the jaw line, a stretch a blind reviewer called exaggerated on ava, amara
+    and mei's fear (and with the dropped jaw, rubbery columns beside george's mouth)."""
+    face = face_of(character)
+    rest = np.asarray(face.neutral, np.float64)
+    skin = face.head.skin_vertex_count
+    moved = np.asarray(face.deform("20E").positions, np.float64)[:skin] - rest[:skin]
+    corner_ids = [marks["lip_corner_left"], marks["lip_corner_right"]]
+    assert moved[corner_ids[0], 0] - moved[corner_ids[1], 0] > 0.08    # the mouth 8 mm wider
+    distance = np.linalg.norm(rest[:skin, None] - rest[corner_ids][None], axis=2).min(axis=1)
+    cheeks = (distance > 0.3) & (np.abs(rest[:skin, 0]) > rest[corner_ids[0], 0])   # beyond the corners
+    assert np.linalg.norm(moved[cheeks], axis=1).max() < 0.01   # nothing 30 mm out moves 1 mm
