@@ -705,3 +705,18 @@ def test_20_stretches_the_lips_not_the_cheeks(face_of, marks, character):
     distance = np.linalg.norm(rest[:skin, None] - rest[corner_ids][None], axis=2).min(axis=1)
     cheeks = (distance > 0.3) & (np.abs(rest[:skin, 0]) > rest[corner_ids[0], 0])   # beyond the corners
     assert np.linalg.norm(moved[cheeks], axis=1).max() < 0.01   # nothing 30 mm out moves 1 mm
+
+
+@pytest.mark.parametrize("character", ["ava", "george", "kwame"])
+def test_12_lifts_the_corners_not_the_jaw_line(face_of, marks, character):
+    """Session 21: zygomaticus major pulls the lip corners up and back, and the skin below them follows
+    less with depth; ARKit's mouthSmile lifted the skin over the mandible with them (12 mm at 20 mm below
+    ava's corners), widening the jowls into "rubbery cheeks" (a blind reviewer, broad smiles)."""
+    face = face_of(character)
+    rest = np.asarray(face.neutral, np.float64)
+    skin = face.head.skin_vertex_count
+    moved = np.asarray(face.deform("12E").positions, np.float64)[:skin] - rest[:skin]
+    corner_ids = [marks["lip_corner_left"], marks["lip_corner_right"]]
+    assert moved[corner_ids, 1].min() > 0.1                       # the corners 10 mm up
+    jaw = rest[:skin, 1] < rest[corner_ids, 1].mean() - 0.3        # 30 mm below the corners or more
+    assert np.abs(moved[jaw, 1]).max() < 0.01

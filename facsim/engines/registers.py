@@ -313,12 +313,16 @@ class RegisterEngine:
 
     def _near_the_corner(self, offsets: np.ndarray, side: str, reach: Mapping[str, float]) -> np.ndarray:
         """A lip-corner target's ``offsets`` (N_base_geo, 3) kept in full within ``reach["full_mm"]`` of the
-        ``side`` lip corner and fading out by ``reach["none_mm"]`` (``corner_reach`` in the table)."""
+        ``side`` lip corner and fading out by ``reach["none_mm"]`` (``corner_reach`` in the table); with
+        ``below: true`` the distance is the depth below the corner's height (nothing above it is held)."""
         from facsim.head.landmarks import landmarks
 
         positions = self.base_positions[self.head.base_index]
         corner = positions[landmarks(self.head)[f"lip_corner_{side}"]]
-        distance = np.linalg.norm(positions - corner, axis=1)
+        if reach.get("below"):
+            distance = np.maximum(corner[1] - positions[:, 1], 0.0)
+        else:
+            distance = np.linalg.norm(positions - corner, axis=1)
         share = smoothstep(float(reach["none_mm"]) / 100.0, float(reach["full_mm"]) / 100.0, distance)
         return (offsets * share[:, None]).astype(offsets.dtype)
 
