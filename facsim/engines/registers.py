@@ -285,6 +285,8 @@ class RegisterEngine:
                 offsets[geo[keep]] += weight * delta[keep]
             if col.pattern == mandible_spec().get("target"):
                 offsets = self._on_the_mandible(offsets)
+            if col.pattern in (register_table().get("skin_only") or ()):
+                offsets[self.head.skin_vertex_count:] = 0.0   # the teeth and tongue keep their shape
             reach = (register_table().get("corner_reach") or {}).get(col.pattern)
             if reach:
                 offsets = self._near_the_corner(offsets, col.side, reach)
