@@ -720,3 +720,16 @@ def test_12_lifts_the_corners_not_the_jaw_line(face_of, marks, character):
     assert moved[corner_ids, 1].min() > 0.1                       # the corners 10 mm up
     jaw = rest[:skin, 1] < rest[corner_ids, 1].mean() - 0.3        # 30 mm below the corners or more
     assert np.abs(moved[jaw, 1]).max() < 0.01
+
+
+@pytest.mark.parametrize("character", ["ava", "george", "kwame"])
+def test_27_stretches_the_mouth_open_taller_not_wider(face_of, character):
+    """Session 21: in 27 the lips stretch over the widely dropped jaw and draw the corners in, an oval
+    taller than wide; ARKit's mouthStretch pulled them out into a round ring (the mouth 0.4 mm narrower
+    than at rest on ava, 1.7 on george)."""
+    from facsim.speech.mouth import mouth_shape
+
+    face = face_of(character)
+    rest, open_ = mouth_shape(face, positions=face.neutral), mouth_shape(face, positions=face.deform("27E").positions)
+    assert open_.width < rest.width - 4.0      # mm: the corners drawn in
+    assert open_.gap > 0.6 * open_.width       # the opening's height against the mouth's width
