@@ -7,9 +7,10 @@ distance between the inner brows (negative: drawn together, AU 4).
 With ``--upper``: the upper-face figures instead — brow rise and spread, the
 glabella's drop, the upper and lower lids' rise, the eye's aperture change
 (negative: narrowed), the cheek's and nose wing's rise (AU 6, 9, 10).
-With ``--lower``: the lower face — the lip corners' rise (mean of both sides),
+With ``--lower``: the lower face — the chin's drop, the lip corners' rise (mean of both sides),
 the change of the mouth's width, the rise of the upper lip's inner edge at the
-midline, the forward motion of the lips, and how far the upper lip's inner
+midline, the rise of the nasolabial fold beside the nose (the skin over the maxilla:
+about 0 when the jaw drops), the forward motion of the lips, and how far the upper lip's inner
 edge lies above the upper incisors' edge (positive: that much upper tooth
 shows when the lips are parted; about -1 at rest).
 
@@ -35,7 +36,7 @@ COLUMNS = ("chin", "lo-lip", "jaw", "gap", "in-brow", "out-brow", "brow-dx")
 UPPER_EXPRESSIONS = ["1", "2", "4", "1+2", "1+4", "1+2+4", "5", "6", "7", "9", "41", "42", "43", "44",
                      "anger", "fear", "sadness", "surprise", "disgust", "happiness"]
 UPPER_COLUMNS = ("in-brow", "out-brow", "brow-dx", "glab", "up-lid", "lo-lid", "aperture", "cheek", "nose")
-LOWER_COLUMNS = ("lo-lip", "jaw", "gap", "corner", "width", "up-lip", "protr", "teeth")
+LOWER_COLUMNS = ("chin", "lo-lip", "jaw", "gap", "corner", "width", "up-lip", "naso", "protr", "teeth")
 
 
 def amplitudes(face, expression) -> dict[str, float]:
@@ -77,6 +78,7 @@ def amplitudes(face, expression) -> dict[str, float]:
         "corner": MM * np.mean(p[corners, 1] - rest[corners, 1]),
         "width": shape.width - rest_shape.width,
         "up-lip": MM * (p[gauge.upper_lip, 1] - rest[gauge.upper_lip, 1]),
+        "naso": rise("nasolabial_fold"),
         "protr": shape.protrusion,
         "teeth": MM * (p[gauge.upper_lip, 1] - p[gauge.incisor_edge, 1]),
     }

@@ -655,3 +655,81 @@ def test_the_lower_lip_drops_with_the_chin(face_of, marks, character):
 
         assert turn(marks["chin"]) > np.radians(10), text
         assert turn(lip) < 1.03 * turn(marks["chin"]), text
+
+
+@pytest.mark.parametrize("character", ["ava", "george", "kwame"])
+def test_the_dropped_jaw_leaves_the_skin_over_the_maxilla(face_of, marks, character):
+    """Session 21: the upper lip and the cheeks beside the nose lie on the maxilla, which does not move
+    when the mandible drops (26, 27). The authored jawOpen dragged them with it: the nasolabial fold
+    came down 5.7 mm at 26E and 9.1 mm at 27E on george, long folds of skin beside the open mouth
+    ("rubbery mouth and neck", a blind reviewer, fear and surprise at 100 %)."""
+    face = face_of(character)
+    rest = np.asarray(face.neutral, np.float64)
+    for text in ("26E", "27E"):
+        moved = np.asarray(face.deform(text).positions, np.float64) - rest
+        assert -moved[marks["chin"], 1] > 0.15, text    # the jaw still drops (15 mm at least)
+        for side in ("left", "right"):
+            assert abs(moved[marks[f"nasolabial_fold_{side}"], 1]) < 0.015, (text, side)
+
+
+@pytest.mark.parametrize("character", ["ava", "george", "kwame"])
+def test_15_pulls_the_corners_down_not_the_cheeks_and_jowls(face_of, marks, character):
+    """Session 21: depressor anguli oris pulls the lip corner down toward its origin on the mandible;
+    the skin around the corner follows less with distance. ARKit's mouthFrown moved a slab of cheek and
+    jowl from the nasolabial fold (3.9 mm down on liam) to the jaw line as one piece, with a U-shaped
+    pouch under the mouth where it met the still chin ("rubbery chin", a blind reviewer, liam's sadness)."""
+    face = face_of(character)
+    rest = np.asarray(face.neutral, np.float64)
+    skin = face.head.skin_vertex_count
+    moved = np.asarray(face.deform("15E").positions, np.float64)[:skin] - rest[:skin]
+    corners = rest[[marks["lip_corner_left"], marks["lip_corner_right"]]]
+    assert -moved[[marks["lip_corner_left"], marks["lip_corner_right"]], 1].min() > 0.04   # corners 4 mm down
+    distance = np.linalg.norm(rest[:skin, None] - corners[None], axis=2).min(axis=1)
+    far = distance > 0.25
+    assert np.linalg.norm(moved[far], axis=1).max() < 0.01   # nothing 25 mm from the corners moves 1 mm
+    for side in ("left", "right"):
+        assert abs(moved[marks[f"nasolabial_fold_{side}"], 1]) < 0.015, side
+
+
+@pytest.mark.parametrize("character", ["ava", "george", "kwame"])
+def test_20_stretches_the_lips_not_the_cheeks(face_of, marks, character):
+    """Session 21: risorius stretches the lip corners out; ARKit's mouthStretch slid the cheeks beside the
+    mouth out with them down to the jaw line, a stretch a blind reviewer called exaggerated on ava, amara
+    and mei's fear (and with the dropped jaw, rubbery columns beside george's mouth)."""
+    face = face_of(character)
+    rest = np.asarray(face.neutral, np.float64)
+    skin = face.head.skin_vertex_count
+    moved = np.asarray(face.deform("20E").positions, np.float64)[:skin] - rest[:skin]
+    corner_ids = [marks["lip_corner_left"], marks["lip_corner_right"]]
+    assert moved[corner_ids[0], 0] - moved[corner_ids[1], 0] > 0.08    # the mouth 8 mm wider
+    distance = np.linalg.norm(rest[:skin, None] - rest[corner_ids][None], axis=2).min(axis=1)
+    cheeks = (distance > 0.3) & (np.abs(rest[:skin, 0]) > rest[corner_ids[0], 0])   # beyond the corners
+    assert np.linalg.norm(moved[cheeks], axis=1).max() < 0.01   # nothing 30 mm out moves 1 mm
+
+
+@pytest.mark.parametrize("character", ["ava", "george", "kwame"])
+def test_12_lifts_the_corners_not_the_jaw_line(face_of, marks, character):
+    """Session 21: zygomaticus major pulls the lip corners up and back, and the skin below them follows
+    less with depth; ARKit's mouthSmile lifted the skin over the mandible with them (12 mm at 20 mm below
+    ava's corners), widening the jowls into "rubbery cheeks" (a blind reviewer, broad smiles)."""
+    face = face_of(character)
+    rest = np.asarray(face.neutral, np.float64)
+    skin = face.head.skin_vertex_count
+    moved = np.asarray(face.deform("12E").positions, np.float64)[:skin] - rest[:skin]
+    corner_ids = [marks["lip_corner_left"], marks["lip_corner_right"]]
+    assert moved[corner_ids, 1].min() > 0.1                       # the corners 10 mm up
+    jaw = rest[:skin, 1] < rest[corner_ids, 1].mean() - 0.3        # 30 mm below the corners or more
+    assert np.abs(moved[jaw, 1]).max() < 0.01
+
+
+@pytest.mark.parametrize("character", ["ava", "george", "kwame"])
+def test_27_stretches_the_mouth_open_taller_not_wider(face_of, character):
+    """Session 21: in 27 the lips stretch over the widely dropped jaw and draw the corners in, an oval
+    taller than wide; ARKit's mouthStretch pulled them out into a round ring (the mouth 0.4 mm narrower
+    than at rest on ava, 1.7 on george)."""
+    from facsim.speech.mouth import mouth_shape
+
+    face = face_of(character)
+    rest, open_ = mouth_shape(face, positions=face.neutral), mouth_shape(face, positions=face.deform("27E").positions)
+    assert open_.width < rest.width - 4.0      # mm: the corners drawn in
+    assert open_.gap > 0.6 * open_.width       # the opening's height against the mouth's width

@@ -225,6 +225,17 @@ def turn_no_further_than(offsets: np.ndarray, positions: np.ndarray, hinge: np.n
     return (np.asarray(offsets) * scale[:, None]).astype(np.asarray(offsets).dtype)
 
 
+def mandible_share(heights: np.ndarray, lip_line: float, band: tuple[float, float]) -> np.ndarray:
+    """How much of the jaw target's motion each skin point of height ``heights`` (N,) keeps: all of it
+    ``band[0]`` (dm) or more below ``lip_line`` (the lip corners' height), none ``band[1]`` or more above
+    it, where the skin lies on the maxilla, which does not move (a smooth step between).
+
+    >>> mandible_share(np.array([-0.1, 0.0, 0.1]), 0.0, (0.04, 0.08)).round(3)
+    array([1.   , 0.741, 0.   ])
+    """
+    return smoothstep(lip_line + band[1], lip_line - band[0], np.asarray(heights, np.float64))
+
+
 class RegisterEngine:
     """The register engine (an :class:`~facsim.engines.base.Engine`): Activations → :class:`Deformation`.
 
@@ -274,6 +285,11 @@ class RegisterEngine:
                 offsets[geo[keep]] += weight * delta[keep]
             if col.pattern == mandible_spec().get("target"):
                 offsets = self._on_the_mandible(offsets)
+            if col.pattern in (register_table().get("skin_only") or ()):
+                offsets[self.head.skin_vertex_count:] = 0.0   # the teeth and tongue keep their shape
+            reach = (register_table().get("corner_reach") or {}).get(col.pattern)
+            if reach:
+                offsets = self._near_the_corner(offsets, col.side, reach)
             offsets *= (self._reach if col.sided else self._half)[:, None]
             self._columns[col] = offsets
         return self._columns[col]
@@ -286,10 +302,31 @@ class RegisterEngine:
         spec = mandible_spec()
         positions = self.base_positions[self.head.base_index]
         skin = self.head.skin_vertex_count
+        marks = landmarks(self.head)
         out = np.array(offsets, copy=True)
         out[:skin] = turn_no_further_than(offsets[:skin], positions[:skin], self.head.joint(self.base_positions, spec["hinge"]),
-                                          landmarks(self.head)[spec["reference"]])
+                                          marks[spec["reference"]])
+        held = spec.get("maxilla")
+        if held:
+            lip_line = float(np.mean([positions[marks[f"{held['lip_line']}_{side}"], 1] for side in ("left", "right")]))
+            band = (float(held["free_below_mm"]) / 100.0, float(held["held_above_mm"]) / 100.0)
+            out[:skin] *= mandible_share(positions[:skin, 1], lip_line, band)[:, None].astype(out.dtype)
         return out
+
+    def _near_the_corner(self, offsets: np.ndarray, side: str, reach: Mapping[str, float]) -> np.ndarray:
+        """A lip-corner target's ``offsets`` (N_base_geo, 3) kept in full within ``reach["full_mm"]`` of the
+        ``side`` lip corner and fading out by ``reach["none_mm"]`` (``corner_reach`` in the table); with
+        ``below: true`` the distance is the depth below the corner's height (nothing above it is held)."""
+        from facsim.head.landmarks import landmarks
+
+        positions = self.base_positions[self.head.base_index]
+        corner = positions[landmarks(self.head)[f"lip_corner_{side}"]]
+        if reach.get("below"):
+            distance = np.maximum(corner[1] - positions[:, 1], 0.0)
+        else:
+            distance = np.linalg.norm(positions - corner, axis=1)
+        share = smoothstep(float(reach["none_mm"]) / 100.0, float(reach["full_mm"]) / 100.0, distance)
+        return (offsets * share[:, None]).astype(offsets.dtype)
 
     @cached_property
     def lids(self) -> dict:
