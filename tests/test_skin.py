@@ -131,10 +131,12 @@ def test_lips_show_vertical_furrows_not_a_flat_paint(face_of, marks):
         x, y = int(x), int(y)
         return np.abs(np.diff(image[y - 8:y + 1, x - 24:x + 25], axis=1)).mean()
 
-    # Crossing the lower lip's furrows varies the brightness far more than the chin's skin does
-    # (1.8x: since session 16 the chin carries blood and melanin patches and more micro-relief,
-    # 0.71 -> 0.79 here, while the lip's furrows stayed at 1.6).
-    assert across("lower_lip") > 1.8 * across("chin")
+    # Crossing the lower lip's furrows varies the brightness as much as the chin's skin does, whose
+    # own grain is its pores' (a lip drawn as flat paint: far less). (Until session 21 the chin's
+    # pores faded to a flat mean at this size: 0.85 here against the lip's 1.6, and this asked for
+    # 1.8x the chin; since, the chin's grain is 1.9, as a photograph's skin shows.)
+    assert across("lower_lip") > 1.3
+    assert across("lower_lip") > 0.7 * across("chin")
 
 
 def test_hair_texture_keeps_its_strands_but_not_its_painted_light():
