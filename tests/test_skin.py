@@ -495,11 +495,12 @@ def test_lips_fade_into_the_skin_in_a_muted_rose_not_a_salmon_cut_out(face_of, m
     assert 20 < hue < 45, (lip, hue)
 
 
-def _forehead_and_cheek(face, marks, size):
+def _forehead_and_cheek(face, marks, size, appearance=None):
     """(the forehead's CIELAB pixels around its middle (51 x 81 px), the key-side cheek's median
-    CIELAB, the forehead's) in a front view at ``size`` px."""
+    CIELAB, the forehead's) in a front view at ``size`` px (``appearance``: the face's own)."""
     camera = face.camera(size=(size, size))
-    image = face.renderer(size=size, body="none").render(face.neutral, appearance=face.appearance, camera=camera,
+    appearance = appearance or face.appearance
+    image = face.renderer(size=size, body="none").render(face.neutral, appearance=appearance, camera=camera,
                                                          occlusion=face.shading_occlusion)[..., :3]
     lab = _cielab(image.reshape(-1, 3)).reshape(size, size, 3)
     forehead = face.neutral[marks["glabella"]] + np.array([0.0, 0.25, -0.03])
@@ -512,13 +513,17 @@ def _forehead_and_cheek(face, marks, size):
 def test_age_spots_and_freckles_are_tan_patches_not_a_rash_of_red_dots(face_of, marks):
     """Older, sun-exposed skin shows sparse tan lentigines and freckles, about the skin's own hue:
     few pixels of george's forehead at 448 px are redder (CIELAB a*) than their surround blurred over
-    3 px. (Session 19's main: 3.7 % of them, a rash of small red-brown dots; the blind reviewer's
-    "blotchy".)"""
+    3 px (under 1.5 %; with his lines, session 21: 2.3 %). (Session 19's main, with his lines: 3.7 % of them, a rash of small red-brown dots; the blind reviewer's
+    "blotchy".) Without his forehead lines, whose shaded flanks are a little warmer than the skin
+    around them, as a fold's shade is (light scattered under the skin comes out red)."""
     from scipy.ndimage import gaussian_filter
 
-    forehead, _, _ = _forehead_and_cheek(face_of("george"), marks, 448)
+    face = face_of("george")
+    without_lines = face.appearance.folds.copy()
+    without_lines[..., 0] = 0
+    forehead, _, _ = _forehead_and_cheek(face, marks, 448, dataclasses.replace(face.appearance, folds=without_lines))
     redder = forehead[..., 1] - gaussian_filter(forehead[..., 1], 3)
-    assert np.mean(redder > 2.5) < 0.02, np.mean(redder > 2.5)
+    assert np.mean(redder > 2.5) < 0.015, np.mean(redder > 2.5)
 
 
 def test_the_cheeks_flush_is_faint(face_of, marks):

@@ -616,9 +616,25 @@ void main() {
     // the same map blurred over ~4x their width (its mip level two up), so the surface between
     // two lines bulges into a roll whose lower half faces down, into soft shade, as a compressed
     // forehead's does, instead of lying flat between sunk grooves.
+    // The grooves' slope per pixel: the map's differences over a texel along u and v, carried to
+    // the screen by the texture coordinates' derivatives (constant over a triangle). (The map's
+    // own screen derivatives are one value per 2x2-pixel quad: at 1024 px the crow's feet broke
+    // into staircases of light and dark blocks, drawn lines rather than relief.) The rolls (the
+    // map two mip levels up) likewise, over four texels.
+    // (Central differences: one-sided ones put the flanks' light and shade half a texel off the
+    // crevice's floor.)
+    vec2 fold_step = 1.0 / vec2(textureSize(u_folds, 0));
+    vec2 du = vec2(0.5 * fold_step.x, 0.0), dv = vec2(0.0, 0.5 * fold_step.y);
     vec2 rolls = texture(u_folds, v_uv, 2.0).rg;
-    vec2 fold_h = FOLD_RELIEF * (folds.rg - rolls);
-    float dh_dx = dot(dFdx(fold_h), depth), dh_dy = dot(dFdy(fold_h), depth);
+    mat2 fold_uv = mat2(texture(u_folds, v_uv + du).rg - texture(u_folds, v_uv - du).rg
+                        - 0.25 * (texture(u_folds, v_uv + 4.0 * du, 2.0).rg - texture(u_folds, v_uv - 4.0 * du, 2.0).rg),
+                        texture(u_folds, v_uv + dv).rg - texture(u_folds, v_uv - dv).rg
+                        - 0.25 * (texture(u_folds, v_uv + 4.0 * dv, 2.0).rg - texture(u_folds, v_uv - 4.0 * dv, 2.0).rg));
+    // (columns: the grooves less the rolls, per texel along u and along v)
+    vec2 uv_dx = dFdx(v_uv) / fold_step, uv_dy = dFdy(v_uv) / fold_step;   // texels per pixel
+    vec2 fold_dx = FOLD_RELIEF * (fold_uv * uv_dx);
+    vec2 fold_dy = FOLD_RELIEF * (fold_uv * uv_dy);
+    float dh_dx = dot(fold_dx, depth), dh_dy = dot(fold_dy, depth);
     vec3 groove_grad = sign(det) * (dh_dx * r1 + dh_dy * r2);
     n = normalize(abs(det) * n - groove_grad);
 #ifdef USE_WRINKLE
