@@ -623,14 +623,18 @@ void main() {
     // map two mip levels up) likewise, over four texels.
     // (Central differences: one-sided ones put the flanks' light and shade half a texel off the
     // crevice's floor.)
+    // (Only where the map has folds nearby, its blur two mip levels up not zero: a branch, which
+    // llvmpipe skips for the blocks of pixels away from them, most of the face.)
     vec2 fold_step = 1.0 / vec2(textureSize(u_folds, 0));
-    vec2 du = vec2(0.5 * fold_step.x, 0.0), dv = vec2(0.0, 0.5 * fold_step.y);
     vec2 rolls = texture(u_folds, v_uv, 2.0).rg;
-    mat2 fold_uv = mat2(texture(u_folds, v_uv + du).rg - texture(u_folds, v_uv - du).rg
-                        - 0.25 * (texture(u_folds, v_uv + 4.0 * du, 2.0).rg - texture(u_folds, v_uv - 4.0 * du, 2.0).rg),
-                        texture(u_folds, v_uv + dv).rg - texture(u_folds, v_uv - dv).rg
-                        - 0.25 * (texture(u_folds, v_uv + 4.0 * dv, 2.0).rg - texture(u_folds, v_uv - 4.0 * dv, 2.0).rg));
-    // (columns: the grooves less the rolls, per texel along u and along v)
+    mat2 fold_uv = mat2(0.0);   // columns: the grooves less the rolls, per texel along u and along v
+    if (rolls.r + rolls.g > 0.0) {
+        vec2 du = vec2(0.5 * fold_step.x, 0.0), dv = vec2(0.0, 0.5 * fold_step.y);
+        fold_uv = mat2(texture(u_folds, v_uv + du).rg - texture(u_folds, v_uv - du).rg
+                       - 0.25 * (texture(u_folds, v_uv + 4.0 * du, 2.0).rg - texture(u_folds, v_uv - 4.0 * du, 2.0).rg),
+                       texture(u_folds, v_uv + dv).rg - texture(u_folds, v_uv - dv).rg
+                       - 0.25 * (texture(u_folds, v_uv + 4.0 * dv, 2.0).rg - texture(u_folds, v_uv - 4.0 * dv, 2.0).rg));
+    }
     vec2 uv_dx = dFdx(v_uv) / fold_step, uv_dy = dFdy(v_uv) / fold_step;   // texels per pixel
     vec2 fold_dx = FOLD_RELIEF * (fold_uv * uv_dx);
     vec2 fold_dy = FOLD_RELIEF * (fold_uv * uv_dy);
