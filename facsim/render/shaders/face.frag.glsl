@@ -623,12 +623,13 @@ void main() {
     // map two mip levels up) likewise, over four texels.
     // (Central differences: one-sided ones put the flanks' light and shade half a texel off the
     // crevice's floor.)
-    // (Only where the map has folds nearby, its blur two mip levels up not zero: a branch, which
-    // llvmpipe skips for the blocks of pixels away from them, most of the face.)
+    // (Only where the map has folds nearby, its blur two mip levels up not zero, and they show
+    // (depth: a young face's lines only where an AU compresses the skin): a branch, which llvmpipe
+    // skips for the blocks of pixels away from them, most of the face.)
     vec2 fold_step = 1.0 / vec2(textureSize(u_folds, 0));
     vec2 rolls = texture(u_folds, v_uv, 2.0).rg;
     mat2 fold_uv = mat2(0.0);   // columns: the grooves less the rolls, per texel along u and along v
-    if (rolls.r + rolls.g > 0.0) {
+    if (dot(rolls, abs(depth)) > 0.0) {
         vec2 du = vec2(0.5 * fold_step.x, 0.0), dv = vec2(0.0, 0.5 * fold_step.y);
         fold_uv = mat2(texture(u_folds, v_uv + du).rg - texture(u_folds, v_uv - du).rg
                        - 0.25 * (texture(u_folds, v_uv + 4.0 * du, 2.0).rg - texture(u_folds, v_uv - 4.0 * du, 2.0).rg),
