@@ -22,6 +22,11 @@ specular S = L1 - D (luminance). Regions are small boxes at landmarks (both side
   lies near C* 17-23 and hue 50-65 degrees whatever its lightness (light skin about L* 65, a*
   11, b* 15; dark skin about L* 40, a* 11, b* 18); scikit-image's studio portrait of Eileen
   Collins (``skimage.data.astronaut()``) shows her cheeks at L* 76-81, C* 19, hue 66-70.
+- ``sheen grain``, ``tone grain``: the pixel-scale grain (pores and fine lines in aggregate) of
+  the specular S over the forehead and nose boxes and of the diffuse D over the larger cheek
+  boxes: each over itself blurred by 1.5 px, its standard deviation in per cent.
+- ``px step``: the displayed grey level's mean step between neighbouring pixels over the forehead
+  box (a studio portrait's skin, ``skimage.data.astronaut()``, at ~1 px per mm: 3.4-4.5).
 - ``tone cv`` and ``hue sd``: the skin's own unevenness on the cheeks (larger boxes): the
   diffuse light D over D blurred by 8 px (the shading's slow change removed), its standard
   deviation (per cent); and the standard deviation of the diffuse light's hue,
@@ -159,6 +164,17 @@ def figures(name, expression=""):
         ys, xs = np.nonzero(forehead)
         patch = specular[ys.min():ys.max() + 1, xs.min():xs.max() + 1]
         out["speckle"] = float(np.abs(np.diff(patch, axis=1)).mean() / max(patch.mean(), 1e-6))
+        # The sheen's and the colour's pixel-scale grain (pores and fine lines, in aggregate):
+        # the specular S on the forehead's and nose's boxes, the diffuse D on the cheeks', each
+        # over itself blurred by 1.5 px; standard deviations in per cent.
+        t_zone = regions["forehead"] | regions["nose"]
+        out["sheen grain"] = float(100 * np.std((specular / np.maximum(gaussian_filter(specular, 1.5), 1e-6))[t_zone]))
+        out["tone grain"] = float(100 * np.std((d / np.maximum(gaussian_filter(d, 1.5), 1e-6))[cheeks]))
+        # As displayed: the mean step of the pixels' grey level (0-255) from each to its right-hand
+        # neighbour over the forehead's box (skimage.data.astronaut()'s cheeks and forehead, a studio
+        # portrait at ~1 px per mm: 3.4-4.5).
+        grey = image.astype(float).mean(-1)[ys.min():ys.max() + 1, xs.min():xs.max() + 1]
+        out["px step"] = float(np.abs(np.diff(grey, axis=1)).mean())
 
         # Eyes: recolour the iris / sclera and keep the changed pixels.
         def part(key, colour):

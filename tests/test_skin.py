@@ -131,10 +131,12 @@ def test_lips_show_vertical_furrows_not_a_flat_paint(face_of, marks):
         x, y = int(x), int(y)
         return np.abs(np.diff(image[y - 8:y + 1, x - 24:x + 25], axis=1)).mean()
 
-    # Crossing the lower lip's furrows varies the brightness far more than the chin's skin does
-    # (1.8x: since session 16 the chin carries blood and melanin patches and more micro-relief,
-    # 0.71 -> 0.79 here, while the lip's furrows stayed at 1.6).
-    assert across("lower_lip") > 1.8 * across("chin")
+    # Crossing the lower lip's furrows varies the brightness as much as the chin's skin does, whose
+    # own grain is its pores' (a lip drawn as flat paint: far less). (Until session 21 the chin's
+    # pores faded to a flat mean at this size: 0.85 here against the lip's 1.6, and this asked for
+    # 1.8x the chin; since, the chin's grain is 1.9, as a photograph's skin shows.)
+    assert across("lower_lip") > 1.3
+    assert across("lower_lip") > 0.7 * across("chin")
 
 
 def test_hair_texture_keeps_its_strands_but_not_its_painted_light():
@@ -493,11 +495,12 @@ def test_lips_fade_into_the_skin_in_a_muted_rose_not_a_salmon_cut_out(face_of, m
     assert 20 < hue < 45, (lip, hue)
 
 
-def _forehead_and_cheek(face, marks, size):
+def _forehead_and_cheek(face, marks, size, appearance=None):
     """(the forehead's CIELAB pixels around its middle (51 x 81 px), the key-side cheek's median
-    CIELAB, the forehead's) in a front view at ``size`` px."""
+    CIELAB, the forehead's) in a front view at ``size`` px (``appearance``: the face's own)."""
     camera = face.camera(size=(size, size))
-    image = face.renderer(size=size, body="none").render(face.neutral, appearance=face.appearance, camera=camera,
+    appearance = appearance or face.appearance
+    image = face.renderer(size=size, body="none").render(face.neutral, appearance=appearance, camera=camera,
                                                          occlusion=face.shading_occlusion)[..., :3]
     lab = _cielab(image.reshape(-1, 3)).reshape(size, size, 3)
     forehead = face.neutral[marks["glabella"]] + np.array([0.0, 0.25, -0.03])
@@ -510,13 +513,17 @@ def _forehead_and_cheek(face, marks, size):
 def test_age_spots_and_freckles_are_tan_patches_not_a_rash_of_red_dots(face_of, marks):
     """Older, sun-exposed skin shows sparse tan lentigines and freckles, about the skin's own hue:
     few pixels of george's forehead at 448 px are redder (CIELAB a*) than their surround blurred over
-    3 px. (Session 19's main: 3.7 % of them, a rash of small red-brown dots; the blind reviewer's
-    "blotchy".)"""
+    3 px (under 1.5 %; with his lines, session 21: 2.3 %). (Session 19's main, with his lines: 3.7 % of them, a rash of small red-brown dots; the blind reviewer's
+    "blotchy".) Without his forehead lines, whose shaded flanks are a little warmer than the skin
+    around them, as a fold's shade is (light scattered under the skin comes out red)."""
     from scipy.ndimage import gaussian_filter
 
-    forehead, _, _ = _forehead_and_cheek(face_of("george"), marks, 448)
+    face = face_of("george")
+    without_lines = face.appearance.folds.copy()
+    without_lines[..., 0] = 0
+    forehead, _, _ = _forehead_and_cheek(face, marks, 448, dataclasses.replace(face.appearance, folds=without_lines))
     redder = forehead[..., 1] - gaussian_filter(forehead[..., 1], 3)
-    assert np.mean(redder > 2.5) < 0.02, np.mean(redder > 2.5)
+    assert np.mean(redder > 2.5) < 0.015, np.mean(redder > 2.5)
 
 
 def test_the_cheeks_flush_is_faint(face_of, marks):

@@ -53,8 +53,10 @@ def render_sphere(radius: float, *, oil: int = 90, key=(-0.9, 0.0, 0.45)):
     (camera left), with a uniform oil map (detail.b; 90 = the cheeks' 0.35, 255 = the T-zone's)."""
     points, faces = sphere()
     p = (points * radius).astype(np.float32)
+    # (Texture coordinates at a face's scale, hm08's 3.5 dm per u and 7 per v, projected from the
+    # front: the skin's noise and pores vary over the sphere as over a face, not one arbitrary value.)
     topology = RenderTopology(faces=faces, render_to_geo=np.arange(len(p)),
-                              uv=np.full((len(p), 2), 0.5, np.float32),
+                              uv=(0.5 + p[:, :2] / np.array([3.5, 7.0])).astype(np.float32),
                               region=np.full(len(p), REGIONS.index("skin"), np.uint8),
                               eye_coord=np.zeros((len(p), 3), np.float32))
     detail = np.zeros((4, 4, 4), np.uint8)
@@ -128,3 +130,70 @@ def test_hollows_are_shaded_under_a_frontal_key_bulges_are_not(mirrored):
     flat, groove, ridge = at(0.0), at(0.25), at(-0.25)
     assert groove < 0.9 * flat, (groove, flat)
     assert ridge == pytest.approx(flat, rel=0.03), (ridge, flat)
+
+
+def render_skin_patch(size: int, *, oil: int = 255, folds=None, key=(0.0, 0.0, 1.0)):
+    """A flat 12-cm square of skin facing the camera, its texture coordinates at hm08's face scale
+    (350 mm per u, 700 per v), seen ``size`` px across (256: ~2 px per mm, the face in a 448-512-px
+    stimulus), the key frontal (by default) so its sheen lies over the whole patch; ``oil`` as
+    detail.b (255: the T-zone's); ``folds``: Appearance.folds, drawn at full age. The image's
+    luminance, linear."""
+    xs = np.linspace(-0.6, 0.6, 31)
+    x, y = np.meshgrid(xs, xs)
+    p = np.stack([x, y, np.zeros_like(x)], -1).reshape(-1, 3).astype(np.float32)
+    ids = np.arange(len(p)).reshape(31, 31)
+    faces = np.concatenate([np.stack([ids[:-1, :-1], ids[:-1, 1:], ids[1:, 1:]], -1).reshape(-1, 3),
+                            np.stack([ids[:-1, :-1], ids[1:, 1:], ids[1:, :-1]], -1).reshape(-1, 3)])
+    uv = np.stack([0.3 + x.ravel() * (100 / 350), 0.5 + y.ravel() * (100 / 700)], -1).astype(np.float32)
+    topology = RenderTopology(faces=faces, render_to_geo=np.arange(len(p)), uv=uv,
+                              region=np.full(len(p), REGIONS.index("skin"), np.uint8),
+                              eye_coord=np.zeros((len(p), 3), np.float32))
+    detail = np.zeros((4, 4, 4), np.uint8)
+    detail[..., 2] = oil
+    lighting = Lighting(key_direction=key, fill_color=(0, 0, 0), rim_color=(0, 0, 0),
+                        sky=(0.05, 0.05, 0.05), ground=(0.05, 0.05, 0.05))
+    camera = frame_camera(np.array([-0.6, -0.6, -0.1]), np.array([0.6, 0.6, 0.1]), view="front", projection="orthographic")
+    appearance = Appearance(DEFAULT_COLORS, detail=detail, folds=folds, age=1.0 if folds is not None else 0.0)
+    with Renderer(topology, size=size, antialias=1, shadows=False) as renderer:
+        image = renderer.render(p, appearance=appearance, camera=camera, lighting=lighting)
+    c = image[..., :3].astype(float) / 255
+    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4) @ np.array([0.2126, 0.7152, 0.0722])
+
+
+def pixel_grain(luminance):
+    """Per cent: the pixel-scale variation (over the image blurred by 1.5 px) in the middle half."""
+    from scipy.ndimage import gaussian_filter
+
+    n = len(luminance)
+    ratio = luminance / gaussian_filter(luminance, 1.5)
+    return 100 * np.std(ratio[n // 4:3 * n // 4, n // 4:3 * n // 4])
+
+
+def test_pores_break_up_the_sheen_at_the_stimulus_size_and_keep_it_fixed_to_the_skin():
+    """At ~2 px per mm a pixel holds a few pores: oily skin's sheen and matte skin's colour show their
+    aggregate as a fine grain (issue 13: "glossy", "smooth avatar skin"; faded to a flat mean, the
+    grain was 2.0 and 1.3 %), the sheen's the stronger, and the same frame draws the same grain."""
+    oily, matte = render_skin_patch(256), render_skin_patch(256, oil=0)
+    assert pixel_grain(oily) > 2.8, pixel_grain(oily)
+    assert 1.8 < pixel_grain(matte) < pixel_grain(oily) - 0.5, (pixel_grain(oily), pixel_grain(matte))
+    assert np.array_equal(oily, render_skin_patch(256))
+
+
+def test_fold_lines_are_shaded_per_pixel_not_in_2x2_blocks():
+    """A groove of the fold map (a forehead line, crow's feet) seen ~4 px per mm: its slope, and so
+    its light and shade, changes from each pixel to the next, not only between the 2x2-pixel
+    quads that screen derivatives are taken over (issue 13: at 1024 px the crow's feet drew as
+    staircases of blocks, "painted")."""
+    from facsim.head.skin import FOLD_SIZE
+
+    rows = np.arange(FOLD_SIZE[0])[:, None]
+    grooves = np.exp(-(((rows + 6) % 12 - 6) / 2.0) ** 2)   # lines along u every 12 texels (~1 cm)
+    folds = np.zeros((*FOLD_SIZE, 4), np.uint8)
+    folds[..., 0] = np.broadcast_to(255 * grooves, FOLD_SIZE).round()
+    folds[..., 3] = 255
+    luminance = render_skin_patch(512, oil=0, folds=folds, key=(0.0, 0.6, 0.8))
+    column_steps = np.abs(np.diff(luminance[128:384, 128:384], axis=0))   # across the lines
+    within_quads, across_quads = column_steps[1::2].mean(), column_steps[0::2].mean()
+    ratio = max(within_quads, across_quads) / min(within_quads, across_quads)
+    assert column_steps.mean() > 0.01           # the grooves show ...
+    assert ratio < 1.2, (within_quads, across_quads)   # ... shaded pixel by pixel (quad derivatives: 10x)

@@ -106,6 +106,26 @@ vec2 spots(vec2 p, float prob, float radius, int salt) {
     return vec2(cover * step(h, prob), fract(h * 13.7));
 }
 
+// The aggregate of relief finer than a pixel (pores ~0.35 mm apart, the skin's fine lines): value
+// noise over cells of ``p``'s units, evaluated at the octave whose cells are about two pixels
+// across, its contrast scaled as the mean of that many finer cells varies (1/sqrt(N): halved per
+// octave up). A pixel of a photograph holds a few pores and shows how many: skin keeps a fine
+// grain, fixed to the surface, at any size; faded to its flat mean instead (as the grain below
+// is), the skin at 448-512 px was an airbrushed glaze (issue 13: "smooth avatar skin"). Each
+// octave has its own offset, so the pattern is continuous where the octave changes. Mean 0;
+// standard deviation ~0.17 (value noise's) where the cells are 2 px or larger, half that per
+// octave finer.
+float pore_aggregate(vec2 p) {
+    float cells_per_px = max(max(length(dFdx(p)), length(dFdy(p))), 1e-6);
+    float lod = max(log2(cells_per_px) + 1.0, 0.0);
+    float l0 = floor(lod);
+    float f = lod - l0;
+    float a = value_noise(p * exp2(-l0) + 7.31 * l0, 0) - 0.5;
+    float b = value_noise(p * exp2(-l0 - 1.0) + 7.31 * (l0 + 1.0), 0) - 0.5;
+    // (Two independent noises blended have less contrast than either: renormalised.)
+    return mix(a, b, f) * inversesqrt(1.0 - 2.0 * f + 2.0 * f * f) * exp2(-lod);
+}
+
 // How much of each channel's diffuse light sees the scattered normal (v_scatter_normal) rather
 // than the surface's own: red travels furthest under the skin, blue least.
 const vec3 SCATTER_SOFTNESS = vec3(0.6, 0.3, 0.12);
@@ -127,6 +147,12 @@ const float CONCAVE_FULL = 4.0;
 // warmth and the skin's scattering turned into red dots (session 19's "rash" on george).
 const vec3 FRECKLE = vec3(0.86, 0.78, 0.69);
 const vec3 AGE_SPOT = vec3(0.88, 0.81, 0.72);
+// Pores (pore_aggregate): cells ~0.35 mm (hm08's face UV: ~350 mm per u, 700 per v), and how much
+// they vary the skin's colour and break its sheen, per unit of the aggregate, on skin of average
+// pore density (tone.b 0.4; the nose and the cheeks beside it more, the forehead's sides less).
+const vec2 PORE_CELLS = vec2(1000.0, 2000.0);
+const float PORE_TONE = 0.3;
+const float PORE_SHEEN = 2.5;
 
 // Skin's specular (Fresnel F0 = SKIN_F0) from one light, in its two lobes (broad, tight):
 // GGX distributions of the given roughness (by region: skin_lobes in skin_light.glsl, the tight
@@ -486,10 +512,14 @@ void main() {
     float grain = mix(0.5, value_noise(grain_uv, 0),
                       clamp(2.0 - 1.2 * max(fwidth(grain_uv.x), fwidth(grain_uv.y)), 0.0, 1.0));
     float blotch = value_noise(skin_uv * vec2(150.0, 300.0), 0);
+    float pores = pore_aggregate(skin_uv * PORE_CELLS);
     float patches = value_noise(skin_uv * vec2(24.0, 48.0) + 17.0, 0);
     float mottle = 0.6 * blotch + 0.4 * grain;
     vec3 albedo = u_skin * (1.0 + vec3(0.10, 0.12, 0.13) * (1.0 + 1.2 * u_age) * (mottle - 0.5));
     albedo *= mix(vec3(1.04, 0.97, 0.96), vec3(0.975, 1.0, 1.02), patches);
+    // (Their openings hold keratin and sebum, yellow-grey: they vary the skin's lightness, a
+    // little less its redness, or at 448 px their grain read as fine red dots.)
+    albedo *= 1.0 + PORE_TONE * (0.6 + tone.b) * pores * vec3(1.15, 1.0, 0.9);
     // The variation is in the skin's two pigments, not a grey noise: blood (haemoglobin takes
     // green and blue) gathers in irregular flushed patches about a centimetre across, broken
     // up by the blotches, and melanin lies unevenly in larger, softer patches (darker, a
@@ -611,9 +641,30 @@ void main() {
     // the same map blurred over ~4x their width (its mip level two up), so the surface between
     // two lines bulges into a roll whose lower half faces down, into soft shade, as a compressed
     // forehead's does, instead of lying flat between sunk grooves.
+    // The grooves' slope per pixel: the map's differences over a texel along u and v, carried to
+    // the screen by the texture coordinates' derivatives (constant over a triangle). (The map's
+    // own screen derivatives are one value per 2x2-pixel quad: at 1024 px the crow's feet broke
+    // into staircases of light and dark blocks, drawn lines rather than relief.) The rolls (the
+    // map two mip levels up) likewise, over four texels.
+    // (Central differences: one-sided ones put the flanks' light and shade half a texel off the
+    // crevice's floor.)
+    // (Only where the map has folds nearby, its blur two mip levels up not zero, and they show
+    // (depth: a young face's lines only where an AU compresses the skin): a branch, which llvmpipe
+    // skips for the blocks of pixels away from them, most of the face.)
+    vec2 fold_step = 1.0 / vec2(textureSize(u_folds, 0));
     vec2 rolls = texture(u_folds, v_uv, 2.0).rg;
-    vec2 fold_h = FOLD_RELIEF * (folds.rg - rolls);
-    float dh_dx = dot(dFdx(fold_h), depth), dh_dy = dot(dFdy(fold_h), depth);
+    mat2 fold_uv = mat2(0.0);   // columns: the grooves less the rolls, per texel along u and along v
+    if (dot(rolls, abs(depth)) > 0.0) {
+        vec2 du = vec2(0.5 * fold_step.x, 0.0), dv = vec2(0.0, 0.5 * fold_step.y);
+        fold_uv = mat2(texture(u_folds, v_uv + du).rg - texture(u_folds, v_uv - du).rg
+                       - 0.25 * (texture(u_folds, v_uv + 4.0 * du, 2.0).rg - texture(u_folds, v_uv - 4.0 * du, 2.0).rg),
+                       texture(u_folds, v_uv + dv).rg - texture(u_folds, v_uv - dv).rg
+                       - 0.25 * (texture(u_folds, v_uv + 4.0 * dv, 2.0).rg - texture(u_folds, v_uv - 4.0 * dv, 2.0).rg));
+    }
+    vec2 uv_dx = dFdx(v_uv) / fold_step, uv_dy = dFdy(v_uv) / fold_step;   // texels per pixel
+    vec2 fold_dx = FOLD_RELIEF * (fold_uv * uv_dx);
+    vec2 fold_dy = FOLD_RELIEF * (fold_uv * uv_dy);
+    float dh_dx = dot(fold_dx, depth), dh_dy = dot(fold_dy, depth);
     vec3 groove_grad = sign(det) * (dh_dx * r1 + dh_dy * r2);
     n = normalize(abs(det) * n - groove_grad);
 #ifdef USE_WRINKLE
@@ -748,7 +799,8 @@ void main() {
     vec3 spec = dot(skin_specular(bumped, u_key_dir, v, ndv, roughness), weight) * u_key_col * key_shadow
               + dot(skin_specular(bumped, u_rim_dir, v, ndv, roughness), weight) * u_rim_col;
     // (Times pi: the diffuse term here is albedo times N.L, without the Lambert 1/pi.)
-    spec *= PI * (1.0 - hair) * (0.85 + 0.3 * grain) * spec_break;
+    spec *= PI * (1.0 - hair) * (0.85 + 0.3 * grain) * spec_break
+          * max(1.0 + PORE_SHEEN * (0.6 + tone.b) * (1.0 - lips) * pores, 0.0);
     // The mucosa's film of saliva mirrors the lights in a thin bright line where the lip's
     // inner edge turns toward them. (A branch: llvmpipe skips it for the blocks of pixels
     // away from the lips, nearly all of them.)
