@@ -217,9 +217,6 @@ def anatomy(head) -> Anatomy:
     margins, canthi = _lid_margins(base, edges, kind, eye_side)
     tissue = _tissue_fields(spec["tissue"], base[:n], kind, eye_side, eye_centre, eye_radius,
                             lips_mask, adj)
-    tarsus = spec["tissue"]["lids"].get("tarsus")
-    if tarsus:
-        tissue["attach"][_upper_tarsus(base[:n], kind, margins, tarsus["height"])] = tarsus["attach"]
     tissue = {key: 0.5 * (v + v[mirror]) for key, v in tissue.items()}
     lip_half, rim_pairs = _lip_halves(base[:n], edges, kind, lips_mask)
     jaw_weight = _jaw_weight(spec["jaw"], base[:n], kind, lip_half)
@@ -242,17 +239,6 @@ def _mouth_corner(points, edges, kind) -> int:
         rim[a[(~lining[a]) & lining[b]]] = True
     ids = np.flatnonzero(rim & (points[:, 0] > 0))
     return int(ids[np.argmax(points[ids, 0])])
-
-
-def _upper_tarsus(points, kind, margins, height) -> np.ndarray:
-    """(N,) bool: the lid skin over each upper tarsal plate, within ``height`` (dm) of the upper
-    lid's margin and nearer to it than to the lower one."""
-    def distance_to(lid):
-        ids = np.concatenate([margins[side][lid] for side in SIDES])
-        return np.min(np.linalg.norm(points[:, None, :] - points[None, ids, :], axis=2), axis=1)
-
-    upper = distance_to("upper")
-    return (kind == LID) & (upper < height) & (upper < distance_to("lower"))
 
 
 def _lid_margins(base, edges, kind, eye_side):
