@@ -175,6 +175,15 @@ def test_smile_lifts_the_corners_not_the_lower_lip(single, marks):
     assert delta[marks["lower_lip"], Y] < 0.4 * corner
 
 
+def test_smile_draws_the_corners_up_and_out(single, marks):
+    """FACS 12 pulls the lip corners up and out, obliquely toward the cheekbone (session 21: over
+    a pulley above the corner, noah's corner went 7.9 mm out and 17.9 up, a narrow smile)."""
+    solved, neutral = single
+    corner = marks["lip_corner_left"]
+    moved = solved[12][corner] - neutral[corner]
+    assert moved[Y] > 0.1 and moved[X] > 0.095                 # up 10 mm, out 9.5 mm at least
+
+
 def test_masking_cheek_raiser_after_smile_lifts_the_corner_less(engine, marks):
     corner = marks["lip_corner_left"]
     neutral, six, twelve, both = engine.solve_many(
