@@ -321,11 +321,14 @@ def test_closed_lips_show_no_grey_sliver_of_teeth(face_of, character):
 def test_the_muscle_engine_shows_the_same_teeth(face_of):
     # 16 pulls the lower lip off the lower teeth. (The muscle engine's 10 barely lifts the upper
     # lip's inner rim, so its 10+25 shows at most the lower incisors' edges since they rest
-    # lower, :data:`facsim.head.mouth.LOWER_TEETH_DROP`.)
+    # lower, :data:`facsim.head.mouth.LOWER_TEETH_DROP`.) Lit, not left in the mouth's dark
+    # (teeth in the dark read under 60): since session 21 the teeth are lit about as the skin
+    # beside them, ~10 % below before, and the muscle engine's narrower opening shows them
+    # nearer the lips' shade (median 126 on ava, the register engine's 155).
     face = face_of("ava", "muscle")
     image, teeth, _ = _mouth_pixels(face, "muscle", "10+16+25")
     assert teeth.sum() > 30
-    assert np.median(_luminance(image[teeth])) > 130
+    assert np.median(_luminance(image[teeth])) > 110
 
 
 @pytest.mark.parametrize("expression", ["0", "12C", "6+12+25"])
