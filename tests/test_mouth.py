@@ -199,7 +199,7 @@ def test_teeth_are_about_as_light_as_the_lit_skin_beside_them(face_of, expressio
     # inserted in the face, where photographs show them about as light as the lit skin.
     from skimage.color import rgb2lab
 
-    image, teeth = _teeth_render(face_of("ava"), expression, 512)
+    image, teeth = _part_render(face_of("ava"), expression, 512, "teeth")
     lightest = _lightest_third_lab(image, teeth)[:, 0].mean()
     ys, xs = np.nonzero(teeth)
     y, x = int(ys.mean()), int(xs.mean())
@@ -222,18 +222,8 @@ def test_the_inside_of_the_arch_is_not_a_grey_wall(face_of):
     # bands carry a lingual slope 8-13 mm deep; drawn as enamel it showed as a pale grey wall
     # (~500 grey enamel pixels at 512 px); only the crowns' inner faces are enamel, the rest
     # is gum and the floor of the mouth in the arch's shade.
-    from facsim import Face
-
-    face = face_of("ava")
-    deformation = face.deform("1+2+5+26")
-    renders = []
-    for colour in (None, "#ffffff", "#000000"):
-        character = face.character if colour is None else face.character.with_(colors={"teeth": colour})
-        with Face(character) as marked:
-            renders.append(marked.render(deformation=deformation, size=512, view="three-quarter-left",
-                                         antialias=1)[..., :3].astype(float))
-    image, white, black = renders
-    enamel = image[np.abs(white - black).max(axis=-1) > 3]
+    image, teeth = _part_render(face_of("ava"), "1+2+5+26", 512, "teeth", view="three-quarter-left")
+    enamel = image[teeth]
     grey = (_luminance(enamel) > 40) & (enamel.max(axis=1) - enamel.min(axis=1) < 40)
     assert len(enamel) > 200            # the front crowns still show
     assert grey.sum() < 300
@@ -245,32 +235,24 @@ def test_the_cavity_falls_off_to_near_black_at_the_back(face_of, character):
     # throat: the lining seen through surprise's opening (mostly the back of the mouth and
     # the palate) is near-black. (One flat dark red, luminance 15.3 on every lining pixel,
     # read as "mouth interior flat".)
-    from facsim import Face
-
-    face = face_of(character)
-    deformation = face.deform("1+2+5+26")
-    renders = []
-    for colour in (None, "#ffffff", "#000000"):
-        character_ = face.character if colour is None else face.character.with_(colors={"mouth_interior": colour})
-        with Face(character_) as marked:
-            renders.append(marked.render(deformation=deformation, size=512, antialias=1)[..., :3].astype(float))
-    image, white, black = renders
-    lining = _luminance(image[np.abs(white - black).max(axis=-1) > 3])
+    image, interior = _part_render(face_of(character), "1+2+5+26", 512, "mouth_interior")
+    lining = _luminance(image[interior])
     assert len(lining) > 100
     assert np.median(lining) < 8
 
 
-def _render_with_tongue(face, expression, size):
-    """``face`` showing ``expression`` at ``size`` px (RGB floats), and the tongue's pixels: where
-    recolouring the tongue white and then black changes the picture."""
+def _part_render(face, expression, size, part, **view):
+    """``face`` showing ``expression`` at ``size`` px (RGB floats) and the pixels of its ``part``
+    (a colour name: "teeth", "tongue", "mouth_interior"): where recolouring that part white and
+    then black changes the picture (however dark it is drawn)."""
     from facsim import Face
 
     deformation = face.deform(expression)
     renders = []
     for colour in (None, "#ffffff", "#000000"):
-        character = face.character if colour is None else face.character.with_(colors={"tongue": colour})
+        character = face.character if colour is None else face.character.with_(colors={part: colour})
         with Face(character) as marked:
-            renders.append(marked.render(deformation=deformation, size=size, antialias=1)[..., :3].astype(float))
+            renders.append(marked.render(deformation=deformation, size=size, antialias=1, **view)[..., :3].astype(float))
     image, white, black = renders
     return image, np.abs(white - black).max(axis=-1) > 3
 
@@ -279,7 +261,7 @@ def test_an_open_mouths_tongue_is_wet(face_of):
     # The tongue's film mirrors the key through the opening: a sheen on its front (its
     # brightest pixels ~160-180 at 512 px), where the shade of the mouth dimmed it to a
     # matte 120-140 like the rest of the tongue.
-    image, tongue = _render_with_tongue(face_of("ava"), "1+2+5+26", 512)
+    image, tongue = _part_render(face_of("ava"), "1+2+5+26", 512, "tongue")
     luminance = _luminance(image[tongue])
     lit = luminance[luminance > 30]
     assert len(lit) > 500
@@ -292,28 +274,13 @@ def test_at_rest_the_lips_hide_the_teeth(face_of):
     assert teeth.sum() < 12   # at most a few pixels in the lips' parting line
 
 
-def _teeth_render(face, expression, size, **view):
-    """``face`` showing ``expression`` (RGB floats) and its teeth's pixels: where recolouring
-    the teeth white and then black changes the picture (however dark they are drawn)."""
-    from facsim import Face
-
-    deformation = face.deform(expression)
-    renders = []
-    for colour in (None, "#ffffff", "#000000"):
-        character = face.character if colour is None else face.character.with_(colors={"teeth": colour})
-        with Face(character) as marked:
-            renders.append(marked.render(deformation=deformation, size=size, antialias=1, **view)[..., :3].astype(float))
-    image, white, black = renders
-    return image, np.abs(white - black).max(axis=-1) > 3
-
-
 @pytest.mark.parametrize("character", ["ava", "mei"])
 def test_closed_lips_show_no_grey_sliver_of_teeth(face_of, character):
     # hm08's closed lips leave a slit (~1 mm on mei, 2-3 mm near ava's corners) through which
     # the teeth show. A slit lets in little light: in photographs it is a dark line. Lit as
     # under a raised lip, the teeth drew a grey sliver (up to luminance 80-140 at 512 px)
     # outlined in black between the lips.
-    image, teeth = _teeth_render(face_of(character), "0", 512)
+    image, teeth = _part_render(face_of(character), "0", 512, "teeth")
     assert teeth.sum() > 0              # the slit is there
     assert _luminance(image[teeth]).max() < 60
 
@@ -441,7 +408,7 @@ def test_a_wide_open_mouth_shows_the_tongues_back_in_a_dark_red_not_black(face_o
     # Its light fell to 0.015 by mid-tongue: one flat black ("dark holes", a blind reviewer),
     # cut by the tongue's crest in a hard line. The light falls off with depth to what the
     # cheeks and lips scatter in, warm: dark red-brown, darkening toward the throat.
-    image, tongue = _render_with_tongue(face_of("ava"), "1+2+5+20+25+27", 256)
+    image, tongue = _part_render(face_of("ava"), "1+2+5+20+25+27", 256, "tongue")
     rows = np.flatnonzero(tongue.any(axis=1))
     back = tongue & (np.arange(256)[:, None] < rows.min() + 0.4 * (rows.max() - rows.min()))
     red, green, _ = image[back].mean(axis=0)
@@ -456,17 +423,7 @@ def test_a_stretched_open_mouths_back_teeth_are_not_black_wedges(face_of, charac
     # teeth and the inside of its arch. In the cheeks' shade they fell to pure black wedges
     # with straight edges (a blind reviewer: "molar wedges"; a third to a half of those pixels
     # under 8 of 255). The light scattered into the mouth keeps them a warm, dark brown-red.
-    from facsim import Face
-
-    face = face_of(character)
-    deformation = face.deform("1+2+4+5+20+26")
-    renders = []
-    for colour in (None, "#ffffff", "#000000"):
-        marked_character = face.character if colour is None else face.character.with_(colors={"teeth": colour})
-        with Face(marked_character) as marked:
-            renders.append(marked.render(deformation=deformation, size=256, antialias=1)[..., :3].astype(float))
-    image, white, black = renders
-    teeth = np.abs(white - black).max(axis=-1) > 3
+    image, teeth = _part_render(face_of(character), "1+2+4+5+20+26", 256, "teeth")
     columns = np.flatnonzero(teeth.any(axis=0))
     fifth = (columns.max() - columns.min()) // 5
     corners = teeth.copy()
