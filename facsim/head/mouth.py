@@ -478,8 +478,8 @@ def mouth_light(rim: MouthRim, positions: np.ndarray, occlusion: np.ndarray) -> 
         # Parted beyond where the lips' inner rims sit at rest (they touch in front of them).
         parted = np.clip((upper_edge(x) - lower_edge(x) - rest_gap - lo) / (hi - lo), 0.0, 1.0)
         parted = parted * parted * (3.0 - 2.0 * parted)
-        closed = CLOSED_LIP_VISIBILITY if ring_index < len(rim.rings) else 0.0
-        occlusion[ring] = np.maximum(occlusion[ring], visibility * (closed + (1.0 - closed) * parted))
+        touching = CLOSED_LIP_VISIBILITY if ring_index < len(rim.rings) else 0.0   # the lips' rings, not the lining's
+        occlusion[ring] = np.maximum(occlusion[ring], visibility * (touching + (1.0 - touching) * parted))
     lo, hi = TONGUE_LIT_GAP
     lit = np.clip((upper_edge(middle) - lower_edge(middle) - rim.rest_gap_middle - lo) / (hi - lo), 0.0, 1.0)
     occlusion[rim.tongue] = lit * lit * (3.0 - 2.0 * lit)

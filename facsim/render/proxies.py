@@ -270,13 +270,10 @@ def volume_normals(points: np.ndarray, card_normals: np.ndarray, *, card_weight:
     so still cards keep their shading exactly (the renderer keeps still hair as pixels
     between the frames of a video).
     """
-    y = points[:, 1]
-    crown = points[y >= np.percentile(y, 90)]
-    axis = crown.mean(axis=0)
-    axis_y = float(y.max()) - VOLUME_RADIUS
+    axis, top = _crown_axis(points)
     q = np.empty_like(points)
     q[:, 0], q[:, 2] = axis[0], axis[2]
-    q[:, 1] = np.minimum(y, axis_y)
+    q[:, 1] = np.minimum(points[:, 1], top - VOLUME_RADIUS)
     out = points - q
     out /= np.linalg.norm(out, axis=1, keepdims=True) + 1e-12
     card = np.where((np.einsum("ij,ij->i", card_normals, out) < 0)[:, None], -card_normals, card_normals)
@@ -288,9 +285,15 @@ def hair_apex(points: np.ndarray) -> np.ndarray:
     """(3,) a point a quarter of :data:`VOLUME_RADIUS` above the crown of hair ``points``
     (N, 3), on the axis of :func:`volume_normals`' volume: strands flow down and out from it
     over the volume's surface (the shader's strand highlight follows that flow)."""
+    axis, top = _crown_axis(points)
+    return np.array([axis[0], top + 0.25 * VOLUME_RADIUS, axis[2]], np.float32)
+
+
+def _crown_axis(points: np.ndarray) -> tuple[np.ndarray, float]:
+    """The hair volume's axis, the mean of the crown's points (the highest tenth of ``points``
+    (N, 3); only its x and z matter), and the crown's height."""
     y = points[:, 1]
-    axis = points[y >= np.percentile(y, 90)].mean(axis=0)
-    return np.array([axis[0], float(y.max()) + 0.25 * VOLUME_RADIUS, axis[2]], np.float32)
+    return points[y >= np.percentile(y, 90)].mean(axis=0), float(y.max())
 
 
 def along_volume(tangents: np.ndarray, normals: np.ndarray) -> np.ndarray:

@@ -1080,8 +1080,8 @@ void main() {
     // (The lower row's back teeth sit lower in the cheeks' shade: its corridor starts nearer
     // the front, or a stretched mouth (20+26) showed them as pale slabs in its corners.)
     float depth_shade = mix(1.0, 0.09, smoothstep(mix(0.12, 0.08, lower), mix(0.36, 0.28, lower), arc));
-    float lip_shadow = mix(LIP_SHADOW_FLOOR, 1.0, smoothstep(-0.002, 0.022, v_occlusion))
-                     * mix(CLOSED_LIPS_DARK, 1.0, smoothstep(-1.3, -0.7, v_occlusion));
+    float slit_light = mix(CLOSED_LIPS_DARK, 1.0, smoothstep(-1.3, -0.7, v_occlusion));
+    float lip_shadow = mix(LIP_SHADOW_FLOOR, 1.0, smoothstep(-0.002, 0.022, v_occlusion)) * slit_light;
     float row_light = mix(1.0, 0.62, lower);
     // The inside of the arch faces the tongue and throat: it only catches light scattered in.
     float mouth_shade = depth_shade * lip_shadow * row_light * mix(1.0, 0.12, smoothstep(0.0, 0.1, lingual))
@@ -1094,8 +1094,7 @@ void main() {
     // What light reaches the back teeth has bounced off the cheeks' red lining: warm, not grey.
     // So does what reaches the inside of the arch.
     radiance *= mix(vec3(1.0, 0.6, 0.5), vec3(1.0), depth_shade * (1.0 - 0.8 * smoothstep(0.0, 0.3, lingual)));
-    radiance += DEEP_TEETH_LIGHT * DEEP_TEETH_BOUNCE * albedo * (1.0 - mouth_shade)
-              * mix(CLOSED_LIPS_DARK, 1.0, smoothstep(-1.3, -0.7, v_occlusion));
+    radiance += DEEP_TEETH_LIGHT * DEEP_TEETH_BOUNCE * albedo * (1.0 - mouth_shade) * slit_light;
 #endif
 
 #ifdef REGION_TONGUE
