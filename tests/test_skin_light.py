@@ -197,3 +197,46 @@ def test_fold_lines_are_shaded_per_pixel_not_in_2x2_blocks():
     ratio = max(within_quads, across_quads) / min(within_quads, across_quads)
     assert column_steps.mean() > 0.01           # the grooves show ...
     assert ratio < 1.2, (within_quads, across_quads)   # ... shaded pixel by pixel (quad derivatives: 10x)
+
+
+def render_lip_sphere(size: int = 192, key=(-0.3, 0.3, 0.9)):
+    """A 5-mm sphere of lip (the paint's lip mask full, cheek-dry oil), its texture coordinates at
+    hm08's face scale, filling a ``size``² image, lit by a key near the camera: its luminance
+    (linear) and the disc's pixels."""
+    points, faces = sphere(60, 90)
+    radius = 0.05
+    p = (points * radius).astype(np.float32)
+    topology = RenderTopology(faces=faces, render_to_geo=np.arange(len(p)),
+                              uv=(0.5 + p[:, :2] / np.array([3.5, 7.0])).astype(np.float32),
+                              region=np.full(len(p), REGIONS.index("skin"), np.uint8),
+                              eye_coord=np.zeros((len(p), 3), np.float32))
+    paint = np.zeros((4, 4, 4), np.uint8)
+    paint[..., 1] = 255
+    detail = np.zeros((4, 4, 4), np.uint8)
+    detail[..., 2] = 90
+    lighting = Lighting(key_direction=key, fill_color=(0, 0, 0), rim_color=(0, 0, 0), sky=(0.02, 0.02, 0.02),
+                        ground=(0.02, 0.02, 0.02))
+    camera = frame_camera(-radius * np.ones(3), radius * np.ones(3), view="front", projection="orthographic")
+    with Renderer(topology, size=size, antialias=1, shadows=False) as renderer:
+        image = renderer.render(p, appearance=Appearance(DEFAULT_COLORS, paint=paint, detail=detail),
+                                camera=camera, lighting=lighting)
+    c = image[..., :3].astype(float) / 255
+    luminance = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4) @ np.array([0.2126, 0.7152, 0.0722])
+    y, x = np.mgrid[:size, :size] + 0.5 - size / 2
+    return luminance, x * x + y * y < (0.45 * size) ** 2
+
+
+def test_the_lips_sheen_is_a_narrow_broken_highlight_not_a_broad_glaze():
+    """Lips are moist: their film mirrors the key in a few narrow glints broken by the furrows and
+    drying in patches, over a faint broad sheen of the dry vermilion. (Until session 22 a broad
+    lobe of weight ~0.36, roughness 0.6, glazed them: the brightest pixel 1.8 times the lip's
+    median, the highlight's pixel-scale variation 3.5 %; "plastic lip sheen".)"""
+    from scipy.ndimage import gaussian_filter
+
+    luminance, disc = render_lip_sphere()
+    median = np.median(luminance[disc])
+    assert luminance[disc].max() > 2.3 * median          # narrow, bright glints ...
+    smooth = gaussian_filter(luminance, 3.0)
+    highlight = disc & (smooth > 1.2 * median)
+    assert highlight.sum() > 50
+    assert 100 * np.std(luminance[highlight] / smooth[highlight]) > 4.2   # ... broken, not one glaze

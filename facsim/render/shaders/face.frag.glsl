@@ -129,8 +129,14 @@ float pore_aggregate(vec2 p) {
 // How much of each channel's diffuse light sees the scattered normal (v_scatter_normal) rather
 // than the surface's own: red travels furthest under the skin, blue least.
 const vec3 SCATTER_SOFTNESS = vec3(0.6, 0.3, 0.12);
-// The lips' wet film is smoother than the skin's oil: their tight lobe's roughness.
-const float LIP_ROUGHNESS = 0.38;
+// The lips' sheen (skin_lobes): the vermilion's dry, lined surface gives only a faint broad lobe
+// (weight LIP_LOBES.x, roughness LIP_BROAD_ROUGHNESS); the moist film, smoother than the skin's
+// oil, a narrow one (LIP_ROUGHNESS) of weight LIP_LOBES.y where it is wet, broken by the furrows
+// and in patches (wet in main). (Until session 22 a broad lobe of weight ~0.36 and roughness 0.6
+// glazed the whole lower lip: "plastic lip sheen".)
+const vec2 LIP_LOBES = vec2(0.2, 0.32);
+const float LIP_BROAD_ROUGHNESS = 0.66;
+const float LIP_ROUGHNESS = 0.3;
 // The lips' colour fades into the skin's over the lip mask blurred to this mip level of the paint
 // texture (level 4.5: a blur over ~23 of its 2048 rows), this share of it - the red fades over ~2 mm
 // at the border on hm08's lips.
@@ -791,9 +797,13 @@ void main() {
     float film = smoothstep(0.75, 1.05, oil);
     // Moist, but the film is broken by the furrows and by the lips' fine mottle: a continuous
     // glossy band along the lip read as rubber.
-    float wet = max(lips * (1.0 - 0.85 * lip_line) * (0.55 + 0.45 * blotch), mucosa);
+    // The film beads and dries in patches a millimetre or two across (moist), so the narrow
+    // highlight breaks into strokes between the furrows rather than one band.
+    // (Off the lips, nearly all pixels, the noise is skipped.)
+    float moist = lips > 0.0 ? smoothstep(0.3, 0.75, value_noise(skin_uv * vec2(260.0, 520.0) + 31.0, 0)) : 0.0;
+    float wet = max(lips * (1.0 - lip_line) * (1.0 - lip_line) * (0.25 + 0.75 * moist) * (0.55 + 0.45 * blotch), mucosa);
     // Lobe weights (broad, tight); the fill is too weak to show: key and rim only.
-    SkinLobes lobes = skin_lobes(oil, film, wet, blotch, patches);
+    SkinLobes lobes = skin_lobes(oil, film, lips, wet, blotch, patches);
     vec2 weight = lobes.weight;
     vec2 roughness = lobes.roughness;
     vec3 spec = dot(skin_specular(bumped, u_key_dir, v, ndv, roughness), weight) * u_key_col * key_shadow

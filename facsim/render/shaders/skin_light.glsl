@@ -18,17 +18,18 @@ float scatter_reach(float curvature) {
 // facsim.head.appearance, the forehead's middle, the nose, the chin) is smoother and shinier
 // than the drier cheeks, its sheen uneven in patches a centimetre or so across (``patches``)
 // and broken at the millimetre scale (``blotch``), never one even glaze; the oil film's tighter
-// lobe only where the skin is oiliest (``film``); the lips' wet film (``wet``) its own. (Until
+// lobe only where the skin is oiliest (``film``); the lips (``lips``: their mask) and their wet
+// film (``wet``: the lips' film and the mucosa) their own. (Until
 // session 18 one broad lobe of weight 0.6 and roughness 0.6 lay over the whole face.)
 struct SkinLobes { vec2 weight; vec2 roughness; };
-SkinLobes skin_lobes(float oil, float film, float wet, float blotch, float patches) {
+SkinLobes skin_lobes(float oil, float film, float lips, float wet, float blotch, float patches) {
     float tzone = smoothstep(0.4, 0.85, oil);
-    float lip = min(2.0 * wet, 1.0);   // the lips' broad sheen: as it was, roughness 0.6, weight 0.6 less the film's
+    float lip = max(lips, min(2.0 * wet, 1.0));   // the lips' lobes (LIP_LOBES in face.frag.glsl)
     float uneven = (0.7 + 0.6 * patches) * (0.8 + 0.4 * blotch);
     SkinLobes l;
-    l.weight = vec2(mix(mix(0.42, 0.62, tzone) * uneven, 0.6, lip) - 0.3 * wet,
-                    (0.08 * tzone + 0.22 * film) * uneven + 0.2 * wet);
-    l.roughness = vec2(mix(mix(0.66, 0.54, tzone), 0.6, lip), mix(mix(0.48, 0.42, film), LIP_ROUGHNESS, lip));
+    l.weight = vec2(mix(mix(0.42, 0.62, tzone) * uneven, LIP_LOBES.x, lip),
+                    (0.08 * tzone + 0.22 * film) * uneven + LIP_LOBES.y * wet);
+    l.roughness = vec2(mix(mix(0.66, 0.54, tzone), LIP_BROAD_ROUGHNESS, lip), mix(mix(0.48, 0.42, film), LIP_ROUGHNESS, lip));
     return l;
 }
 #endif
