@@ -533,3 +533,32 @@ def test_the_cheeks_flush_is_faint(face_of, marks):
     _, cheek, forehead = _forehead_and_cheek(face_of("mei"), marks, 448)
     excess = np.hypot(*cheek[1:]) - np.hypot(*forehead[1:])
     assert excess < 5.5, (cheek, forehead)
+
+
+@pytest.mark.parametrize("name", ["ava", "george"])
+def test_a_mesh_crease_is_a_shade_not_a_red_line(face_of, head, name):
+    """Where the skin folds (4's furrow between the brows), the flank turned from the key is in
+    shade: darker in all three channels, a little warmer, as a fold in a photograph of skin; not a
+    saturated red stroke (issue 13, session 21's review: "sharp reddish mesh creases", the glabella
+    streak in 4+9). Over a ~2.5-cm patch at 1024 px: the pixels in shade (6 L* under the patch's
+    median) carry at most 2 C* more than it (until session 22 +4.5 on ava, +4.3 on george; now
+    -0.2 and +0.2), and no pixel stands out in chroma far beyond the skin's own mottle (the 99th
+    percentile: +19.8 and +20.3 over the median; now +7.0 and +9.9)."""
+    face = face_of(name)
+    size = 1024
+    deformation = face.deform("4E+9E")
+    positions = np.asarray(deformation.positions, np.float32)
+    camera = face.camera(size=(size, size))
+    image = face.renderer(size=size, body="none").render(
+        positions, appearance=face.appearance, camera=camera, wrinkle=deformation.wrinkle,
+        crease_phase=deformation.crease_phase, occlusion=face.frame_occlusion(positions))
+    skin = head.base_vertices[head.base_index[: head.skin_vertex_count]]
+    vertex = int(np.argmin(((skin - np.asarray(CREASE_PLACES["glabella"])) ** 2).sum(1)))
+    (x, y), = project(camera, positions[[vertex]], size)[0].astype(int)
+    lab = _cielab(image[y - 40:y + 40, x - 40:x + 40, :3])
+    lightness, chroma = lab[..., 0], np.hypot(lab[..., 1], lab[..., 2])
+    shade = lightness < np.median(lightness) - 6
+    assert shade.mean() > 0.05                       # the fold is there ...
+    excess = chroma[shade].mean() - np.median(chroma)
+    assert excess < 2.0, excess                      # ... as shade,
+    assert np.percentile(chroma, 99) - np.median(chroma) < 12.0   # not as a red line

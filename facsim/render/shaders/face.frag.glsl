@@ -126,6 +126,11 @@ float pore_aggregate(vec2 p) {
     return mix(a, b, f) * inversesqrt(1.0 - 2.0 * f + 2.0 * f * f) * exp2(-lod);
 }
 
+// The most red over green the skin's diffuse light may carry where the mesh folds (see main), and
+// where that is: 1 - cos of the angle between the surface's normal and the scatter normal (~10-26 deg).
+const float REDDEST_SCATTER = 1.3;
+const float MESH_FOLD_FROM = 0.015;
+const float MESH_FOLD_FULL = 0.1;
 // How much of each channel's diffuse light sees the scattered normal (v_scatter_normal) rather
 // than the surface's own: red travels furthest under the skin, blue least.
 const vec3 SCATTER_SOFTNESS = vec3(0.6, 0.3, 0.12);
@@ -744,10 +749,17 @@ void main() {
     // blue most: folds look soft and warm, not carved in grey (v_scatter_normal is the normal
     // averaged over two rings of neighbours, ~1 cm).
     vec3 n_scatter = normalize(gl_FrontFacing ? v_scatter_normal : -v_scatter_normal);
+    vec3 n_scatter_mesh = n_scatter;
     // The drawn grooves and rolls are 3-5 mm across, about as far as red light travels under the
     // skin, not the centimetre the averaged normal smooths over: the scattered light sees half
     // their slope. (Seeing none of it, the grooves' shade was all green and blue: red lines.)
+    // So do the engine's furrows' rolls (crease_fold), a few millimetres across too: seeing none
+    // of their slope, the line over the brows in 1+2 drew as a pink stroke (issue 13, session 21).
+#ifdef USE_WRINKLE
+    n_scatter = normalize(abs(det) * n_scatter - GROOVE_SCATTER * (groove_grad + fold_grad));
+#else
     n_scatter = normalize(abs(det) * n_scatter - GROOVE_SCATTER * groove_grad);
+#endif
     vec3 softness = SCATTER_SOFTNESS * (1.0 - hair);
     // (The key only: it alone draws the small relief's light and shade; the fill, rim and
     // sky are broad and dim, and a second full evaluation cost ~10 % of a video frame.)
@@ -777,6 +789,16 @@ void main() {
     lit += u_key_col * key_shadow * vec3(0.075, 0.018, 0.006) * exp(-key_cos * key_cos * 16.0) * contact * scatter;
     // Light that scatters out of the skin's shadowed side is redder than the light going in.
     lit *= mix(vec3(1.0), vec3(1.06, 0.97, 0.95), (1.0 - contact) * (1.0 - hair));
+    // Where the mesh itself folds (4's furrow between the brows, the line over the brows in 1+2),
+    // its normal turns away from the centimetre-wide scatter normal within a few millimetres: the
+    // red sees the scatter normal and the full wrap while green and blue see the flank, and the
+    // flank turned from the key drew as a saturated red stroke (issue 13: "sharp reddish mesh
+    // creases", "painted"). Light that has come through the skin there is redder than the light
+    // that went in, but only so much (REDDEST_SCATTER: red over green at most that of the shade's
+    // scattered ambient): the fold is a shade, darker in all three channels and a little warmer.
+    // (Only where the normals part: broad curves and terminators keep their red wrap.)
+    float mesh_fold = smoothstep(MESH_FOLD_FROM, MESH_FOLD_FULL, 1.0 - dot(n, n_scatter_mesh));
+    lit.r = mix(lit.r, min(lit.r, REDDEST_SCATTER * lit.g), mesh_fold);
     vec3 diffuse = lit * albedo;
     // Translucency: thin ears and nose wings glow red where the rim light comes from behind
     // them.
