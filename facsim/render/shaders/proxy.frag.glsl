@@ -266,7 +266,14 @@ void main() {
     // along the flow (pixel_strands_uv) take their place: each there where its rank is under
     // the density, so the band thins into streaks of hair with skin between them.
     float sub = smoothstep(16.0, 40.0, fwidth(suv.x) * 256.0);
-    float streak = clamp(0.5 + 2.2 * (pixel_strands_uv(suv, vec2(4.0, 1.5), vec2(3.0, 7.0)) - 0.5), 0.02, 0.98);
+    float strands_px = pixel_strands_uv(suv, vec2(4.0, 1.5), vec2(3.0, 7.0));
+    float streak = clamp(0.5 + 2.2 * (strands_px - 0.5), 0.02, 0.98);
+    // Larger tufts (1024², or where the UVs are dense above the forehead) are soft wedges whose
+    // translucent cover drew light hair as a film (george's grey hairline, blind review,
+    // session 21): their cover is the share of those strands there, each solid, so a tuft
+    // thins toward its tip into strands with skin between them.
+    float tuft_alpha = smoothstep(streak - 0.06, streak + 0.06, 1.25 * alpha);
+    alpha = mix(tuft_alpha, alpha, sub);
     keep = mix(keep, smoothstep(streak - 0.1, streak + 0.1, dens), sub);
     alpha = mix(alpha, mix(0.6, 1.0, smoothstep(0.3, 0.9, dens)), sub);
 #else
@@ -286,7 +293,12 @@ void main() {
     vec3 lit = dk * u_key_col + df * u_fill_col + hemisphere(n) * 0.8;
     // The roots under full cover lie in the cards' shadow; the hairline's fine hairs in the open.
     float light_hair = sqrt(clamp(dot(u_color, vec3(0.2126, 0.7152, 0.0722)), 0.0, 1.0));
-    float curl = 1.0;
+    // Brightness strand by strand (coily: curl by curl), not one flat tone.
+#ifdef COILY
+    float strand_shade = 1.0;
+#else
+    float strand_shade = 0.75 + 0.5 * strands_px;
+#endif
 #ifdef COILY
     {
         // Coily hair at the hairline: curls a millimetre and a few millimetres across, placed on
@@ -297,13 +309,13 @@ void main() {
         vec3 p = crop_turn * v_rest;
         float kink = value_noise3(p * 110.0);
         float coils = value_noise3(transpose(crop_turn) * v_rest * 35.0 + 5.0);
-        curl = (0.55 + 0.9 * kink) * (0.6 + 0.8 * coils);
+        strand_shade = (0.55 + 0.9 * kink) * (0.6 + 0.8 * coils);
         alpha *= smoothstep(0.3, 0.7, 0.55 * coils + 0.45 * kink + 0.35 * (dens - 0.6));
         light_hair *= 0.4;
     }
 #endif
     float shade = mix(0.9, mix(0.35, 0.7, light_hair), smoothstep(0.3, 1.0, v_depth));
-    vec3 albedo = hair_colour(suv * vec2(8.0, 2.0)) * (0.55 + 0.9 * tex.r) * shade * curl;
+    vec3 albedo = hair_colour(suv * vec2(8.0, 2.0)) * (0.55 + 0.9 * tex.r) * shade * strand_shade;
     f_color = vec4(finish(albedo * lit).rgb, alpha);
 #endif
 }
