@@ -287,3 +287,19 @@ def test_a_face_shape_with_lid_points_on_a_line_gets_finite_positions():
     # ngozi's face shape squeezes lid points onto a line; its lashes once came out NaN.
     positions = facsim.Face("ngozi", engine="muscle").deform("12").positions
     assert np.isfinite(positions).all()
+
+
+def test_fear_draws_the_raised_brows_together_and_straightens_them(engine, marks):
+    """Issue 13: in fear (1+2+4) the brows are raised AND drawn together and straightened (FACS).
+    On session 21's main noah's brow heads came 1.6 mm together in fear (the register engine
+    draws ava's 7.9 mm together), raised 9 mm like surprise's: the panel read fear as surprise."""
+    from facsim.facs.emotions import emotion
+
+    got = engine.solve_many([activations(emotion("fear"))])[0] - engine.neutral
+    left, right = marks["inner_brow_left"], marks["inner_brow_right"]
+    together = got[left, 0] - got[right, 0]
+    assert together < -0.03                                     # drawn together by 3 mm at least
+    inner = 0.5 * (got[left, 1] + got[right, 1])
+    outer = 0.5 * (got[marks["outer_brow_left"], 1] + got[marks["outer_brow_right"], 1])
+    assert inner > 0.02 and outer > 0.02                         # both raised 2 mm at least
+    assert abs(outer - inner) < 0.04                             # straightened: no slant of 4 mm
