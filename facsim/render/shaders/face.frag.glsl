@@ -75,6 +75,7 @@ const float FOLD_TEXELS = 3.0;   // a groove's half-width in fold-map texels (~0
 const float FOLD_RELIEF = 1.6;   // height of the grooves and their rolls, of the map's groove depth
 const vec2 CREVICE_SHADE = vec2(0.12, 0.05);   // shade at the floor: lines (R), under-eye lines (G)
 const float GROOVE_SCATTER = 0.5;   // share of the grooves' slope the scattered light sees
+const float FURROW_SCATTER = 0.8;   // and of the engine's furrows' (rolls ~9 mm across: CREASES_PER_DM)
 uniform sampler2D u_folds;   // R forehead lines + crow's feet, G under-eye lines, B fold shade,
                              // A where R and G replace the engine's furrows (facsim.head.skin)
 uniform sampler2D u_tone;    // R darker skin (eyes, mouth, temples), G translucency, B pores, A sun (facsim.head.skin)
@@ -776,10 +777,12 @@ void main() {
     // The drawn grooves and rolls are 3-5 mm across, about as far as red light travels under the
     // skin, not the centimetre the averaged normal smooths over: the scattered light sees half
     // their slope. (Seeing none of it, the grooves' shade was all green and blue: red lines.)
-    // So do the engine's furrows' rolls (crease_fold), a few millimetres across too: seeing none
-    // of their slope, the line over the brows in 1+2 drew as a pink stroke (issue 13, session 21).
+    // The engine's furrows' rolls (crease_fold) are ~9 mm across, well beyond red's reach: the
+    // scattered light sees most of their slope. (Seeing none of it, the line over the brows in 1+2
+    // drew as a pink stroke, issue 13, session 21: over a strip across it at 1024², its shade's C*
+    // over the strip's median +3.3 until session 22, +2.2 at half the slope, +1.5 now.)
 #ifdef USE_WRINKLE
-    n_scatter = normalize(abs(det) * n_scatter - GROOVE_SCATTER * (groove_grad + fold_grad));
+    n_scatter = normalize(abs(det) * n_scatter - GROOVE_SCATTER * groove_grad - FURROW_SCATTER * fold_grad);
 #else
     n_scatter = normalize(abs(det) * n_scatter - GROOVE_SCATTER * groove_grad);
 #endif
