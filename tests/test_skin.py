@@ -535,6 +535,28 @@ def test_the_cheeks_flush_is_faint(face_of, marks):
     assert excess < 5.5, (cheek, forehead)
 
 
+def _crease_colour(face, head, expression, point, half_size):
+    """A patch at 1024 px around a base-mesh ``point`` of ``expression`` (``half_size``: (x, y)
+    pixels): its shaded pixels' share (``dark`` L* under the median), their CIELAB chroma over the
+    patch's median, and the patch's 99th-percentile chroma over the median."""
+    size = 1024
+    deformation = face.deform(expression)
+    positions = np.asarray(deformation.positions, np.float32)
+    camera = face.camera(size=(size, size))
+    image = face.renderer(size=size, body="none").render(
+        positions, appearance=face.appearance, camera=camera, wrinkle=deformation.wrinkle,
+        crease_phase=deformation.crease_phase, occlusion=face.frame_occlusion(positions))
+    skin = head.base_vertices[head.base_index[: head.skin_vertex_count]]
+    vertex = int(np.argmin(((skin - np.asarray(point)) ** 2).sum(1)))
+    (x, y), = project(camera, positions[[vertex]], size)[0].astype(int)
+    (hx, hy), dark = half_size, 6 if half_size[0] == half_size[1] else 4
+    lab = _cielab(image[y - hy:y + hy, x - hx:x + hx, :3])
+    lightness, chroma = lab[..., 0], np.hypot(lab[..., 1], lab[..., 2])
+    shade = lightness < np.median(lightness) - dark
+    return (shade.mean(), chroma[shade].mean() - np.median(chroma),
+            np.percentile(chroma, 99) - np.median(chroma))
+
+
 @pytest.mark.parametrize("name", ["ava", "george"])
 def test_a_mesh_crease_is_a_shade_not_a_red_line(face_of, head, name):
     """Where the skin folds (4's furrow between the brows), the flank turned from the key is in
@@ -544,21 +566,20 @@ def test_a_mesh_crease_is_a_shade_not_a_red_line(face_of, head, name):
     median) carry at most 2 C* more than it (until session 22 +4.5 on ava, +4.3 on george; now
     -0.2 and +0.2), and no pixel stands out in chroma far beyond the skin's own mottle (the 99th
     percentile: +19.8 and +20.3 over the median; now +7.0 and +9.9)."""
-    face = face_of(name)
-    size = 1024
-    deformation = face.deform("4E+9E")
-    positions = np.asarray(deformation.positions, np.float32)
-    camera = face.camera(size=(size, size))
-    image = face.renderer(size=size, body="none").render(
-        positions, appearance=face.appearance, camera=camera, wrinkle=deformation.wrinkle,
-        crease_phase=deformation.crease_phase, occlusion=face.frame_occlusion(positions))
-    skin = head.base_vertices[head.base_index[: head.skin_vertex_count]]
-    vertex = int(np.argmin(((skin - np.asarray(CREASE_PLACES["glabella"])) ** 2).sum(1)))
-    (x, y), = project(camera, positions[[vertex]], size)[0].astype(int)
-    lab = _cielab(image[y - 40:y + 40, x - 40:x + 40, :3])
-    lightness, chroma = lab[..., 0], np.hypot(lab[..., 1], lab[..., 2])
-    shade = lightness < np.median(lightness) - 6
-    assert shade.mean() > 0.05                       # the fold is there ...
-    excess = chroma[shade].mean() - np.median(chroma)
-    assert excess < 2.0, excess                      # ... as shade,
-    assert np.percentile(chroma, 99) - np.median(chroma) < 12.0   # not as a red line
+    shade, excess, top = _crease_colour(face_of(name), head, "4E+9E", CREASE_PLACES["glabella"], (40, 40))
+    assert shade > 0.05                   # the fold is there ...
+    assert excess < 2.0, excess           # ... as shade,
+    assert top < 12.0, top                # not as a red line
+
+
+@pytest.mark.parametrize("name", ["mei", "george"])
+def test_the_line_over_raised_brows_is_a_shade_not_a_pink_stroke(face_of, head, name):
+    """1+2 folds the forehead's skin into a roll over the brows: its lower flank is in shade, not a
+    pink stroke (issue 13, session 21's review: "the line above the brows in 1+2"). Over a ~5 x 1.5-cm
+    strip across it at 1024 px, the shaded pixels (4 L* under the median) carry at most 2.5 C* more
+    than the strip's median, its 99th percentile at most 7 (until session 22: mei +3.9 and +9.6,
+    george +5.0 and +13.2; now +1.5 and +4.1, +2.0 and +4.9)."""
+    shade, excess, top = _crease_colour(face_of(name), head, "1E+2E", (0.0, 7.59, 1.5), (90, 25))
+    assert shade > 0.05                   # the line is there ...
+    assert excess < 2.5, excess           # ... as shade,
+    assert top < 7.0, top                 # not as a pink stroke

@@ -71,6 +71,24 @@ float value_noise(vec2 p, int period_x) {
     return mix(mix(a, b, u.x), mix(c, d, u.x), u.y);
 }
 
+// value_noise (no wrap) with its gradient: (value, d/dp.x, d/dp.y). A bump's slope taken from
+// this per pixel, rather than from screen derivatives of the value (one per 2x2-pixel quad), does
+// not break into 2x2 blocks.
+vec3 value_noise_grad(vec2 p) {
+    vec2 i = floor(p);
+    vec2 f = p - i;
+    vec2 u = f * f * (3.0 - 2.0 * f);
+    vec2 du = 6.0 * f * (1.0 - f);
+    ivec2 i0 = ivec2(i);
+    float a = hash2(i0);
+    float b = hash2(i0 + ivec2(1, 0));
+    float c = hash2(i0 + ivec2(0, 1));
+    float d = hash2(i0 + ivec2(1, 1));
+    float k = a - b - c + d;
+    return vec3(mix(mix(a, b, u.x), mix(c, d, u.x), u.y),
+                du.x * (b - a + k * u.y), du.y * (c - a + k * u.x));
+}
+
 // ---- lighting helpers ---------------------------------------------------------------------
 vec3 hemisphere(vec3 n) {
     return mix(u_ground_col, u_sky_col, 0.5 + 0.5 * n.y);

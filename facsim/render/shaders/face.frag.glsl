@@ -75,6 +75,7 @@ const float FOLD_TEXELS = 3.0;   // a groove's half-width in fold-map texels (~0
 const float FOLD_RELIEF = 1.6;   // height of the grooves and their rolls, of the map's groove depth
 const vec2 CREVICE_SHADE = vec2(0.12, 0.05);   // shade at the floor: lines (R), under-eye lines (G)
 const float GROOVE_SCATTER = 0.5;   // share of the grooves' slope the scattered light sees
+const float FURROW_SCATTER = 0.8;   // and of the engine's furrows' (rolls ~9 mm across: CREASES_PER_DM)
 uniform sampler2D u_folds;   // R forehead lines + crow's feet, G under-eye lines, B fold shade,
                              // A where R and G replace the engine's furrows (facsim.head.skin)
 uniform sampler2D u_tone;    // R darker skin (eyes, mouth, temples), G translucency, B pores, A sun (facsim.head.skin)
@@ -162,6 +163,10 @@ const vec3 AGE_SPOT = vec3(0.88, 0.81, 0.72);
 // they vary the skin's colour and break its sheen, per unit of the aggregate, on skin of average
 // pore density (tone.b 0.4; the nose and the cheeks beside it more, the forehead's sides less).
 const vec2 PORE_CELLS = vec2(1000.0, 2000.0);
+// The fine noises' lattice turned ~33 degrees off the texture axes, which lie nearly along the
+// image's rows and columns in a front view: value noise's cells aligned with the pixels drew the
+// skin's grain and pores at 1024² as a mosaic of square blocks (issue 13: "blocky pores").
+const mat2 GRAIN_TURN = mat2(0.839, 0.545, -0.545, 0.839);
 const float PORE_TONE = 0.3;
 const float PORE_SHEEN = 2.5;
 
@@ -519,11 +524,17 @@ void main() {
     // as in u, hence the 1:2 frequencies: round cells.)
     // Each person's patterns lie elsewhere on the noise (u_skin_seed), so no two share a skin.
     vec2 skin_uv = v_uv + vec2(0.0731, 0.0419) * u_skin_seed;
-    vec2 grain_uv = skin_uv * vec2(350.0, 700.0);
-    float grain = mix(0.5, value_noise(grain_uv, 0),
-                      clamp(2.0 - 1.2 * max(fwidth(grain_uv.x), fwidth(grain_uv.y)), 0.0, 1.0));
+    vec2 grain_uv = GRAIN_TURN * (skin_uv * vec2(350.0, 700.0));
+    vec3 grain_noise = value_noise_grad(grain_uv);   // (its slope: the micro-relief below)
+    float grain_detail = clamp(2.0 - 1.2 * max(fwidth(grain_uv.x), fwidth(grain_uv.y)), 0.0, 1.0);
+    float grain = mix(0.5, grain_noise.x, grain_detail);
+    // (The lips keep the grain on the texture's axes, which their furrows, along v, follow; off
+    // the lips, nearly all pixels, it is skipped.)
+    vec2 lip_grain_uv = skin_uv * vec2(350.0, 700.0);
+    float lip_grain_detail = clamp(2.0 - 1.2 * max(fwidth(lip_grain_uv.x), fwidth(lip_grain_uv.y)), 0.0, 1.0);
+    float lip_grain = paint.g > 0.0 ? mix(0.5, value_noise(lip_grain_uv, 0), lip_grain_detail) : 0.5;
     float blotch = value_noise(skin_uv * vec2(150.0, 300.0), 0);
-    float pores = pore_aggregate(skin_uv * PORE_CELLS);
+    float pores = pore_aggregate(GRAIN_TURN * (skin_uv * PORE_CELLS));
     float patches = value_noise(skin_uv * vec2(24.0, 48.0) + 17.0, 0);
     float mottle = 0.6 * blotch + 0.4 * grain;
     vec3 albedo = u_skin * (1.0 + vec3(0.10, 0.12, 0.13) * (1.0 + 1.2 * u_age) * (mottle - 0.5));
@@ -583,7 +594,7 @@ void main() {
     float lip_s = v_uv.y * 560.0 + 0.8 * blotch;
     float lip_line = pow(0.5 + 0.5 * cos(2.0 * PI * lip_s), 5.0)
                    * (0.25 + 0.75 * hash2(ivec2(int(floor(lip_s + 0.5)), 7)))    // uneven furrows,
-                   * (0.3 + 0.7 * grain);                                         // broken along their length
+                   * (0.3 + 0.7 * lip_grain);                                     // broken along their length
     lip_line = mix(0.1, lip_line, clamp(1.6 - 3.0 * fwidth(lip_s), 0.0, 1.0));
     // Inside the wet-dry line the lips roll into their mucosa (detail.a, facsim.head.mouth.
     // lip_mucosa): smooth (no furrows), wet, a deeper and more bluish red than the vermilion
@@ -692,13 +703,20 @@ void main() {
     // screen derivatives), strongest on the nose and cheeks (tone.b), deeper with age, faded
     // out where it would be finer than a pixel, so it never shimmers. Compiled only for large
     // images (render.py), where pores are bigger than a pixel.
-    vec2 pore_uv = v_uv * vec2(700.0, 1400.0);   // cells ~0.5 mm, round (1:2, see the spots)
-    float pit = smoothstep(0.55, 0.85, value_noise(pore_uv, 0));
-    float pore_h = 0.5 * value_noise(pore_uv * 0.37 + 3.0, 0) - pit;
-    vec3 grad = sign(det) * (dFdx(pore_h) * r1 + dFdy(pore_h) * r2);
+    // (Their slope is the noise's own, per pixel, carried to the screen by the texture
+    // coordinates' derivatives: screen derivatives of the height, one per 2x2-pixel quad, drew the
+    // pores at 1024² as a mosaic of 2-px blocks, issue 13: "blocky pores".)
+    vec2 pore_uv = GRAIN_TURN * (v_uv * vec2(700.0, 1400.0));   // cells ~0.5 mm, round (1:2, see the spots)
+    vec3 pore_noise = value_noise_grad(pore_uv);
+    vec3 bump_noise = value_noise_grad(pore_uv * 0.37 + 3.0);
+    float pit = smoothstep(0.55, 0.85, pore_noise.x);
+    float pit_slope = 6.0 * (pore_noise.x - 0.55) * (0.85 - pore_noise.x) / (0.3 * 0.3 * 0.3) * step(0.55, pore_noise.x) * step(pore_noise.x, 0.85);
+    vec2 pore_slope = 0.5 * 0.37 * bump_noise.yz - pit_slope * pore_noise.yz;   // d height / d pore_uv
+    vec3 grad = sign(det) * (dot(pore_slope, dFdx(pore_uv)) * r1 + dot(pore_slope, dFdy(pore_uv)) * r2);
     float pore_fade = clamp(2.2 - 2.5 * max(fwidth(pore_uv.x), fwidth(pore_uv.y)), 0.0, 1.0);
     float pore_amount = pore_fade * (0.3 + 1.2 * tone.b) * (1.0 - paint.g) * (1.0 - hair);
-    vec3 bumped = normalize(abs(det) * n - (0.0006 + 0.0003 * u_age) * pore_amount * grad);
+    // (0.8 of the height the pores had with a slope per quad: the same mean step between pixels.)
+    vec3 bumped = normalize(abs(det) * n - (0.00048 + 0.00024 * u_age) * pore_amount * grad);
     cavity *= 1.0 - 0.07 * pit * pore_amount;
     float spec_break = 1.0 - 0.6 * pit * pore_amount;   // pores hold no oil film facing the light
 #else
@@ -715,10 +733,16 @@ void main() {
     // 0.04 and only where tone.b passed 0.3 the skin at 768² read as airbrushed wax, issue 13.)
     // (The grain's own peaks, so no further noise is evaluated; it is already faded to its
     // flat mean where it would be finer than a pixel.)
-    float pit = smoothstep(0.62, 0.9, grain) * smoothstep(0.15, 0.8, tone.b) * (1.0 - paint.g) * (1.0 - hair);
-    float relief_h = 0.4 * grain - 0.6 * pit;
-    vec3 grad = sign(det) * (dFdx(relief_h) * r1 + dFdy(relief_h) * r2);
-    float relief = (0.0016 + 0.0008 * u_age) * (0.5 + tone.b) * (1.0 - paint.g) * (1.0 - hair);
+    // (The slope per pixel from the noise's own gradient, as the pores' above.)
+    float pore_share = smoothstep(0.15, 0.8, tone.b) * (1.0 - paint.g) * (1.0 - hair);
+    float pit = smoothstep(0.62, 0.9, grain) * pore_share;
+    float pit_slope = 6.0 * (grain - 0.62) * (0.9 - grain) / (0.28 * 0.28 * 0.28) * step(0.62, grain) * step(grain, 0.9);
+    vec2 relief_slope = (0.4 - 0.6 * pore_share * pit_slope) * grain_detail * grain_noise.yz;   // d height / d grain_uv
+    vec3 grad = sign(det) * (dot(relief_slope, dFdx(grain_uv)) * r1 + dot(relief_slope, dFdy(grain_uv)) * r2);
+    // (Its height 0.6 of what it was with a slope per quad, which averaged the slope over 2x2 pixels:
+    // the same mean step between pixels, 0.0125 on an oily patch at 448 px, and no more red dots where
+    // the relief shades green and blue more than red.)
+    float relief = (0.00096 + 0.00048 * u_age) * (0.5 + tone.b) * (1.0 - paint.g) * (1.0 - hair);
     vec3 bumped = normalize(abs(det) * n - relief * grad);
     cavity *= 1.0 - 0.09 * pit;
     float spec_break = 1.0 - 0.7 * pit;   // pores hold no oil film facing the light
@@ -753,10 +777,12 @@ void main() {
     // The drawn grooves and rolls are 3-5 mm across, about as far as red light travels under the
     // skin, not the centimetre the averaged normal smooths over: the scattered light sees half
     // their slope. (Seeing none of it, the grooves' shade was all green and blue: red lines.)
-    // So do the engine's furrows' rolls (crease_fold), a few millimetres across too: seeing none
-    // of their slope, the line over the brows in 1+2 drew as a pink stroke (issue 13, session 21).
+    // The engine's furrows' rolls (crease_fold) are ~9 mm across, well beyond red's reach: the
+    // scattered light sees most of their slope. (Seeing none of it, the line over the brows in 1+2
+    // drew as a pink stroke, issue 13, session 21: over a strip across it at 1024², its shade's C*
+    // over the strip's median +3.3 until session 22, +2.2 at half the slope, +1.5 now.)
 #ifdef USE_WRINKLE
-    n_scatter = normalize(abs(det) * n_scatter - GROOVE_SCATTER * (groove_grad + fold_grad));
+    n_scatter = normalize(abs(det) * n_scatter - GROOVE_SCATTER * groove_grad - FURROW_SCATTER * fold_grad);
 #else
     n_scatter = normalize(abs(det) * n_scatter - GROOVE_SCATTER * groove_grad);
 #endif
