@@ -18,12 +18,7 @@ count. On their luminance (Rec. 709 weights on the sRGB values) it prints
 - ``crown``: on the crown (hair pixels from the top of the image to 4 % of its height below the
   top of the skin, in the middle 40 % of its width), the standard deviation of the luminance's
   band-pass down the columns (Gaussian 1.5 px minus 6 px) over the mean: rows of cards drawn
-  as horizontal bands across the crown (long01) give a high figure;
-- ``taper``: how gradually long hair's ends thin out below the jaw: the hair's cover over the
-  background, averaged over 9 columns, followed down each column from its last row at 0.85 or
-  more to its first row under 0.15 below that; the median of those heights in pixels. Ends
-  cut straight across (every strand of a clump ending at one height) give 1-3 px; ends that
-  taper, fewer strands and then none, a band several pixels high.
+  as horizontal bands across the crown (long01) give a high figure.
 
     PYTHONPATH=. python3 benchmarks/bench_hair_texture.py [--character liam] [--view front] [--size 512]
 """
@@ -88,27 +83,6 @@ def crown_banding(image: np.ndarray, mask: np.ndarray, without_hair: np.ndarray)
     return (float(band[crown].std() / lum[crown].mean()) if crown.any() else 0.0), int(crown.sum())
 
 
-def end_taper(with_hair: np.ndarray, without_hair: np.ndarray, *, window: int = 9) -> tuple[float, int]:
-    """(taper, columns): the ``taper`` figure (module docstring) of two (H, W, 4) uint8 RGBA
-    renders on a transparent background, and how many columns it was taken over."""
-    from scipy.ndimage import uniform_filter1d
-
-    below = slice(int(0.625 * with_hair.shape[0]), None)
-    bare = without_hair[below, :, 3] < 3
-    cover = np.where(bare, with_hair[below, :, 3].astype(np.float32) / 255.0, 0.0)
-    mean = uniform_filter1d(cover, window, axis=1)
-    heights = []
-    for col in range(cover.shape[1]):
-        solid = np.nonzero(mean[:, col] >= 0.85)[0]
-        if len(solid) == 0:
-            continue
-        gone = np.nonzero(mean[solid[-1]:, col] < 0.15)[0]
-        # (only where the background shows all the way down: not where the garment cuts the ends)
-        if len(gone) and bare[solid[-1]: solid[-1] + gone[0] + 1, col].all():
-            heights.append(gone[0])
-    return (float(np.median(heights)) if heights else 0.0), len(heights)
-
-
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--character", default="liam")
@@ -130,8 +104,6 @@ def main(argv=None) -> int:
     print(f"crown: {banding:.3f} band-pass down the columns over {pixels} crown pixels")
     share, pixels = partial_cover_below_jaw(*images)
     print(f"ends: {share:.3f} of {pixels} hair pixels over the background below the jaw only partly covered")
-    taper, columns = end_taper(*images)
-    print(f"taper: {taper:.1f} px median height over which the ends thin out, over {columns} columns")
     return 0
 
 

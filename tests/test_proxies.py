@@ -376,3 +376,25 @@ def test_the_strand_highlight_is_one_band_across_the_crown_not_patches_of_cards(
     On mei (black long01, where the highlight shows most) at 256² the crown figure was 0.178;
     along the flow 0.112 (ava: 0.085 -> 0.067)."""
     assert _crown_banding(face_of("mei")) < 0.14
+
+
+def test_straight_hair_shows_depth_between_locks_not_one_flat_sheet(face_of):
+    """Straight hair gathers into locks a few millimetres across, placed on the head along the
+    strands: their gaps lie in their neighbours' shade and their crowns catch the light (mei's
+    black bob read as one flat sheet, blind review, session 21). On mei at 256² the hair's
+    detail finer than 2 px over its mean (benchmarks/bench_hair_texture.py's ``fine``) was
+    0.241, with locks 0.266; the crown's banding stays under the limit above (0.112 -> 0.124)."""
+    import sys
+    from pathlib import Path
+
+    from facsim.face import Face
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+    from bench_hair_texture import hair_mask, luminance_variation
+
+    face = face_of("mei")
+    with Face(face.character.with_(hair="none")) as bald:
+        without = bald.render(None, size=256, background=None)
+    with_hair = face.render(None, size=256, background=None)
+    fine, _ = luminance_variation(with_hair, hair_mask(with_hair, without))
+    assert fine > 0.255, fine

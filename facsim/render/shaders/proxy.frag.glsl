@@ -30,6 +30,11 @@ uniform float u_end_fade;     // ... its strands ending one by one over this hei
 uniform vec3 u_hair_apex;     // hair: a point above the crown the strands flow down and out from (world)
 // How much the strand highlight follows the hair's flow over the volume rather than each card's tangent.
 const float HIGHLIGHT_FLOW = 0.7;
+// Straight hair's locks (see main): cells per decimetre on the neutral head (~6 mm), and the light
+// left in the gaps between them for dark and for light hair (light hair scatters more into them).
+const float LOCK_CELLS_PER_DM = 16.0;
+const float LOCK_GAP_DARK = 0.5;
+const float LOCK_GAP_LIGHT = 0.75;
 
 out vec4 f_color;
 
@@ -446,6 +451,7 @@ void main() {
     float coil_clump = 0.5 + 1.3 * (0.5 * (value_noise3(turn_a * v_rest * 18.0 + 1.0)
                                            + value_noise3(turn_b * v_rest * 18.0 + 7.0)) - 0.5);
     float px = 0.5;
+    float lock = 0.5;
 #else
     // On the crown, where strands run sideways from the parting (their direction on the neutral
     // head near horizontal), long01's cards lie in rows across the strands, each row starting
@@ -484,6 +490,17 @@ void main() {
     }
     float px_full = px;
     if (u_along_v > 0.5) px = mix(0.5, px, 0.4);
+    // Locks: strands gather into locks a few millimetres across and several long, placed on the
+    // neutral head along the strands (so they run on across the cards, as px does); the narrow
+    // gaps between them lie in their neighbours' shade and their crowns catch the light, so a
+    // head of straight hair shows depth between locks rather than one smooth sheet (mei's black
+    // bob read as a flat sheet, blind review, session 21). Faded to its mean where finer than a pixel.
+    vec3 lock_p = v_rest * LOCK_CELLS_PER_DM;
+    float lock = mix(0.5, smeared_noise(lock_p + 19.0, 1.6 * along_rest),
+                     clamp(2.5 - 1.6 * length(fwidth(lock_p)), 0.0, 1.0));
+    // (long hair's crown, combed flat sideways from the parting, shows shallower gaps than its
+    // hanging lengths: at full depth there its locks drew bands across the crown)
+    lock = clamp(0.5 + mix(1.6, 0.8, on_head * u_along_v) * (lock - 0.5), 0.0, 1.0);
 #endif
     // The hair's outline: where the volume turns away from the eye, its outer strands stand
     // apart, so the outline breaks into strands and clumps with the background between them
@@ -643,7 +660,8 @@ void main() {
                       * mix(mix(0.8, 0.9, light_hair), 1.0, clump) * mix(0.8, 1.0, mid)
     // and the narrow gaps between clumps are in their neighbours' shade: light and dark
     // alternate across the mass at the scale of clumps, not one smooth shell.
-                      * mix(mix(0.74, 0.8, light_hair), 1.0, smoothstep(0.02, 0.32, px));
+                      * mix(mix(0.74, 0.8, light_hair), 1.0, smoothstep(0.02, 0.32, px))
+                      * mix(mix(LOCK_GAP_DARK, LOCK_GAP_LIGHT, light_hair), 1.0, smoothstep(0.15, 0.6, lock));
     float jitter = 0.22 * (tex.r - 0.5) + 0.12 * (fine - 0.5) + 0.18 * (mid - 0.5) + 0.1 * (clump - 0.5)
                  + 0.25 * (px - 0.5);
     // Key light: strand diffuse blended with a squared half-Lambert, which keeps the volume
@@ -686,7 +704,8 @@ void main() {
     // (The texture's own strands and the cards' clumps keep only part of their say: they stop at
     // each card's edge, and at full strength they cut the band into the cards' shapes.)
     float strands = mix(0.55, 1.0, smoothstep(0.25, 0.7, fine) * smoothstep(0.2, 0.7, mid))
-                  * mix(0.45, 1.0, smoothstep(0.3, 0.65, tex.r)) * mix(0.7, 1.0, clump) * smoothstep(0.3, 0.75, px) * 1.4;
+                  * mix(0.45, 1.0, smoothstep(0.3, 0.65, tex.r)) * mix(0.7, 1.0, clump) * smoothstep(0.3, 0.75, px) * 1.4
+                  * mix(0.4, 1.6, lock);   // the locks' crowns catch the light, their gaps little
     float sparkle = smoothstep(0.45, 0.75, fine) * smoothstep(0.4, 0.7, mid) * smoothstep(0.4, 0.75, px);
     vec3 tint = mix(vec3(1.0), u_color / max(max(u_color.r, u_color.g), max(u_color.b, 1e-4)), 0.5);
     // Light hair's own diffuse is bright already: a full-strength white lobe on it reads as
