@@ -58,10 +58,12 @@ def main(argv=None) -> int:
         with overwriting(getattr(args, "overwrite", False)):
             args.handler(args)
     except KeyboardInterrupt:  # Ctrl-C, SIGTERM or SIGHUP: temporaries were removed on the way out
-        name = signal.Signals(stopped[-1]).name if stopped else "SIGINT"
-        print(f"facsim: interrupted ({name}); nothing was left half-written", file=sys.stderr)
-        return 128 + (stopped[-1] if stopped else signal.SIGINT)
+        return _interrupted(stopped)
     except Exception as exc:  # one clear line, never a traceback (unless asked for)
+        if stopped:
+            # The signal's KeyboardInterrupt was raised inside C code that swallowed it and raised
+            # its own error instead (numpy's structured-array comparison turns it into a TypeError).
+            return _interrupted(stopped)
         if getattr(args, "debug", False) or os.environ.get("FACSIM_DEBUG"):
             raise
         if _is_user_error(exc):
@@ -71,6 +73,13 @@ def main(argv=None) -> int:
               "this bug with the output of the same command run as `facsim --debug ...`", file=sys.stderr)
         return EXIT_INTERNAL
     return 0
+
+
+def _interrupted(stopped: list) -> int:
+    """Say which signal stopped the command; the exit status is 128 + its number, as a shell's."""
+    signum = stopped[-1] if stopped else signal.SIGINT
+    print(f"facsim: interrupted ({signal.Signals(signum).name}); nothing was left half-written", file=sys.stderr)
+    return 128 + signum
 
 
 def _stop_on_signals() -> list:
