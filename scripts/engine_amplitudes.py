@@ -10,9 +10,11 @@ glabella's drop, the upper and lower lids' rise, the eye's aperture change
 With ``--lower``: the lower face — the chin's drop, the lip corners' rise (mean of both sides),
 the change of the mouth's width, the rise of the upper lip's inner edge at the
 midline, the rise of the nasolabial fold beside the nose (the skin over the maxilla:
-about 0 when the jaw drops), the forward motion of the lips, and how far the upper lip's inner
+about 0 when the jaw drops), the forward motion of the lips, how far the upper lip's inner
 edge lies above the upper incisors' edge (positive: that much upper tooth
-shows when the lips are parted; about -1 at rest).
+shows when the lips are parted; about -1 at rest), and how far on average the skin over the
+mandible's body lies off a rigid turn of the chin about the jaw's hinge ("bone": about 0 when it
+turns with the bone).
 
 Usage::
 
@@ -36,7 +38,7 @@ COLUMNS = ("chin", "lo-lip", "jaw", "gap", "in-brow", "out-brow", "brow-dx")
 UPPER_EXPRESSIONS = ["1", "2", "4", "1+2", "1+4", "1+2+4", "5", "6", "7", "9", "41", "42", "43", "44",
                      "anger", "fear", "sadness", "surprise", "disgust", "happiness"]
 UPPER_COLUMNS = ("in-brow", "out-brow", "brow-dx", "glab", "up-lid", "lo-lid", "aperture", "cheek", "nose")
-LOWER_COLUMNS = ("chin", "lo-lip", "jaw", "gap", "corner", "width", "up-lip", "naso", "protr", "teeth")
+LOWER_COLUMNS = ("chin", "lo-lip", "jaw", "gap", "corner", "width", "up-lip", "naso", "protr", "teeth", "bone")
 
 
 def amplitudes(face, expression) -> dict[str, float]:
@@ -81,7 +83,31 @@ def amplitudes(face, expression) -> dict[str, float]:
         "naso": rise("nasolabial_fold"),
         "protr": shape.protrusion,
         "teeth": MM * (p[gauge.upper_lip, 1] - p[gauge.incisor_edge, 1]),
+        "bone": MM * off_the_bone(face, p, marks),
     }
+
+
+def off_the_bone(face, positions, marks) -> float:
+    """Mean distance (dm) of the skin over the mandible's body (the muscle engine's jaw attachment,
+    12 mm or more below the lip corners) from where a rigid turn of the chin about the jaw's hinge,
+    with the chin's own shift, would take it."""
+    from facsim.engines.muscle.net import OUTER, anatomy
+
+    anat = anatomy(face.head)
+    count = anat.skin_count
+    rest = np.asarray(face.neutral, float)[:count]
+    moved = np.asarray(positions, float)[:count]
+    hinge = np.asarray(face.head.joint(face.engine.base_positions, "joint-mouth"), float)[1:]
+    corners = np.mean([rest[marks[f"lip_corner_{s}"], 1] for s in ("left", "right")])
+    on_the_bone = (anat.jaw_weight > 0.99) & (anat.kind == OUTER) & (rest[:, 1] < corners - 0.12)
+    chin = marks["chin"]
+    before, after = rest[chin, 1:] - hinge, moved[chin, 1:] - hinge
+    angle = np.arctan2(before[0], before[1]) - np.arctan2(after[0], after[1])
+    radial = rest[:, 1:] - hinge
+    turned = np.stack([radial[:, 0] * np.cos(angle) - radial[:, 1] * np.sin(angle),
+                       radial[:, 0] * np.sin(angle) + radial[:, 1] * np.cos(angle)], axis=1) + hinge
+    turned += moved[chin, 1:] - turned[chin]
+    return float(np.linalg.norm(moved[on_the_bone, 1:] - turned[on_the_bone], axis=1).mean())
 
 
 def main(argv=None) -> None:

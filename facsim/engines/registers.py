@@ -225,6 +225,29 @@ def turn_no_further_than(offsets: np.ndarray, positions: np.ndarray, hinge: np.n
     return (np.asarray(offsets) * scale[:, None]).astype(np.asarray(offsets).dtype)
 
 
+def carried_by_the_bone(offsets: np.ndarray, positions: np.ndarray, hinge: np.ndarray, reference: int) -> np.ndarray:
+    """Offsets (N, 3) of ``positions`` (N, 3) moved rigidly with the point ``reference`` (the chin):
+    turned about the left-right axis through ``hinge`` by the angle ``offsets`` turn it, then shifted
+    by what its own offset adds to that turn (the condyles gliding down and forward).
+
+    The chin keeps its own offset; a point half as far in front of the hinge drops half as far:
+
+    >>> pos = np.array([[0.0, 0.0, 1.0], [0.3, 0.0, 0.5]])
+    >>> carried_by_the_bone(np.array([[0.0, -0.1, 0.0], [0.0, 0.0, 0.0]]), pos, np.zeros(3), 0).round(3)
+    array([[ 0.   , -0.1  ,  0.   ],
+           [ 0.   , -0.05 ,  0.002]])
+    """
+    positions = np.asarray(positions, np.float64)
+    angle = float(turning_angles(offsets[reference:reference + 1], positions[reference:reference + 1], hinge)[0])
+    radial = positions[:, 1:] - np.asarray(hinge, np.float64)[1:]
+    c, s = math.cos(angle), math.sin(angle)
+    turned = np.stack([radial[:, 0] * c - radial[:, 1] * s, radial[:, 0] * s + radial[:, 1] * c], axis=1) - radial
+    shift = np.asarray(offsets[reference], np.float64)[1:] - turned[reference]
+    out = np.zeros_like(positions)
+    out[:, 1:] = turned + shift
+    return out
+
+
 def mandible_share(heights: np.ndarray, lip_line: float, band: tuple[float, float]) -> np.ndarray:
     """How much of the jaw target's motion each skin point of height ``heights`` (N,) keeps: all of it
     ``band[0]`` (dm) or more below ``lip_line`` (the lip corners' height), none ``band[1]`` or more above
@@ -304,14 +327,34 @@ class RegisterEngine:
         skin = self.head.skin_vertex_count
         marks = landmarks(self.head)
         out = np.array(offsets, copy=True)
-        out[:skin] = turn_no_further_than(offsets[:skin], positions[:skin], self.head.joint(self.base_positions, spec["hinge"]),
-                                          marks[spec["reference"]])
+        hinge = self.head.joint(self.base_positions, spec["hinge"])
+        out[:skin] = turn_no_further_than(offsets[:skin], positions[:skin], hinge, marks[spec["reference"]])
+        bone = spec.get("rigid")
+        if bone:
+            share = self._on_the_bone(bone)
+            carried = carried_by_the_bone(out[:skin], positions[:skin], hinge, marks[spec["reference"]])
+            out[:skin] += share[:, None].astype(out.dtype) * (carried - out[:skin])
         held = spec.get("maxilla")
         if held:
             lip_line = float(np.mean([positions[marks[f"{held['lip_line']}_{side}"], 1] for side in ("left", "right")]))
             band = (float(held["free_below_mm"]) / 100.0, float(held["held_above_mm"]) / 100.0)
             out[:skin] *= mandible_share(positions[:skin, 1], lip_line, band)[:, None].astype(out.dtype)
         return out
+
+    def _on_the_bone(self, spec: Mapping) -> np.ndarray:
+        """How much of each skin point (N_skin,) moves rigidly with the mandible: the muscle engine's
+        jaw attachment (:func:`~facsim.engines.muscle.net.anatomy`), less the lips and the mouth's lining,
+        which stretch over the teeth and keep the target's own motion."""
+        from facsim.engines.muscle.net import MOUTH, adjacency, anatomy, mask_per_vertex, smooth_field
+
+        anat = anatomy(self.head)
+        lips = mask_per_vertex(self.head, "lips")[: anat.skin_count]
+        lips = np.maximum(lips, lips[anat.mirror[: anat.skin_count]])
+        free = (anat.kind == MOUTH) | (lips > float(spec["lip_mask"]))
+        share = np.where(free, 0.0, anat.jaw_weight)
+        share = smooth_field(share, adjacency(anat.edges, anat.skin_count), int(spec["smoothing_passes"]))
+        share[free] = 0.0
+        return share.astype(np.float32)
 
     def _near_the_corner(self, offsets: np.ndarray, side: str, reach: Mapping[str, float]) -> np.ndarray:
         """A lip-corner target's ``offsets`` (N_base_geo, 3) kept in full within ``reach["full_mm"]`` of the
