@@ -175,19 +175,27 @@ def test_smile_lifts_the_corners_not_the_lower_lip(single, marks):
     assert delta[marks["lower_lip"], Y] < 0.4 * corner
 
 
-def test_smile_draws_the_corners_up_and_out(single, marks):
+#: Minimiser iterations per increment at which the checks below are settled. The static solve's
+#: 60 stop short, and where they stop depends on the batch: on session 21's main, noah's corner
+#: went 8.7 mm out in 12 and 6 after 12 lifted it 0.9 mm more in one batch (both checks failed),
+#: 10.3 and 0.3 in another, 11.1 and 0.07 settled (200 and 600 iterations alike).
+SETTLED = 200
+
+
+def test_smile_draws_the_corners_up_and_out(engine, marks):
     """FACS 12 pulls the lip corners up and out, obliquely toward the cheekbone (session 21: over
     a pulley above the corner, noah's corner went 7.9 mm out and 17.9 up, a narrow smile)."""
-    solved, neutral = single
+    neutral, smile = engine.solve_many([Activations(), activations(parse("12"))], iterations=SETTLED)
     corner = marks["lip_corner_left"]
-    moved = solved[12][corner] - neutral[corner]
+    moved = smile[corner] - neutral[corner]
     assert moved[Y] > 0.1 and moved[X] > 0.095                 # up 10 mm, out 9.5 mm at least
 
 
 def test_masking_cheek_raiser_after_smile_lifts_the_corner_less(engine, marks):
     corner = marks["lip_corner_left"]
     neutral, six, twelve, both = engine.solve_many(
-        [Activations(), activations(parse("6")), activations(parse("12")), activations(parse("12+6"))])
+        [Activations(), activations(parse("6")), activations(parse("12")), activations(parse("12+6"))],
+        iterations=SETTLED)
     alone = six[corner, Y] - neutral[corner, Y]
     after = both[corner, Y] - twelve[corner, Y]
     assert alone > MOVES  # the cheek raiser lifts the corner ...
@@ -303,3 +311,18 @@ def test_fear_draws_the_raised_brows_together_and_straightens_them(engine, marks
     outer = 0.5 * (got[marks["outer_brow_left"], 1] + got[marks["outer_brow_right"], 1])
     assert inner > 0.02 and outer > 0.02                         # both raised 2 mm at least
     assert abs(outer - inner) < 0.04                             # straightened: no slant of 4 mm
+
+
+def test_cheek_raiser_leaves_the_nose_unwrinkled(engine, marks):
+    """Issue 13: AU 6 raises the cheeks and bags the skin under the eyes; the nose wrinkles in 9,
+    not in 6. On session 21's main the orbital ring's medial ends lay on the nasal sidewalls and 6
+    pinched the nose into ridges and lines (creases there 1.2 times 9's on noah, now 0.46): every
+    smile (6+12+25) wore disgust's nose and the panel read it as neutral 4-5 times in 6."""
+    rest = engine.neutral
+    glabella, tip = rest[marks["glabella"]], rest[marks["nose_tip"]]
+    nose = np.flatnonzero((np.abs(rest[:, 0]) < 0.13) & (rest[:, 1] > tip[1]) & (rest[:, 1] < glabella[1])
+                          & (rest[:, 2] > tip[2] - 0.35))
+    cheek_raiser, nose_wrinkler = (engine.deform(activations(parse(code))) for code in ("6", "9"))
+    assert cheek_raiser.wrinkle[nose].mean() < 0.6 * nose_wrinkler.wrinkle[nose].mean()
+    lifted = cheek_raiser.positions - rest
+    assert lifted[marks["cheek_left"], 1] > 0.03          # and the cheek still rises 3 mm
