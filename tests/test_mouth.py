@@ -522,3 +522,18 @@ def test_stretched_closed_lips_stay_closed(face_of):
     face = face_of("ava")
     assert mouth_shape(face, "20").gap - mouth_shape(face, "0").gap < 1.0
     assert mouth_shape(face, "20+25").gap - mouth_shape(face, "0").gap > 5.0
+
+
+def test_a_raised_upper_lip_bares_the_gum_between_the_upper_crowns(face_of):
+    # Natural upper centrals are ~10.5 mm from the edge to the gum's zenith, the papillae between
+    # them reaching ~7 mm from the edge: an upper lip raised by 10 shows their pink tips. (At
+    # 13 mm no expression reached the gum: "no gums in broad smiles".)
+    image, teeth = _part_render(face_of("ava"), "10+25", 512, "teeth")
+    columns = np.flatnonzero(teeth.any(axis=0))
+    middle, width = 0.5 * (columns[0] + columns[-1]), columns[-1] - columns[0]
+    rim = teeth.copy()
+    rim[:, : int(middle - 0.2 * width)] = False
+    rim[:, int(middle + 0.2 * width):] = False
+    rim[np.flatnonzero(rim.any(axis=1))[0] + 4:] = False    # 4 px under the upper lip's edge
+    red, green, _ = image[rim].T
+    assert ((red - green) > 35).sum() >= 3                       # pink, not ivory (r - g ~ 16)

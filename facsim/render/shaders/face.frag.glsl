@@ -452,7 +452,7 @@ const float DEEP_TEETH_LIGHT = 0.04;
 // "inserted" in the face. In photographs the teeth in the mouth are about as light as the
 // lit skin beside it.
 const float TEETH_AMBIENT = 0.75;
-const float ENAMEL_GLOW = 0.1;
+const float ENAMEL_GLOW = 0.08;
 // What light reaches the enamel inside the mouth has partly bounced off the lips, gums and
 // tongue: warm. (Dimmed without it, the crowns turned grey, not ivory: C* ~11 at L* ~73.)
 const vec3 INSIDE_WARMTH = vec3(1.0, 0.96, 0.88);
@@ -460,24 +460,38 @@ const vec3 INSIDE_WARMTH = vec3(1.0, 0.96, 0.88);
 // (0.65 drew the upper laterals and canines, whose edges are cut back, as grey-blue slabs).
 const float INCISAL_TRANSLUCENCY = 0.4;
 const vec3 DEEP_TEETH_BOUNCE = vec3(1.0, 0.42, 0.38);
+// Natural teeth differ: each crown's value by up to TOOTH_SHADE_SPREAD.x (a quarter of it brighter
+// or darker than the albedo) and its yellowing toward TOOTH_YELLOW by up to TOOTH_SHADE_SPREAD.y;
+// toward the gum the dentin shows through the thinner enamel (TOOTH_CERVICAL, at the neck).
+const vec2 TOOTH_SHADE_SPREAD = vec2(0.16, 0.7);
+const vec3 TOOTH_YELLOW = vec3(1.0, 0.95, 0.84);
+const vec3 TOOTH_CERVICAL = vec3(0.97, 0.87, 0.7);
+// Where the gum begins on each crown's outer wall (band units up from the biting edge): upper row
+// between the crowns (the papillae's tips), at mid-crown (the zenith); lower row the same.
+const vec4 GUM_LINE = vec4(0.45, 0.65, 0.4, 0.56);
 // Where two crowns touch they leave a soft shadow (an embrasure) ``to_gap`` (dm) from the
 // contact, darkest at the biting edge where they part and a thin shade up the crowns to the
 // gum (``h``, band units up the outer wall) - never a dark line, which read as braces; faded
 // to a faint mean where it would be finer than a pixel (``aa``, dm per pixel). The lower
 // row's edges stay light: seen from above, their embrasures read as dark specks.
-// The crown's normal tilted by its bulge's surface gradient ``grad`` (``det`` the screen
-// frame's determinant), by at most ~27 degrees: where a pixel quad straddles the band's fold
-// at the biting edge the gradient spikes, and the normal turned from the light drew the lower
-// row's edge and crowns with dark specks.
-vec3 crown_normal(vec3 n, float det, vec3 grad) {
-    float most = 0.5 * abs(det);
-    float size = length(grad);
-    return normalize(abs(det) * n - grad * min(1.0, most / max(size, 1e-12)));
+// The crown's normal ``n`` tilted by its bulge's ``slope`` (its height's rate of change along the
+// arch, away from the midline) toward ``along`` (the arch's direction there). The slope is the
+// bulge's own derivative and the direction is taken from the smooth normal, so the tilt is as
+// smooth as they are: from screen derivatives of the bulge, constant over each of hm08's coarse
+// triangles, the crowns were shaded in flat facets (issue 13: "teeth look inserted"), and where a
+// pixel quad straddled the band's fold at the biting edge the gradient spiked into dark specks.
+vec3 crown_normal(vec3 n, vec3 along, float slope) {
+    vec3 t = normalize(cross(vec3(0.0, 1.0, 0.0), n) + vec3(1e-6, 0.0, 0.0));
+    t *= sign(dot(t, along) + 1e-12);
+    return normalize(n - slope * t);
 }
+// (EMBRASURE_SHADE 0.35, up the crowns 0.6 of it: the crowns ran together into one strip; the
+// lower row's, seen from above, keep less up the crowns or the row reads as a grille.)
+const float EMBRASURE_SHADE = 0.5;
 float embrasure_shade(float to_gap, float aa, float h, float lower) {
     float at_edge = mix(1.0, 0.5, lower);
-    return 0.35 * (1.0 - smoothstep(0.0, aa + 0.006, to_gap)) * clamp(1.5 - 120.0 * aa, 0.3, 1.0)
-         * mix(at_edge, 0.6, smoothstep(0.04, 0.25, h));
+    return EMBRASURE_SHADE * (1.0 - smoothstep(0.0, aa + 0.008, to_gap)) * clamp(1.5 - 120.0 * aa, 0.3, 1.0)
+         * mix(at_edge, mix(0.75, 0.4, lower), smoothstep(0.04, 0.25, h));
 }
 #endif
 #if defined(ONE_ALBEDO) || defined(REGION_MOUTH_INTERIOR) || defined(REGION_LASHES) || defined(REGION_GARMENT)
@@ -1087,11 +1101,14 @@ void main() {
     float gap_aa = fwidth(arc);
     float to_gap = min(arc - b0, b1 - arc);
     float convex = 1.0 + CROWN_ROUNDING * (1.0 / 3.0 - side * side);
-    float gap = 1.0 - embrasure_shade(to_gap, gap_aa, h, lower);
+    float gap = shaped ? 1.0 - embrasure_shade(to_gap, gap_aa, h, lower) : 1.0;
     // Scalloped gum line, arched rootward over each crown (crowns ~10 mm of the band's 16),
     // papillae reaching toward the biting edge between crowns. A smile rarely shows it;
     // where it shows it is pink, lit like the teeth (no dark band under the lip).
-    float gum_edge = mix(0.66, 0.58, lower) + mix(0.16, 0.14, lower) * sin(PI * w);
+    // GUM_LINE: (papillae, zenith) in band units (~16 mm): the zenith ~10.5 mm above the upper
+    // central's edge, ~9 mm above the lower's, as on natural crowns. (At 0.82, ~13 mm, the crowns
+    // were too long for any smile to reach the gum: issue 13, "no gums in broad smiles".)
+    float gum_edge = mix(GUM_LINE.x, GUM_LINE.z, lower) + mix(GUM_LINE.y - GUM_LINE.x, GUM_LINE.w - GUM_LINE.z, lower) * sin(PI * w);
     // (Labial side only: the lingual gum lies deep in the arch's shade, and drawn pink it
     // showed as red dots between the lower crowns when 16 bared them.)
     float gum = smoothstep(gum_edge - 0.025, gum_edge + 0.025, h);
@@ -1100,17 +1117,22 @@ void main() {
     // where dentin shows through; at the biting edge the enamel holds no dentin and lets the
     // light through: a translucent blue-grey band (~1.5 mm) under a thin bright rim (the
     // incisal halo, light caught in the edge), as in photographs of teeth.
+    // (Per tooth: its value, its yellowing and how translucent its edge is, each from its own
+    // hash; TOOTH_SHADE_SPREAD. Within 0.92-1.04 and one hue the row read as a uniform strip.)
     float tooth_id = float(kind) + 7.0 * step(0.0, v_uv.x) + 14.0 * lower;
     float vary = hash2(ivec2(int(tooth_id), 29));
-    vec3 enamel = u_albedo * (0.92 + 0.12 * vary) * mix(vec3(1.0), vec3(1.0, 0.97, 0.9), float(kind == 2));
+    float yellowing = hash2(ivec2(int(tooth_id), 41));
+    vec3 enamel = u_albedo * (1.0 + TOOTH_SHADE_SPREAD.x * (vary - 0.75))
+                * mix(vec3(1.0), TOOTH_YELLOW, TOOTH_SHADE_SPREAD.y * yellowing + 0.35 * float(kind == 2));
     float streak = value_noise(vec2(v_uv.x * 140.0, max(h, lingual) * 5.0), 0);
     enamel *= 0.96 + 0.08 * mix(0.5, streak, clamp(1.5 - 20.0 * fwidth(v_uv.x), 0.0, 1.0));
     float edge_h = max(h, lingual) - notch;                 // band units above the edge
     float incisal = (1.0 - smoothstep(0.025, 0.1, edge_h)) * (kind <= 2 ? 1.0 : 0.5) * mix(1.0, 0.6, lower);
-    enamel = mix(enamel, dot(u_albedo, vec3(0.33)) * vec3(0.86, 0.92, 1.0), INCISAL_TRANSLUCENCY * incisal);
+    float translucent = INCISAL_TRANSLUCENCY * (0.6 + 0.8 * hash2(ivec2(int(tooth_id), 53)));
+    enamel = mix(enamel, dot(u_albedo, vec3(0.33)) * vec3(0.86, 0.92, 1.0), translucent * incisal);
     float halo_w = max(0.012, fwidth(edge_h));
     enamel *= 1.0 + 0.22 * exp(-edge_h * edge_h / (halo_w * halo_w)) * (0.012 / halo_w) * float(shaped);
-    enamel *= mix(vec3(1.0), vec3(1.0, 0.93, 0.8), smoothstep(0.3, gum_edge, h));
+    enamel *= mix(vec3(1.0), TOOTH_CERVICAL, smoothstep(0.25, gum_edge, h));   // dentin at the neck
     vec3 gums = vec3(0.62, 0.27, 0.28) * (0.92 + 0.16 * value_noise(v_uv * vec2(60.0, 8.0), 0));
     vec3 albedo = mix(enamel * gap * convex, gums, gum);
     // The lingual slope is enamel only near the biting edge (the crowns' inner faces, ~4 mm);
@@ -1123,11 +1145,10 @@ void main() {
     // Each crown bulges (~1 mm over its width): its normal turns across it (a surface
     // gradient from screen derivatives, as on the skin), so the key lays a soft highlight
     // down each crown and its flanks turn into shade: separate teeth, not a flat strip.
+    // (A bulge of (b1 - b0) / 8 (~1 mm) times 1 - (2w - 1)^2 across the crown: slope -0.5 (2w - 1).)
     vec3 dpdx = dFdx(v_pos), dpdy = dFdy(v_pos);
-    vec3 r1 = cross(dpdy, n), r2 = cross(n, dpdx);
-    float det = dot(dpdx, r1);
-    float bulge_h = 0.01 * (b1 - b0) / 0.08 * (1.0 - (2.0 * w - 1.0) * (2.0 * w - 1.0)) * (1.0 - gum);
-    n = crown_normal(n, det, sign(det) * (dFdx(bulge_h) * r1 + dFdy(bulge_h) * r2));
+    vec3 along = sign(dot(dpdx, cross(dpdy, n))) * (dFdx(arc) * cross(dpdy, n) + dFdy(arc) * cross(n, dpdx));
+    n = crown_normal(n, along, -0.5 * (2.0 * w - 1.0) * (1.0 - gum) * float(shaped));
     // Light inside the mouth falls off with depth: the front teeth catch it, the back ones sit
     // in the shadow of the cheeks (the dark buccal corridor). The upper lip casts a soft
     // contact shadow just under its edge: v_occlusion is the fragment's height (dm) below
