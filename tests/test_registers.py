@@ -508,9 +508,10 @@ def test_a_character_s_natural_asymmetry_moves_one_side_more(face_of):
 def test_a_half_smile_narrows_the_eye_from_below(engine, marks):
     """Session 15 (half smiles read as surprise or neutral by FER2013 4 times in 6): 6 raises the
     cheek and pushes the lower lid up, narrowing the eye from below, not by lowering the upper
-    lid; at half intensity (6+12+25 at 50 %) the lower lid still rises over 2 mm."""
+    lid; at half intensity (6+12+25 at 50 %) the lower lid still rises over 1.5 mm (2.4 until session
+    22, whose fit of 6's lower lid to the eye's aperture, ``lids.yaml`` ``squint``, leaves noah 1.9)."""
     half = _emotion_moved(engine, "happiness", 0.5)
-    assert half[marks["lower_lid_left"], 1] > 0.02
+    assert half[marks["lower_lid_left"], 1] > 0.015
     assert abs(half[marks["upper_lid_left"], 1]) < 0.005
 
 
