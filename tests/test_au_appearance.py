@@ -113,7 +113,9 @@ def test_1_2_raise_the_brows_with_horizontal_forehead_lines(solved, marks, rest)
 def test_smiles_lift_the_corners_up_and_out_with_crows_feet_in_6_12(solved, corner, rest):
     name = solved[0]
     d = _moved(solved, "12")
-    assert d[corner, Y] > 0.12 and d[corner, X] > 0.04        # ≥ 12 mm up, ≥ 4 mm out, in both engines
+    # ≥ 9 mm up, ≥ 3 mm out, in both engines (a maximal smile moves the corner 10-14 mm in all,
+    # more up and back than out; the register engine's moved it 20 mm until session 22)
+    assert d[corner, Y] > 0.09 and d[corner, X] > 0.03
     assert _creases(solved, "6+12", rest, CROWS_FEET) > 0.3, name
 
 

@@ -280,6 +280,32 @@ def raise_gain(lids: EyeLids, rest: np.ndarray, raising: np.ndarray, radius: flo
     return float(np.clip((iris_top + bare * mm - height) / lift, low, high))
 
 
+def squint_gain(lids: EyeLids, rest: np.ndarray, lifting: np.ndarray, squint: np.ndarray, spec: dict) -> float:
+    """The factor on AU 6's lower-lid target that leaves this eye ``open_share`` of its aperture at 6E.
+
+    The aperture is the upper margin's height over the pupil less the lower margin's (as in
+    :func:`rest_lid_weight`) on the relaxed skin ``rest`` (N, 3); at E AU 6's other targets
+    (``lifting``, (N, 3)) and its lower-lid target ``squint`` (N, 3, at its maximum) times the
+    factor close it. Heights change linearly with the factor, so it is solved directly and clipped
+    to ``spec["gain"]`` (``lids.yaml``, ``squint``). 1 where the eye has no margins to measure.
+    """
+    if not lids.ok:
+        return 1.0
+    ahead = float(rest_table()["ahead_degrees"])
+    upper, top = _margin_over_pupil(lids, rest, ahead)
+    lower, bottom = _margin_over_pupil(lids, rest, ahead, lower=True)
+
+    def closing(offsets):
+        return float(np.mean(offsets[lower, 1]) - np.mean(offsets[upper, 1]))
+
+    per_unit = closing(squint)
+    if per_unit <= 1e-9:
+        return 1.0
+    low, high = (float(g) for g in spec["gain"])
+    allowed = (1.0 - float(spec["open_share"])) * (top - bottom) - closing(lifting)
+    return float(np.clip(allowed / per_unit, low, high))
+
+
 def bare_mm(cover_mm: float, spec: dict) -> float:
     """How high (iris-mm) AU 5 at E lifts the upper margin over the iris's top, for a lid whose
     sculpted margin covers ``cover_mm`` of the iris: ``spec["bare_mm"]``, rising to

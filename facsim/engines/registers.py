@@ -440,6 +440,29 @@ class RegisterEngine:
         return {(code, pattern): float(np.mean(shares)) / vmax}
 
     @cached_property
+    def squint(self) -> dict[tuple[int, str], float]:
+        """AU 6's lower-lid target fitted to the character (``lids.yaml`` ``squint``): the factor
+        (the mean of both eyes, :func:`~facsim.engines.lids.squint_gain`) that leaves the relaxed
+        eye ``open_share`` of its aperture at 6E, so a small or hooded eye is narrowed, not shut."""
+        from facsim.engines.lids import squint_gain
+
+        spec = load_yaml("lids.yaml")["squint"]
+        code, pattern = int(spec["au"]), spec["target"]
+        skin = self.head.skin_vertex_count
+        relaxed = self.sculpted[:skin] + self.rest_lids.offsets(Activations(), skin)
+        gains = []
+        for side in ("left", "right"):
+            lifting, squint = np.zeros_like(relaxed), np.zeros_like(relaxed)
+            for reg in register_table()["action_units"][code]["registers"]:
+                offsets = float(reg["max"]) * self.column(Column(reg["target"], side))[:skin]
+                if reg["target"] == pattern:
+                    squint += offsets
+                else:
+                    lifting += offsets
+            gains.append(squint_gain(self.lids["faceunits/eyeBlink{Side}", side], relaxed, lifting, squint, spec))
+        return {(code, pattern): float(np.mean(gains))}
+
+    @cached_property
     def neutral(self) -> np.ndarray:
         """The face at rest (N_geo, 3): the sculpted face with relaxed lids."""
         return self.deform(Activations()).positions
@@ -447,13 +470,13 @@ class RegisterEngine:
     def weights(self, act: Activations) -> dict[Column, float]:
         """Column weights of ``act`` (Eq. 1), each side's by the character's gain there (its natural
         asymmetry) and AU 5's lid-raising targets by :attr:`lid_raise`, AU 4's push on the lid
-        fitted (:attr:`brow_push`), plus the relaxed lids' shares of the closing and the lower lid's targets."""
+        fitted (:attr:`brow_push`) and AU 6's lower lid (:attr:`squint`), plus the relaxed lids' shares of the closing and the lower lid's targets."""
         from facsim.engines.lids import rest_table
 
         raising, raise_gain = self.lid_raise
         weights = {col: w * (1.0 if col.pattern in BONE_TARGETS else self.side_gain[col.side])
                    * (raise_gain if col.pattern in raising else 1.0)
-                   for col, w in register_weights(act, self.brow_push).items()}
+                   for col, w in register_weights(act, {**self.brow_push, **self.squint}).items()}
         for side in ("left", "right"):
             for pattern, share in ((rest_table()["target"], self.rest_lids.share(act, side)),
                                    (rest_table()["lower"]["target"], self.rest_lids.lower_share(act, side))):
