@@ -77,12 +77,13 @@ def test_a_character_model_is_built_once_and_shared(face_of):
 def test_batched_solves_equal_single_ones(engine):
     """A batch solves each expression as it would alone, up to round-off: the batch's width
     changes the last bits of the sparse solves, and 60 L-BFGS iterations can carry them to
-    0.14 mm (15 on the symmetric ava; hm08 units are decimetres), under half a pixel at 512².
-    Each solve is still repeatable: the same batch gives the same bits."""
+    0.25 mm (15 on the symmetric ava since session 22's corrugator and orbicularis changes; hm08
+    units are decimetres), half a pixel at 512². Each solve is still repeatable: the same batch
+    gives the same bits."""
     acts = [activations(parse(t)) for t in ("1", "15", "26")]
     together = engine.solve_many(acts)
     for act, batched in zip(acts, together):
-        assert np.abs(engine.deform(act).positions - batched).max() < 2e-3
+        assert np.abs(engine.deform(act).positions - batched).max() < 3e-3
 
 
 def test_jaw_statics(model):

@@ -470,7 +470,8 @@ class RegisterEngine:
     def weights(self, act: Activations) -> dict[Column, float]:
         """Column weights of ``act`` (Eq. 1), each side's by the character's gain there (its natural
         asymmetry) and AU 5's lid-raising targets by :attr:`lid_raise`, AU 4's push on the lid
-        fitted (:attr:`brow_push`) and AU 6's lower lid (:attr:`squint`), plus the relaxed lids' shares of the closing and the lower lid's targets."""
+        fitted (:attr:`brow_push`) and AU 6's lower lid (:attr:`squint`), plus the relaxed lids' shares of
+        the closing and the lower lid's targets."""
         from facsim.engines.lids import rest_table
 
         raising, raise_gain = self.lid_raise
