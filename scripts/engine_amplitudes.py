@@ -83,14 +83,14 @@ def amplitudes(face, expression) -> dict[str, float]:
         "naso": rise("nasolabial_fold"),
         "protr": shape.protrusion,
         "teeth": MM * (p[gauge.upper_lip, 1] - p[gauge.incisor_edge, 1]),
-        "bone": MM * off_the_bone(face, p, marks),
+        "bone": MM * float(off_the_bone(face, p, marks)[1].mean()),
     }
 
 
-def off_the_bone(face, positions, marks) -> float:
-    """Mean distance (dm) of the skin over the mandible's body (the muscle engine's jaw attachment,
-    12 mm or more below the lip corners) from where a rigid turn of the chin about the jaw's hinge,
-    with the chin's own shift, would take it."""
+def off_the_bone(face, positions, marks) -> tuple[float, np.ndarray]:
+    """The chin's turn (radians) about the jaw's hinge, and the distance (dm) of each point of the
+    skin over the mandible's body (the muscle engine's jaw attachment, 12 mm or more below the lip
+    corners) from where that rigid turn, with the chin's own shift, would take it."""
     from facsim.engines.muscle.net import OUTER, anatomy
 
     anat = anatomy(face.head)
@@ -107,7 +107,7 @@ def off_the_bone(face, positions, marks) -> float:
     turned = np.stack([radial[:, 0] * np.cos(angle) - radial[:, 1] * np.sin(angle),
                        radial[:, 0] * np.sin(angle) + radial[:, 1] * np.cos(angle)], axis=1) + hinge
     turned += moved[chin, 1:] - turned[chin]
-    return float(np.linalg.norm(moved[on_the_bone, 1:] - turned[on_the_bone], axis=1).mean())
+    return float(angle), np.linalg.norm(moved[on_the_bone, 1:] - turned[on_the_bone], axis=1)
 
 
 def main(argv=None) -> None:

@@ -684,25 +684,15 @@ def test_the_skin_over_the_mandible_turns_with_the_bone(face_of, marks, characte
     (george's fear at 100 % rated 1 of 5, "warped lower face", a blind reviewer). Measured against the
     chin's own turn and shift, over the muscle engine's jaw attachment 12 mm or more below the lip corners:
     main's mean was 5.6-6.0 mm (26E) and 8.3-9.0 (27E), its 95th percentile 15-21 mm."""
-    from facsim.engines.muscle.net import OUTER, anatomy
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts"))
+    from engine_amplitudes import off_the_bone
 
     face = face_of(character)
-    anat = anatomy(face.head)
-    count = anat.skin_count
-    rest = np.asarray(face.neutral, np.float64)[:count]
-    hinge = np.asarray(face.head.joint(face.engine.base_positions, "joint-mouth"), np.float64)[1:]
-    corners = np.mean([rest[marks[f"lip_corner_{side}"], 1] for side in ("left", "right")])
-    on_the_bone = (anat.jaw_weight > 0.99) & (anat.kind == OUTER) & (rest[:, 1] < corners - 0.12)
-    chin = marks["chin"]
     for text in ("26E", "27E"):
-        moved = np.asarray(face.deform(text).positions, np.float64)[:count]
-        before, after = rest[chin, 1:] - hinge, moved[chin, 1:] - hinge
-        angle = np.arctan2(before[0], before[1]) - np.arctan2(after[0], after[1])
-        radial = rest[:, 1:] - hinge
-        turned = np.stack([radial[:, 0] * np.cos(angle) - radial[:, 1] * np.sin(angle),
-                           radial[:, 0] * np.sin(angle) + radial[:, 1] * np.cos(angle)], axis=1) + hinge
-        turned += moved[chin, 1:] - turned[chin]
-        off = np.linalg.norm(moved[on_the_bone, 1:] - turned[on_the_bone], axis=1)
+        angle, off = off_the_bone(face, face.deform(text).positions, marks)
         assert angle > np.radians(10), text
         assert off.mean() < 0.04 and np.percentile(off, 95) < 0.10, (text, off.mean(), np.percentile(off, 95))
 

@@ -320,20 +320,26 @@ def _scalp_alpha(face, size: int) -> np.ndarray:
     return image[..., 3].astype(np.float32) / 255.0
 
 
+def _hairline_band(alpha: np.ndarray, blur: float) -> np.ndarray:
+    """The hairline's band in the scalp layer's cover ``alpha``: in front (the image's upper middle)
+    where the cover blurred over ``blur`` pixels is 0.1-0.6, between bare skin and solid hair."""
+    from scipy.ndimage import gaussian_filter
+
+    h = alpha.shape[0]
+    front = np.zeros_like(alpha, bool)
+    front[int(0.1 * h):int(0.45 * h), int(0.25 * h):int(0.75 * h)] = True
+    blurred = gaussian_filter(alpha, blur)
+    return front & (blurred > 0.1) & (blurred < 0.6)
+
+
 def test_a_hairline_at_stimulus_size_thins_into_streaks_not_a_film(face_of):
     """At 448² the scalp layer's tufts are finer than a pixel; drawn as their mean cover they
     lay along the hairline as an even translucent film of the hair's colour (a brim under the
     cards, blind review session 20: "helmet"). Strands and clumps a few pixels across along
     the flow take their place, with skin between them: over liam's hairline band (where the
     layer's blurred cover is 0.1-0.6, in front) the share of bare pixels was 0.235, now 0.32."""
-    from scipy.ndimage import gaussian_filter
-
     alpha = _scalp_alpha(face_of("liam"), 448)
-    h = alpha.shape[0]
-    front = np.zeros_like(alpha, bool)
-    front[int(0.1 * h):int(0.45 * h), int(0.25 * h):int(0.75 * h)] = True
-    blurred = gaussian_filter(alpha, 3)
-    band = front & (blurred > 0.1) & (blurred < 0.6)
+    band = _hairline_band(alpha, blur=3)
     assert band.sum() > 2000
     assert (alpha[band] < 0.05).mean() > 0.28
 
@@ -344,13 +350,7 @@ def test_a_grey_hairline_at_1024_is_strands_not_a_translucent_film(face_of):
     (blind review, session 21); now a tuft's cover is the share of strands a few pixels across
     there, each solid. Over george's hairline band (the layer's blurred cover 0.1-0.6, in
     front) the share of translucent pixels (cover 0.05-0.5) was 0.23 at 1024², now 0.14."""
-    from scipy.ndimage import gaussian_filter
-
     alpha = _scalp_alpha(face_of("george"), 1024)
-    h = alpha.shape[0]
-    front = np.zeros_like(alpha, bool)
-    front[int(0.1 * h):int(0.45 * h), int(0.25 * h):int(0.75 * h)] = True
-    blurred = gaussian_filter(alpha, 7)
-    band = front & (blurred > 0.1) & (blurred < 0.6)
+    band = _hairline_band(alpha, blur=7)
     assert band.sum() > 10000
     assert ((alpha[band] >= 0.05) & (alpha[band] < 0.5)).mean() < 0.19

@@ -48,10 +48,9 @@ def test_a_plane_has_no_curvature_however_fine_its_mesh():
     assert np.abs(curvature).max() < 1e-4
 
 
-def render_sphere(radius: float, *, oil: int = 90, key=(-0.9, 0.0, 0.45), seed: float = 0.0):
-    """A skin sphere of ``radius`` (dm) filling a 96² image, lit by the key only from the side
-    (camera left), with a uniform oil map (detail.b; 90 = the cheeks' 0.35, 255 = the T-zone's)."""
-    points, faces = sphere()
+def _render_skin_sphere(points, faces, radius: float, appearance, *, key, size: int) -> np.ndarray:
+    """A skin sphere (unit ``points``, ``faces``) of ``radius`` (dm) filling a ``size``² image, lit by
+    the key only, with ``appearance``: the rendered RGBA."""
     p = (points * radius).astype(np.float32)
     # (Texture coordinates at a face's scale, hm08's 3.5 dm per u and 7 per v, projected from the
     # front: the skin's noise and pores vary over the sphere as over a face, not one arbitrary value.)
@@ -59,14 +58,21 @@ def render_sphere(radius: float, *, oil: int = 90, key=(-0.9, 0.0, 0.45), seed: 
                               uv=(0.5 + p[:, :2] / np.array([3.5, 7.0])).astype(np.float32),
                               region=np.full(len(p), REGIONS.index("skin"), np.uint8),
                               eye_coord=np.zeros((len(p), 3), np.float32))
-    detail = np.zeros((4, 4, 4), np.uint8)
-    detail[..., 2] = oil
-    appearance = Appearance(DEFAULT_COLORS, detail=detail, seed=seed)
     lighting = Lighting(key_direction=key, fill_color=(0, 0, 0), rim_color=(0, 0, 0), sky=(0.02, 0.02, 0.02),
                         ground=(0.02, 0.02, 0.02))
     camera = frame_camera(-radius * np.ones(3), radius * np.ones(3), view="front", projection="orthographic")
-    with Renderer(topology, size=96, antialias=1, shadows=False) as renderer:
-        return renderer.render(p, appearance=appearance, camera=camera, lighting=lighting).astype(float)
+    with Renderer(topology, size=size, antialias=1, shadows=False) as renderer:
+        return renderer.render(p, appearance=appearance, camera=camera, lighting=lighting)
+
+
+def render_sphere(radius: float, *, oil: int = 90, key=(-0.9, 0.0, 0.45), seed: float = 0.0):
+    """A skin sphere of ``radius`` (dm) filling a 96² image, lit by the key only from the side
+    (camera left), with a uniform oil map (detail.b; 90 = the cheeks' 0.35, 255 = the T-zone's)."""
+    points, faces = sphere()
+    detail = np.zeros((4, 4, 4), np.uint8)
+    detail[..., 2] = oil
+    appearance = Appearance(DEFAULT_COLORS, detail=detail, seed=seed)
+    return _render_skin_sphere(points, faces, radius, appearance, key=key, size=96).astype(float)
 
 
 def test_light_wraps_further_past_the_terminator_on_a_tightly_curved_surface():
@@ -207,22 +213,12 @@ def render_lip_sphere(size: int = 192, key=(-0.3, 0.3, 0.9)):
     hm08's face scale, filling a ``size``² image, lit by a key near the camera: its luminance
     (linear) and the disc's pixels."""
     points, faces = sphere(60, 90)
-    radius = 0.05
-    p = (points * radius).astype(np.float32)
-    topology = RenderTopology(faces=faces, render_to_geo=np.arange(len(p)),
-                              uv=(0.5 + p[:, :2] / np.array([3.5, 7.0])).astype(np.float32),
-                              region=np.full(len(p), REGIONS.index("skin"), np.uint8),
-                              eye_coord=np.zeros((len(p), 3), np.float32))
     paint = np.zeros((4, 4, 4), np.uint8)
     paint[..., 1] = 255
     detail = np.zeros((4, 4, 4), np.uint8)
     detail[..., 2] = 90
-    lighting = Lighting(key_direction=key, fill_color=(0, 0, 0), rim_color=(0, 0, 0), sky=(0.02, 0.02, 0.02),
-                        ground=(0.02, 0.02, 0.02))
-    camera = frame_camera(-radius * np.ones(3), radius * np.ones(3), view="front", projection="orthographic")
-    with Renderer(topology, size=size, antialias=1, shadows=False) as renderer:
-        image = renderer.render(p, appearance=Appearance(DEFAULT_COLORS, paint=paint, detail=detail),
-                                camera=camera, lighting=lighting)
+    image = _render_skin_sphere(points, faces, 0.05, Appearance(DEFAULT_COLORS, paint=paint, detail=detail),
+                                key=key, size=size)
     c = image[..., :3].astype(float) / 255
     luminance = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4) @ np.array([0.2126, 0.7152, 0.0722])
     y, x = np.mgrid[:size, :size] + 0.5 - size / 2

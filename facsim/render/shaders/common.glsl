@@ -89,6 +89,12 @@ vec3 value_noise_grad(vec2 p) {
                 du.x * (b - a + k * u.y), du.y * (c - a + k * u.x));
 }
 
+// The slope of smoothstep(e0, e1, x) in x: a bump shaped by smoothstep keeps its slope per pixel.
+float smoothstep_slope(float e0, float e1, float x) {
+    float t = clamp((x - e0) / (e1 - e0), 0.0, 1.0);
+    return 6.0 * t * (1.0 - t) / (e1 - e0);
+}
+
 // ---- lighting helpers ---------------------------------------------------------------------
 vec3 hemisphere(vec3 n) {
     return mix(u_ground_col, u_sky_col, 0.5 + 0.5 * n.y);

@@ -107,6 +107,12 @@ vec2 spots(vec2 p, float prob, float radius, int salt) {
     return vec2(cover * step(h, prob), fract(h * 13.7));
 }
 
+// How much of a noise over cells of ``p``'s units shows: all of it where a cell spans two pixels
+// or more, none where it is finer than about one (its mean there, or it shimmers).
+float noise_detail(vec2 p) {
+    return clamp(2.0 - 1.2 * max(fwidth(p.x), fwidth(p.y)), 0.0, 1.0);
+}
+
 // The aggregate of relief finer than a pixel (pores ~0.35 mm apart, the skin's fine lines): value
 // noise over cells of ``p``'s units, evaluated at the octave whose cells are about two pixels
 // across, its contrast scaled as the mean of that many finer cells varies (1/sqrt(N): halved per
@@ -540,12 +546,12 @@ void main() {
     vec2 skin_uv = v_uv + vec2(0.0731, 0.0419) * u_skin_seed;
     vec2 grain_uv = GRAIN_TURN * (skin_uv * vec2(350.0, 700.0));
     vec3 grain_noise = value_noise_grad(grain_uv);   // (its slope: the micro-relief below)
-    float grain_detail = clamp(2.0 - 1.2 * max(fwidth(grain_uv.x), fwidth(grain_uv.y)), 0.0, 1.0);
+    float grain_detail = noise_detail(grain_uv);
     float grain = mix(0.5, grain_noise.x, grain_detail);
     // (The lips keep the grain on the texture's axes, which their furrows, along v, follow; off
     // the lips, nearly all pixels, it is skipped.)
     vec2 lip_grain_uv = skin_uv * vec2(350.0, 700.0);
-    float lip_grain_detail = clamp(2.0 - 1.2 * max(fwidth(lip_grain_uv.x), fwidth(lip_grain_uv.y)), 0.0, 1.0);
+    float lip_grain_detail = noise_detail(lip_grain_uv);   // (derivatives outside the branch)
     float lip_grain = paint.g > 0.0 ? mix(0.5, value_noise(lip_grain_uv, 0), lip_grain_detail) : 0.5;
     float blotch = value_noise(skin_uv * vec2(150.0, 300.0), 0);
     float pores = pore_aggregate(GRAIN_TURN * (skin_uv * PORE_CELLS));
@@ -724,7 +730,7 @@ void main() {
     vec3 pore_noise = value_noise_grad(pore_uv);
     vec3 bump_noise = value_noise_grad(pore_uv * 0.37 + 3.0);
     float pit = smoothstep(0.55, 0.85, pore_noise.x);
-    float pit_slope = 6.0 * (pore_noise.x - 0.55) * (0.85 - pore_noise.x) / (0.3 * 0.3 * 0.3) * step(0.55, pore_noise.x) * step(pore_noise.x, 0.85);
+    float pit_slope = smoothstep_slope(0.55, 0.85, pore_noise.x);
     vec2 pore_slope = 0.5 * 0.37 * bump_noise.yz - pit_slope * pore_noise.yz;   // d height / d pore_uv
     vec3 grad = sign(det) * (dot(pore_slope, dFdx(pore_uv)) * r1 + dot(pore_slope, dFdy(pore_uv)) * r2);
     float pore_fade = clamp(2.2 - 2.5 * max(fwidth(pore_uv.x), fwidth(pore_uv.y)), 0.0, 1.0);
@@ -750,7 +756,7 @@ void main() {
     // (The slope per pixel from the noise's own gradient, as the pores' above.)
     float pore_share = smoothstep(0.15, 0.8, tone.b) * (1.0 - paint.g) * (1.0 - hair);
     float pit = smoothstep(0.62, 0.9, grain) * pore_share;
-    float pit_slope = 6.0 * (grain - 0.62) * (0.9 - grain) / (0.28 * 0.28 * 0.28) * step(0.62, grain) * step(grain, 0.9);
+    float pit_slope = smoothstep_slope(0.62, 0.9, grain);
     vec2 relief_slope = (0.4 - 0.6 * pore_share * pit_slope) * grain_detail * grain_noise.yz;   // d height / d grain_uv
     vec3 grad = sign(det) * (dot(relief_slope, dFdx(grain_uv)) * r1 + dot(relief_slope, dFdy(grain_uv)) * r2);
     // (Its height 0.6 of what it was with a slope per quad, which averaged the slope over 2x2 pixels:
