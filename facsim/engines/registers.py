@@ -359,7 +359,8 @@ class RegisterEngine:
     def _near_the_corner(self, offsets: np.ndarray, side: str, reach: Mapping[str, float]) -> np.ndarray:
         """A lip-corner target's ``offsets`` (N_base_geo, 3) kept in full within ``reach["full_mm"]`` of the
         ``side`` lip corner and fading out by ``reach["none_mm"]`` (``corner_reach`` in the table); with
-        ``below: true`` the distance is the depth below the corner's height (nothing above it is held)."""
+        ``below: true`` the distance is the depth below the corner's height (nothing above it is held); with
+        ``smoothing_passes`` the skin between the two follows the corner smoothly (:meth:`_smoothed_beyond_the_lips`)."""
         from facsim.head.landmarks import landmarks
 
         positions = self.base_positions[self.head.base_index]
@@ -369,7 +370,35 @@ class RegisterEngine:
         else:
             distance = np.linalg.norm(positions - corner, axis=1)
         share = smoothstep(float(reach["none_mm"]) / 100.0, float(reach["full_mm"]) / 100.0, distance)
-        return (offsets * share[:, None]).astype(offsets.dtype)
+        out = offsets * share[:, None]
+        passes = int(reach.get("smoothing_passes", 0))
+        if passes:
+            out = self._smoothed_beyond_the_lips(out, passes, (share <= 0.0) | (share >= 1.0))
+        return out.astype(offsets.dtype)
+
+    def _smoothed_beyond_the_lips(self, offsets: np.ndarray, passes: int, held: np.ndarray) -> np.ndarray:
+        """``offsets`` (N_base_geo, 3) with the skin beyond the lips following them smoothly: its motion
+        averaged with its neighbours' ``passes`` times. The lips, the mouth's lining and the skin two rings
+        off them keep their own motion (smoothed there, the lining showed through the skin at george's
+        corners), as do the ``held`` points (N_base_geo,): the corner's skin and the still skin."""
+        from facsim.engines.muscle.net import MOUTH, adjacency, anatomy, mask_per_vertex
+
+        anat = anatomy(self.head)
+        skin = anat.skin_count
+        lips = mask_per_vertex(self.head, "lips")[:skin]
+        lips = np.maximum(lips, lips[anat.mirror[:skin]])
+        neighbours = adjacency(anat.edges, skin)
+        mouth = ((anat.kind == MOUTH) | (lips > 0.5)).astype(np.float64)
+        for _ in range(2):
+            mouth = np.minimum(neighbours @ mouth + mouth, 1.0)
+        keep = (mouth > 0.0) | held[:skin]
+        degree = np.asarray(neighbours.sum(axis=1)).ravel() + 1.0
+        out = np.array(offsets, np.float64, copy=True)
+        field = out[:skin]
+        for _ in range(passes):
+            field = np.where(keep[:, None], field, (neighbours @ field + field) / degree[:, None])
+        out[:skin] = field
+        return out
 
     @cached_property
     def lids(self) -> dict:
