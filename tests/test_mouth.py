@@ -226,7 +226,7 @@ def test_teeth_are_about_as_light_as_the_lit_skin_beside_them(face_of, expressio
     # inserted in the face. Natural teeth in photographs are L* ~65-80, lighter than the lit
     # skin but not by a third. (Session 23 lit the crowns' biting edges as the front they face,
     # not averaged with the band's lingual fold, and recalibrated: ava's smile 73 against a
-    # cheek of 59.5 in the smile's shade, 1.23; 10+25 72 against 68. Below 1.2 held only while
+    # cheek of 59.5 in the smile's shade, 1.23; 10+25 73 against 68. Below 1.2 held only while
     # the fold darkened every crown toward its edge, a grey row at L* 65.)
     from skimage.color import rgb2lab
 
@@ -245,9 +245,9 @@ def test_open_mouths_show_teeth_brighter_than_the_cavity(face_of, expression):
     image, teeth, cavity = _mouth_pixels(face, "registers", expression)
     assert teeth.sum() > 40 and cavity.sum() > 40
     # (Lit about as the skin beside them, not brighter: test_teeth_are_about_as_light_...)
-    # Since session 23 the upper incisors rest 3 mm under hm08's, so the open mouth shows
-    # their edges right under the upper lip, in its shade (ava 1+2+5+26: 109 px at a median
-    # of 120, was 61 px at 174; 16+26 119, 22+25 118); teeth in the mouth's dark read under 60.
+    # Since session 23 the upper incisors rest 3.5 mm under hm08's, so the open mouth shows
+    # their edges right under the upper lip, in its shade (ava 1+2+5+26: 104 px at a median
+    # of 118, was 61 px at 174; 16+26 120, 22+25 122); teeth in the mouth's dark read under 60.
     assert np.median(_luminance(image[teeth])) > 100
     assert np.median(_luminance(image[cavity])) < 0.6 * np.median(_luminance(image[teeth]))
 
@@ -272,7 +272,7 @@ def test_the_cavity_falls_off_to_near_black_at_the_back(face_of, character):
     # read as "mouth interior flat".)
     image, interior = _part_render(face_of(character), "1+2+5+26", 512, "mouth_interior")
     lining = _luminance(image[interior])
-    # (Enough pixels to judge: ava's upper incisors, resting 3 mm lower since session 23, hide
+    # (Enough pixels to judge: ava's upper incisors, resting 3.5 mm lower since session 23, hide
     # some of it under the upper lip: 92 px, was 100+.)
     assert len(lining) > 60
     assert np.median(lining) < 8

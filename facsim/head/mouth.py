@@ -49,7 +49,7 @@ TONGUE_FALL_ALONG = (0.1, 0.5)
 #: value to the second between the ages in :data:`UPPER_TEETH_DROP_AGES`: older faces show
 #: less upper and relatively more lower teeth, one of the cues that reads as age. (At 2.2 mm
 #: fading to 0, 27 showed no upper teeth on george and 1 px of them on amara at 448 px.)
-UPPER_TEETH_DROP = (0.03, 0.01)
+UPPER_TEETH_DROP = (0.035, 0.015)
 UPPER_TEETH_DROP_AGES = (30.0, 60.0)
 #: The lower row rests in occlusion with the upper (the bite): its incisors' edges this far
 #: (dm) above the upper incisors' (the overbite, 2–3 mm in natural teeth) and their labial
@@ -58,7 +58,7 @@ UPPER_TEETH_DROP_AGES = (30.0, 60.0)
 #: cut through each other and a bite (10+25, 6+12+25) showed a jagged dark line between
 #: them; with the bite the upper edge lies in front of the lower crowns and shades them.
 #: The whole row moves rigidly, so the jaw carries it as before.
-OVERBITE = 0.022
+OVERBITE = 0.02
 OVERJET = 0.02
 #: The middle of the dental arch (dm, |x|) whose incisors' edges set the bite.
 INCISOR_REACH = 0.02
