@@ -40,20 +40,28 @@ TONGUE_BELOW_TEETH = 0.012
 #: tongue lies low behind the lower teeth and the dark cavity opens above it.
 TONGUE_FALL = 0.8
 TONGUE_FALL_ALONG = (0.1, 0.5)
-#: The upper teeth rest this far (dm) lower than hm08 puts them, in young adults. hm08
-#: hides the upper incisors 1 mm above the lips' meeting line, so a mouth that opened by
-#: the jaw alone (26, 27) showed no upper teeth; a relaxed young adult shows 2–3 mm of them
-#: below the upper lip once the lips part. The display shrinks with age as the upper lip
-#: lengthens (Vig & Brundo 1978: from ~3.4 mm under 30 to ~0 past 60), so the drop fades
-#: out between the ages in :data:`UPPER_TEETH_DROP_AGES`: older faces show less upper and
-#: relatively more lower teeth, one of the cues that reads as age.
-UPPER_TEETH_DROP = 0.022
+#: The upper teeth rest this far (dm) lower than hm08 puts them: young adults first, the
+#: oldest last. hm08 hides the upper incisors 1 mm above the lips' meeting line, so a mouth
+#: that opened by the jaw alone (26, 27) showed no upper teeth; a relaxed young adult shows
+#: 2–3 mm of them below the upper lip once the lips part, and an open mouth shows the upper
+#: incisors' edges under the lip. The display shrinks with age as the upper lip lengthens
+#: (Vig & Brundo 1978: from ~3.4 mm under 30 to ~0 past 60), so the drop goes from the first
+#: value to the second between the ages in :data:`UPPER_TEETH_DROP_AGES`: older faces show
+#: less upper and relatively more lower teeth, one of the cues that reads as age. (At 2.2 mm
+#: fading to 0, 27 showed no upper teeth on george and 1 px of them on amara at 448 px.)
+UPPER_TEETH_DROP = (0.035, 0.015)
 UPPER_TEETH_DROP_AGES = (30.0, 60.0)
-#: The lower teeth rest this far (dm) lower than hm08 puts them. hm08's lower incisors reach
-#: the lips' meeting line, so every open mouth (25+26, surprise's 26) bared their whole
-#: crowns above the lower lip, a bright row of blocks; in photographs of open mouths the
-#: lower lip covers most of the lower teeth, and a jaw that drops shows their edges.
-LOWER_TEETH_DROP = 0.012
+#: The lower row rests in occlusion with the upper (the bite): its incisors' edges this far
+#: (dm) above the upper incisors' (the overbite, 2–3 mm in natural teeth) and their labial
+#: face this far behind the upper incisors' edge (the overjet, 2–3 mm). hm08 put the two
+#: rows' edges at one depth, overlapping by 0.3–0.5 mm (george: 1.3 mm apart), so the rows
+#: cut through each other and a bite (10+25, 6+12+25) showed a jagged dark line between
+#: them; with the bite the upper edge lies in front of the lower crowns and shades them.
+#: The whole row moves rigidly, so the jaw carries it as before.
+OVERBITE = 0.02
+OVERJET = 0.02
+#: The middle of the dental arch (dm, |x|) whose incisors' edges set the bite.
+INCISOR_REACH = 0.02
 #: Radius (dm, in plan) within which a tooth vertex's biting edge and root row are looked
 #: up: a column's rows lie within 3 mm of each other, columns 5–8 mm apart.
 COLUMN_REACH = 0.035
@@ -73,9 +81,9 @@ RIM_REACH = 0.08
 
 def rest_mouth(base_positions: np.ndarray, data, *, age: float = 25.0) -> np.ndarray:
     """Base positions (19158, 3) with the mouth's parts at rest: the upper teeth lowered by
-    :data:`UPPER_TEETH_DROP` (less with ``age`` in years), the lower by
-    :data:`LOWER_TEETH_DROP`, the tongue lowered into the floor of the mouth, and the
-    mouth's lining kept :data:`CAVITY_CLEARANCE` behind the skin.
+    :func:`upper_teeth_drop` (less with ``age`` in years), the lower row set in the bite
+    under them (:func:`bite_offset`), the tongue lowered into the floor of the mouth, and
+    the mouth's lining kept :data:`CAVITY_CLEARANCE` behind the skin.
 
     The tongue is squashed toward its underside (about its lowest point) until its top
     sits :data:`TONGUE_BELOW_TEETH` under the lower incisors' edge, and further behind the
@@ -87,11 +95,10 @@ def rest_mouth(base_positions: np.ndarray, data, *, age: float = 25.0) -> np.nda
     out = np.array(base_positions, np.float32, copy=True)
     lining, skin_triangles = _lining_and_skin(data)
     out[lining] = _behind_skin(out[lining], out[skin_triangles], CAVITY_CLEARANCE)
-    young, old = UPPER_TEETH_DROP_AGES
-    out[data.group_vertices(UPPER_TEETH), 1] -= UPPER_TEETH_DROP * float(np.clip((old - age) / (old - young), 0.0, 1.0))
-    out[data.group_vertices(LOWER_TEETH), 1] -= LOWER_TEETH_DROP
+    upper, lower = data.group_vertices(UPPER_TEETH), data.group_vertices(LOWER_TEETH)
+    out[upper, 1] -= upper_teeth_drop(age)
+    out[lower] += bite_offset(out[upper], out[lower])
     tongue = data.group_vertices(TONGUE)
-    lower = data.group_vertices(LOWER_TEETH)
     y = out[tongue, 1]
     bottom, top = float(y.min()), float(y.max())
     target = float(out[lower, 1].max()) - TONGUE_BELOW_TEETH
@@ -105,6 +112,32 @@ def rest_mouth(base_positions: np.ndarray, data, *, age: float = 25.0) -> np.nda
     fall = fall * fall * (3.0 - 2.0 * fall)
     out[tongue, 1] = bottom + scale * (1.0 - TONGUE_FALL * fall) * (y - bottom)
     return out
+
+
+def upper_teeth_drop(age: float) -> float:
+    """How far (dm) the upper teeth rest below hm08's at ``age`` (years): :data:`UPPER_TEETH_DROP`."""
+    young, old = UPPER_TEETH_DROP_AGES
+    first, last = UPPER_TEETH_DROP
+    return float(np.interp(age, (young, old), (first, last)))
+
+
+def incisal_edges(upper: np.ndarray, lower: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The front incisors' biting edges: the lowest point of the ``upper`` row's and the
+    highest of the ``lower`` row's vertices (each (N, 3)) within :data:`INCISOR_REACH` of the
+    midline (the middle of the arch, x = 0)."""
+    def edge(p, pick):
+        front = p[np.abs(p[:, 0]) <= INCISOR_REACH]
+        front = front if len(front) else p
+        return front[pick(front[:, 1])]
+    return edge(upper, np.argmin), edge(lower, np.argmax)
+
+
+def bite_offset(upper: np.ndarray, lower: np.ndarray) -> np.ndarray:
+    """(3,) translation that puts the ``lower`` row (N, 3) in the bite under the ``upper``:
+    its incisors' edges :data:`OVERBITE` above the upper incisors' edges and
+    :data:`OVERJET` behind them."""
+    top, bottom = incisal_edges(upper, lower)
+    return np.array([0.0, top[1] + OVERBITE - bottom[1], top[2] - OVERJET - bottom[2]], np.float32)
 
 
 def _lining_and_skin(data) -> tuple[np.ndarray, np.ndarray]:

@@ -77,6 +77,32 @@ def lash_coordinates(positions: np.ndarray, eyes: list[np.ndarray],
     return np.concatenate(out).astype(np.float32)
 
 
+def teeth_normal_operator(topology: RenderTopology, faces: np.ndarray, n_vertices: int) -> sp.csr_matrix:
+    """:func:`normal_operator` of ``faces`` (geometry triangles of ``topology``) whose teeth keep
+    their biting edge's normals off the band's lingual slope.
+
+    hm08's teeth bands fold at the biting edge: the outer wall turns back into the lingual
+    slope there, so the edge row's averaged normals point down, and across the wall's lowest
+    triangles (8 mm tall) every crown darkened toward its edge in a V-shaped facet. Here the
+    lingual faces do not count toward the edge's and the outer wall's normals (the teeth's
+    coordinates, :func:`facsim.head.mouth.teeth_coordinates`: height 0 at the edge, -1 on the
+    lingual slope). Without teeth coordinates (all zeros) this is :func:`normal_operator`.
+    """
+    from facsim.head.mouth import LOWER_ROW_OFFSET
+
+    operator = normal_operator(faces, n_vertices).tocoo()
+    teeth = np.flatnonzero(topology.region == REGIONS.index("teeth"))
+    height = np.full(n_vertices, np.nan, np.float32)
+    h = topology.uv[teeth, 1]
+    height[topology.render_to_geo[teeth]] = h - LOWER_ROW_OFFSET * (h > 0.5 * LOWER_ROW_OFFSET)
+    with np.errstate(invalid="ignore"):
+        lingual_face = (height[faces] < -0.5).any(axis=1)
+        wall = height >= 0.0
+    keep = ~(lingual_face[operator.col] & wall[operator.row])
+    return sp.csr_matrix((operator.data[keep], (operator.row[keep], operator.col[keep])),
+                         shape=operator.shape, dtype=np.float32)
+
+
 def smoothing_operator(faces: np.ndarray, n_vertices: int) -> sp.csr_matrix:
     """Sparse (n_vertices, n_vertices) float32 matrix averaging each vertex with its one-ring
     neighbours (rows sum to one; a vertex on no face keeps its own value).

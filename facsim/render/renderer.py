@@ -50,7 +50,8 @@ from facsim.render.camera import Camera, projection_matrix, view_matrix, _size_p
 from facsim.media.images import write_png
 from facsim.render.geometry import (CREASES_PER_DM, _faces_touching, _orientation, crease_phase, eye_rotation, lash_coordinates,
                               normal_operator, region_components, scattered_normals, smoothing_operator,
-                              sphere_centre, sphere_directions, surface_curvature, vertex_normals)
+                              sphere_centre, sphere_directions, surface_curvature, teeth_normal_operator,
+                              vertex_normals)
 from facsim.render.gl import RenderError, _set_uniform, _shader_source, compile_program, gl_context
 from facsim.render.inputs import (COLOR_NAMES, DEFAULT_BROW_UV_FRAME, DEFAULT_COLORS, HM08_BROW_UV_FRAME, REGIONS,
                             Appearance, Lighting, RenderTopology, brow_uv_frame, srgb_to_linear)
@@ -233,7 +234,7 @@ class Renderer:
         self._n_geo = topology.n_geo
         self._faces = topology.faces.copy()
         self._geo_faces = np.ascontiguousarray(topology.geo_faces)
-        self._normal_op = normal_operator(self._geo_faces, self._n_geo)
+        self._normal_op = teeth_normal_operator(topology, self._geo_faces, self._n_geo)
         self._smoothing_op = smoothing_operator(self._geo_faces, self._n_geo)
         self._render_op = None  # face -> render vertex sums, built when wrinkles first come
         self._face_region = topology.face_regions()

@@ -458,7 +458,13 @@ const float DEEP_TEETH_LIGHT = 0.04;
 // "inserted" in the face. In photographs the teeth in the mouth are about as light as the
 // lit skin beside it.
 const float TEETH_AMBIENT = 0.75;
-const float ENAMEL_GLOW = 0.08;
+const float ENAMEL_GLOW = 0.06;
+// The share of that light the enamel returns. (0.9 was set while the biting edge's normals
+// pointed down, averaged with the band's lingual fold, which darkened every crown toward its
+// edge; with the edge lit as the front it faces (render.geometry.teeth_normal_operator), 0.9
+// drew a smile's teeth at L* ~83, 1.39 times the cheek's: glowing. Natural teeth in
+// photographs are L* ~65-80, lighter than the skin but not by a third.)
+const float TEETH_DIFFUSE = 0.65;
 // What light reaches the enamel inside the mouth has partly bounced off the lips, gums and
 // tongue: warm. (Dimmed without it, the crowns turned grey, not ivory: C* ~11 at L* ~73.)
 const vec3 INSIDE_WARMTH = vec3(1.0, 0.96, 0.88);
@@ -1174,7 +1180,7 @@ void main() {
     float wet = specular_light(n, v, 120.0).r * 0.35 + specular_light(n, v, 30.0).r * 0.05;
     vec3 spec = vec3(wet) * (1.0 - 0.6 * gum) * schlick(0.05, max(dot(n, v), 0.0)) * 3.0;
     // Enamel scatters light inside the tooth: a little of its own brightness beyond the lighting.
-    radiance = ((diffuse_light(n, vec3(0.3, 0.25, 0.2), TEETH_AMBIENT) * 0.9 + ENAMEL_GLOW) * albedo * mix(INSIDE_WARMTH, vec3(1.0), gum)
+    radiance = ((diffuse_light(n, vec3(0.3, 0.25, 0.2), TEETH_AMBIENT) * TEETH_DIFFUSE + ENAMEL_GLOW) * albedo * mix(INSIDE_WARMTH, vec3(1.0), gum)
                 + spec) * mouth_shade;
     // What light reaches the back teeth has bounced off the cheeks' red lining: warm, not grey.
     // So does what reaches the inside of the arch.
