@@ -821,6 +821,37 @@ def test_12_draws_the_corners_up_and_back_more_than_out(face_of, marks, characte
     assert 0.1 < widening < 0.25
 
 
+def _lower_lip_profile(face, positions) -> tuple[float, float]:
+    """The lower lip's inner rim on ``positions`` (mm): how far it lies higher 0.85 of the way to the
+    corners than at the midline (the depth of its U), and how far its midline moved up from rest."""
+    rim = face._mouth_rim.lower
+    rest = np.asarray(face.neutral, np.float64)[rim]
+    moved = np.asarray(positions, np.float64)[rim]
+    order = np.argsort(rest[:, X])
+    across = rest[order, X] / np.abs(rest[:, X]).max()
+    middle = np.interp(0.0, across, moved[order, Y])
+    depth = np.interp([-0.85, 0.85], across, moved[order, Y]).mean() - middle
+    return 100.0 * depth, 100.0 * (middle - np.interp(0.0, across, rest[order, Y]))
+
+
+@pytest.mark.parametrize("character", ["ava", "mei", "kwame", "george"])
+def test_a_half_smiles_lower_lip_hangs_in_a_u(face_of, character):
+    """Session 23 (happiness at 50 % read neutral by FER2013 5 times in 6, "the half smile's lower lip is
+    flat"): with the lips apart the lower lip hangs in a U between the raised corners, its middle lowest.
+    Until then it rose with the corners (its middle 1 mm below rest in 6+12+25 at 50 %, the U 6.0-6.6 mm
+    deeper than at rest); now the middle hangs 3 mm below rest and the U deepens by over 7.5 mm. 12
+    without 25 keeps the lips together: the lower lip rests on the upper one and rises with it."""
+    from facsim.facs.emotions import emotion
+
+    face = face_of(character)
+    at_rest, _ = _lower_lip_profile(face, face.neutral)
+    depth, middle = _lower_lip_profile(face, face.deform(emotion("happiness", intensity=0.5)).positions)
+    assert middle < -2.0
+    assert depth - at_rest > 7.5
+    for closed in ("12E", "12C", "6+12"):
+        assert _lower_lip_profile(face, face.deform(closed).positions)[1] > 2.0   # risen with the upper lip
+
+
 @pytest.mark.parametrize("character", ["ava", "george", "kwame"])
 def test_27_stretches_the_mouth_open_taller_not_wider(face_of, character):
     """Session 21: in 27 the lips stretch over the widely dropped jaw and draw the corners in, an oval

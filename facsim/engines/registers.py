@@ -248,6 +248,21 @@ def carried_by_the_bone(offsets: np.ndarray, positions: np.ndarray, hinge: np.nd
     return out
 
 
+def lowering_part(offsets: np.ndarray, band: float) -> np.ndarray:
+    """The downward part of a target's ``offsets`` (N, 3): points it lowers by ``band`` (dm) or more
+    keep their whole offset, points it raises keep none (a smooth step between), so an AU can take
+    one lip's motion from a target that moves both (``lowering_only`` in the table).
+
+    >>> lowering_part(np.array([[0.1, -0.2, 0.0], [0.1, 0.2, 0.0], [0.1, 0.0, 0.0]]), 0.1).round(3)
+    array([[ 0.1, -0.2,  0. ],
+           [ 0. ,  0. ,  0. ],
+           [ 0. ,  0. ,  0. ]])
+    """
+    offsets = np.asarray(offsets)
+    share = smoothstep(0.0, -band, offsets[:, 1].astype(np.float64))
+    return (offsets * share[:, None]).astype(offsets.dtype)
+
+
 def mandible_share(heights: np.ndarray, lip_line: float, band: tuple[float, float]) -> np.ndarray:
     """How much of the jaw target's motion each skin point of height ``heights`` (N,) keeps: all of it
     ``band[0]`` (dm) or more below ``lip_line`` (the lip corners' height), none ``band[1]`` or more above
@@ -310,6 +325,9 @@ class RegisterEngine:
                 offsets = self._on_the_mandible(offsets)
             if col.pattern in (register_table().get("skin_only") or ()):
                 offsets[self.head.skin_vertex_count:] = 0.0   # the teeth and tongue keep their shape
+            lowering = (register_table().get("lowering_only") or {}).get(col.pattern)
+            if lowering:
+                offsets = lowering_part(offsets, float(lowering["band_mm"]) / 100.0)
             reach = (register_table().get("corner_reach") or {}).get(col.pattern)
             if reach:
                 offsets = self._near_the_corner(offsets, col.side, reach)
