@@ -14,7 +14,7 @@ from facsim.facs.activations import activations
 from facsim.facs.notation import parse
 
 MM = 100.0
-EXPRESSIONS = ["25", "26", "27", "2", "1+2", "1+4", "4", "6"]
+EXPRESSIONS = ["25", "26", "27", "2", "1+2", "1+4", "4", "6", "6+12+25"]
 
 
 @pytest.fixture(scope="module")
@@ -82,6 +82,36 @@ def test_lips_part_drops_the_jaw_far_less_than_jaw_drop(muscle):
     f25, f26 = muscle["25"][0], muscle["26"][0]
     assert f25["gap"] > 3.0           # the lips part (0 mm before at the midline) ...
     assert f25["jaw"] < 0.5 * f26["jaw"]   # ... without the jaw drop of 26
+
+
+def _upper_lip_over_the_incisors(positions, gauge, face_of) -> float:
+    """How far (mm) the lowest point of the upper lip's middle lies above the upper incisors' edge:
+    that much upper tooth shows from the front when the lips are apart."""
+    from facsim.engines.muscle.net import anatomy
+
+    anat = anatomy(face_of("ava", "muscle").head)
+    n = anat.skin_count
+    middle = np.flatnonzero((anat.lip_half[:n] == 1) & (np.abs(anat.base[:n, 0]) < 0.04))
+    p = np.asarray(positions, float)
+    return MM * (p[middle, 1].min() - p[gauge.incisor_edge, 1])
+
+
+def test_the_upper_lip_hangs_from_the_skull_as_the_jaw_drops(muscle):
+    """The upper lip is tied to the maxilla, not dragged down by the opening jaw (FACS 25-27: the
+    lower lip and jaw move, the upper lip stays). On main 98c87e1 it came 8.6 mm down on 27, 3.0 on 26
+    and 1.1 on 25; the register engine keeps it within 0.1 mm on 27 and lifts it 2 mm on 25."""
+    assert muscle["27"][0]["upper_lip"] < 3.0
+    assert muscle["26"][0]["upper_lip"] < 1.5
+    assert muscle["25"][0]["upper_lip"] < -1.0   # relaxed orbicularis oris: the upper lip rises a little
+
+
+def test_parted_lips_and_smiles_show_the_upper_teeth(muscle, gauges, face_of):
+    """25 and the full smile 6+12+25 (happiness) show the upper incisors: on main 98c87e1 the upper
+    lip's middle hung 0.4 mm below their edge on 25 and 2.3 on 6+12+25, and photo-trained raters read
+    4 of 6 muscle-engine smiles as neutral (the register engine: 3.2 and 6.0 mm)."""
+    _, gauge = gauges
+    assert _upper_lip_over_the_incisors(muscle["25"][1], gauge, face_of) > 2.0
+    assert _upper_lip_over_the_incisors(muscle["6+12+25"][1], gauge, face_of) > 4.0
 
 
 def _jaw_motion(rest, p, teeth):

@@ -406,6 +406,18 @@ def _sphincter_chain(b: _Builder, m: dict, index: int, side: str, sels: list[dic
         b.segment(p, q, index, weight, fiber_id)
         if p >= 0 and q >= 0:
             b.arc(p, q, b.c["muscle_passive"], beta=0.0, compress=0.2)
+    if m.get("tone"):
+        # The tone a ring holds pulls its points in toward its centre (seen from the front); relaxed,
+        # it is released as an outward push: orbicularis oris letting go parts the lips (FACS 25).
+        nodes = [r for r in chain if r >= 0]
+        centre = np.mean([b.position(r) for r in chain], axis=0)
+        for node in nodes:
+            inward = centre - b.position(node)
+            inward[2] = 0.0
+            b.relax["node"].append(node)
+            b.relax["dir"].append(inward / max(np.linalg.norm(inward), 1e-12))
+            b.relax["muscle"].append(index)
+            b.relax["weight"].append(1.0 / len(nodes))
 
 
 def _jaw_action(b: _Builder, m: dict, side: str, net: TensionNet) -> np.ndarray:

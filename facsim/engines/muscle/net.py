@@ -488,6 +488,8 @@ class TensionNet:
     eye_ids, eye_index, eye_floor : lid/sac points, their eye (0 left, 1 right), least distance to its centre.
     eye_centre : (2, 3), eye_radius : float
     rim_pairs : (P, 2) upper/lower lip rim points facing each other.
+    tether_ids, tether_anchor, tether_length, tether_k : the upper lip's tether to the maxilla
+        (points, their skull anchors (T, 3), the length each may reach before it holds, stiffness).
     hinge : (3,) the jaw's hinge (temporomandibular axis along X through it).
     scale : character size relative to the base mesh (eye-centre distance ratio).
     """
@@ -517,6 +519,10 @@ class TensionNet:
     hinge: np.ndarray
     scale: float
     constants: dict
+    tether_ids: np.ndarray = None
+    tether_anchor: np.ndarray = None
+    tether_length: np.ndarray = None
+    tether_k: np.ndarray = None
     laplacian: sp.csr_matrix = None   # (N_skin, N_skin) umbrella Laplacian of the skin
     bend_k: np.ndarray = None         # (N_skin,) bending stiffness per point
 
@@ -640,6 +646,8 @@ def build_net(head, base_positions, *, anat: Anatomy | None = None, spec: dict |
     gap = np.linalg.norm(rest[eye_ids] - eye_centre[eye_index], axis=1)
     eye_floor = np.minimum(gap, eye_radius + constants["lid_clearance"] * scale)
 
+    tether = _upper_lip_tether(anat, rest, area, depth, constants["upper_lip_tether"], scale)
+
     return TensionNet(
         rest=rest, normal=normal, area=area, triangles=tri, arcs=arcs, depth=depth,
         attach_skull=attach_skull, attach_jaw=attach_jaw, volume_k=volume_k,
@@ -648,8 +656,32 @@ def build_net(head, base_positions, *, anat: Anatomy | None = None, spec: dict |
         eye_ids=eye_ids, eye_index=eye_index, eye_floor=eye_floor, eye_centre=eye_centre,
         eye_radius=eye_radius, rim_pairs=anat.rim_pairs,
         hinge=np.asarray(head.joint(base_positions, "joint-mouth"), float),
-        scale=scale, constants=constants, laplacian=laplacian, bend_k=bend_k,
+        scale=scale, constants=constants, laplacian=laplacian, bend_k=bend_k, **tether,
     )
+
+
+def _upper_lip_tether(anat: Anatomy, rest, area, depth, spec: dict, scale: float) -> dict:
+    """The upper lip hangs from the maxilla: each point of its middle part is tied to a skull point
+    ``height`` above it by a tension-only spring that is slack for ``slack`` more than its rest length.
+
+    Its mucosa runs up the vestibule to the gum (the labial frenum in the middle), so the lip rises
+    freely (10, 12 shorten the tie) but cannot be dragged far down: without it the skin stretched
+    between the lip and the opening jaw pulled the upper lip 8.6 mm down on 27 and 1-2 mm on 25,
+    closing a smile's show of upper teeth (issue 13). The corners are left free (15, 20).
+    """
+    n = anat.skin_count
+    base = anat.base[:n]
+    corner = abs(base[anat.mouth_corner, 0])
+    share = np.abs(base[:, 0]) / (spec["reach"] * corner)
+    # The red of the upper lip and its skin up to the nose (the white lip, over the maxilla).
+    white = (anat.lip_half[:n] == 0) & (anat.jaw_weight < 0.01) & (base[:, 1] > base[anat.mouth_corner, 1]) & (
+        base[:, 1] < spec["top"])
+    ids = np.flatnonzero(((anat.lip_half[:n] == 1) | white) & (anat.kind[:n] == OUTER) & (share < 1.0))
+    weight = (1.0 - share[ids] ** 2) ** 2
+    height = spec["height"] * scale
+    anchor = rest[ids] + np.array([0.0, height, 0.0])
+    return dict(tether_ids=ids, tether_anchor=anchor, tether_length=np.full(len(ids), height + spec["slack"] * scale),
+                tether_k=spec["stiffness"] * weight * area[ids] / np.maximum(depth[ids], 1e-3))
 
 
 # -------------------------------------------------------------------- jaw ---

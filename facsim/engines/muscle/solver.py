@@ -9,7 +9,8 @@ The face at rest under a set of muscle actions is the minimiser of
          + Σ_fibers T L₀ Φ(λ)                      muscles: tension × path length (λ = l/L₀, the
                                                  fiber's path), weakening as the fiber shortens
          + ½ Σ_segments k_g (g L − l)₊²            no muscle segment shorter than g of its rest
-         + ½ Σ penalties                           lips against each other, the tongue's tip
+         + ½ Σ penalties                           lips against each other, the tongue's tip,
+                                                 the upper lip's tie to the maxilla
          − Σ f · x                                  released tone, air pressure, muscle bellies
 
 over the skin and muscle points ``x``, subject to one-sided contacts: the
@@ -111,6 +112,10 @@ class Model:
     lip_pairs: np.ndarray        # (P, 2) upper/lower rim points
     lip_floor: np.ndarray        # (P,) least separation (the rest one where the lips already overlap)
     lip_k: float
+    tether_ids: np.ndarray       # (T,) upper-lip points hanging from the maxilla ...
+    tether_anchor: np.ndarray    # (3, 1, T) ... from these skull points ...
+    tether_length: np.ndarray    # (T,) ... free up to this distance ...
+    tether_k: np.ndarray         # (T,) ... then held this stiffly
     seg_a: sp.csr_matrix         # (S, N) picks a segment's first end when it is a point ...
     seg_b: sp.csr_matrix
     seg_scatter_a: sp.csr_matrix  # (N, S)
@@ -356,6 +361,8 @@ def build_model(net: TensionNet, layer: MuscleLayer, spec: dict, tongue: TongueM
         eye_ids=eye_ids, eye_centre=net.eye_centre[eye_index].T[:, None, :], eye_floor=eye_floor,
         site_blend=0.02 * net.scale,
         lip_pairs=rim, lip_floor=np.minimum(lip_sep, 0.0), lip_k=float(np.median(net.contact_k[net.contact_k > 0])),
+        tether_ids=net.tether_ids, tether_anchor=net.tether_anchor.T[:, None, :], tether_length=net.tether_length,
+        tether_k=net.tether_k,
         seg_a=seg_a, seg_b=seg_b, seg_scatter_a=seg_a.T.tocsr(), seg_scatter_b=seg_b.T.tocsr(),
         seg_bone_a=bone_a, seg_bone_b=bone_b, seg_rest=seg_rest,
         seg_guard_k=const["guard_stiffness"] * layer.force[layer.seg_muscle] * layer.seg_weight / seg_rest,
@@ -671,6 +678,13 @@ def energy(model: Model, x: np.ndarray, ld: Loads):
     push = model.lip_k * pen * ld.lip_up
     np.add.at(grad, (slice(None), slice(None), up), -push)
     np.add.at(grad, (slice(None), slice(None), lo), push)
+
+    # The upper lip hangs from the maxilla: a tie longer than its free length pulls back.
+    v = x[:, :, model.tether_ids] - model.tether_anchor
+    dist = np.sqrt(_dot(v, v))
+    over = np.maximum(dist - model.tether_length, 0.0)
+    total += 0.5 * (model.tether_k * over * over).sum(-1)
+    grad[:, :, model.tether_ids] += (model.tether_k * over / np.maximum(dist, 1e-12)) * v
 
     # The tongue's tip pushes what it meets (the lining directly; lips and cheeks through their tissue).
     tg = model.tongue
