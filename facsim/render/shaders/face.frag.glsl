@@ -140,16 +140,18 @@ float pore_aggregate(vec2 p) {
 // albedo's multiplier. (Without it the cheeks' hue varied at this scale by about 1.0 % against
 // 1.8 % on a studio portrait's, skimage.data.astronaut(): an even tint, "waxy" to the reviewer.)
 const float MID_FLUSH = 0.26;     // the flush's green and blue loss per unit of its noise
-const float MID_PIGMENT = 0.12;   // the pigment's darkening per unit of its noise
+const float MID_PIGMENT = 0.12;   // the pigment's darkening per unit of its noise (2.6x in dark skin:
+                                  // kwame's face of one even brown read as a mask)
 vec3 mid_tone(vec2 skin_uv, float redness, float melanin_rich) {
     // (Cells ~12 and ~6 mm for the flush, ~22 and ~9 mm for the pigment; 1:2 in u:v, round.)
     float flush = 0.6 * value_noise(skin_uv * vec2(30.0, 60.0) + 63.0, 0)
                 + 0.4 * value_noise(skin_uv * vec2(60.0, 120.0) + 29.0, 0) - 0.5;
     float pigment = 0.65 * value_noise(skin_uv * vec2(16.0, 32.0) + 83.0, 0)
                   + 0.35 * value_noise(skin_uv * vec2(40.0, 80.0) + 47.0, 0) - 0.5;
+    // (The forehead flushes less than the cheeks: mei's forehead, a patch of it, passed skin's C*.)
     float f = MID_FLUSH * flush * (0.4 + 1.6 * redness) * (1.0 - 0.7 * melanin_rich);
     vec3 tint = 1.0 - f * vec3(-0.15, 1.0, 0.85);
-    return tint * (1.0 - MID_PIGMENT * (1.0 + melanin_rich) * pigment * vec3(0.95, 1.0, 1.08));
+    return tint * (1.0 - MID_PIGMENT * (1.0 + 1.6 * melanin_rich) * pigment * vec3(0.95, 1.0, 1.08));
 }
 
 // The most red over green the skin's diffuse light may carry where the mesh folds (see main), and
