@@ -139,10 +139,11 @@ float pore_aggregate(vec2 p) {
 }
 
 // A shaved beard's shadow is the stubble's dark hairs seen in and through the skin, a follicle
-// every millimetre or so (STUBBLE_CELLS: cells per texture unit, ~1 mm), so its cover varies from
-// pixel to pixel as the number of hairs a pixel holds does (pore_aggregate: at 448 px a fine
-// salt-and-pepper; at 1024 px hairs about a pixel across), by STUBBLE_GRAIN per unit of the
-// aggregate. (An even blue-grey tint over the beard's area read as paint on george and kwame.)
+// every half millimetre to millimetre (STUBBLE_CELLS: cells per texture unit, ~0.5 mm), so its cover
+// varies from pixel to pixel as the number of hairs a pixel holds does (pore_aggregate: at 448 px a
+// fine salt-and-pepper; at 1024 px specks a couple of pixels across), by STUBBLE_GRAIN per unit of
+// the aggregate. (An even blue-grey tint over the beard's area read as paint on george and kwame;
+// at 1-mm cells and 3.0 the stubble drew a camouflage of blotches.)
 const vec2 STUBBLE_CELLS = vec2(700.0, 1400.0);
 const float STUBBLE_GRAIN = 1.5;
 
