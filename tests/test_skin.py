@@ -627,3 +627,27 @@ def test_the_cheeks_colour_varies_in_patches_a_few_millimetres_across(face_of, m
         mask[y - r:y + r + 1, x - r:x + r + 1] = True
     _, hue = _mid_scale_unevenness(image, mask, px_per_mm)
     assert hue > 1.3, hue
+
+
+@pytest.mark.parametrize("name", ["george", "kwame"])
+def test_a_shaved_beards_shadow_is_a_stipple_of_stubble_not_an_even_tint(face_of, marks, name):
+    """A shaved beard's shadow is its stubble, a dark hair every millimetre or so: at 448 px the chin's
+    pixel-scale grain (luminance over itself blurred by 1.5 px, its standard deviation) is over 1.25x
+    what it is without the beard (main 98c87e1: 1.0x, an even blue-grey tint that read as paint)."""
+    from scipy.ndimage import gaussian_filter
+
+    size = 448
+    face = face_of(name)
+    camera = face.camera(size=(size, size))
+    chin = face.neutral[marks["chin"]] + 0.3 * (face.neutral[marks["lower_lip"]] - face.neutral[marks["chin"]])
+    (x, y), = project(camera, [chin], size)[0].astype(int)
+
+    def grain(appearance):
+        image = face.renderer(size=size, body="none").render(face.neutral, appearance=appearance, camera=camera,
+                                                             occlusion=face.shading_occlusion)
+        lum = image[..., :3].astype(float) @ np.array([0.2126, 0.7152, 0.0722])
+        return np.std((lum / gaussian_filter(lum, 1.5))[y - 6:y + 7, x - 6:x + 7])
+
+    assert face.appearance.beard > 0.5
+    ratio = grain(face.appearance) / grain(dataclasses.replace(face.appearance, beard=0.0))
+    assert ratio > 1.25, ratio

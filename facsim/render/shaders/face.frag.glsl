@@ -122,8 +122,7 @@ float noise_detail(vec2 p) {
 // octave has its own offset, so the pattern is continuous where the octave changes. Mean 0;
 // standard deviation ~0.17 (value noise's) where the cells are 2 px or larger, half that per
 // octave finer.
-float pore_aggregate(vec2 p) {
-    float cells_per_px = max(max(length(dFdx(p)), length(dFdy(p))), 1e-6);
+float pore_aggregate(vec2 p, float cells_per_px) {
     float lod = max(log2(cells_per_px) + 1.0, 0.0);
     float l0 = floor(lod);
     float f = lod - l0;
@@ -132,6 +131,21 @@ float pore_aggregate(vec2 p) {
     // (Two independent noises blended have less contrast than either: renormalised.)
     return mix(a, b, f) * inversesqrt(1.0 - 2.0 * f + 2.0 * f * f) * exp2(-lod);
 }
+float cells_per_pixel(vec2 p) {
+    return max(max(length(dFdx(p)), length(dFdy(p))), 1e-6);
+}
+float pore_aggregate(vec2 p) {
+    return pore_aggregate(p, cells_per_pixel(p));
+}
+
+// A shaved beard's shadow is the stubble's dark hairs seen in and through the skin, a follicle
+// every half millimetre to millimetre (STUBBLE_CELLS: cells per texture unit, ~0.5 mm), so its cover
+// varies from pixel to pixel as the number of hairs a pixel holds does (pore_aggregate: at 448 px a
+// fine salt-and-pepper; at 1024 px specks a couple of pixels across), by STUBBLE_GRAIN per unit of
+// the aggregate. (An even blue-grey tint over the beard's area read as paint on george and kwame;
+// at 1-mm cells and 3.0 the stubble drew a camouflage of blotches.)
+const vec2 STUBBLE_CELLS = vec2(700.0, 1400.0);
+const float STUBBLE_GRAIN = 1.5;
 
 // The skin's unevenness between the blotches and the regional maps (5-30 mm, what a photograph of
 // a face at 448 px shows most): blood flushes the skin in irregular patches (more where the
@@ -140,16 +154,18 @@ float pore_aggregate(vec2 p) {
 // albedo's multiplier. (Without it the cheeks' hue varied at this scale by about 1.0 % against
 // 1.8 % on a studio portrait's, skimage.data.astronaut(): an even tint, "waxy" to the reviewer.)
 const float MID_FLUSH = 0.26;     // the flush's green and blue loss per unit of its noise
-const float MID_PIGMENT = 0.12;   // the pigment's darkening per unit of its noise
+const float MID_PIGMENT = 0.12;   // the pigment's darkening per unit of its noise (2.6x in dark skin:
+                                  // kwame's face of one even brown read as a mask)
 vec3 mid_tone(vec2 skin_uv, float redness, float melanin_rich) {
     // (Cells ~12 and ~6 mm for the flush, ~22 and ~9 mm for the pigment; 1:2 in u:v, round.)
     float flush = 0.6 * value_noise(skin_uv * vec2(30.0, 60.0) + 63.0, 0)
                 + 0.4 * value_noise(skin_uv * vec2(60.0, 120.0) + 29.0, 0) - 0.5;
     float pigment = 0.65 * value_noise(skin_uv * vec2(16.0, 32.0) + 83.0, 0)
                   + 0.35 * value_noise(skin_uv * vec2(40.0, 80.0) + 47.0, 0) - 0.5;
+    // (The forehead flushes less than the cheeks: mei's forehead, a patch of it, passed skin's C*.)
     float f = MID_FLUSH * flush * (0.4 + 1.6 * redness) * (1.0 - 0.7 * melanin_rich);
     vec3 tint = 1.0 - f * vec3(-0.15, 1.0, 0.85);
-    return tint * (1.0 - MID_PIGMENT * (1.0 + melanin_rich) * pigment * vec3(0.95, 1.0, 1.08));
+    return tint * (1.0 - MID_PIGMENT * (1.0 + 1.6 * melanin_rich) * pigment * vec3(0.95, 1.0, 1.08));
 }
 
 // The most red over green the skin's diffuse light may carry where the mesh folds (see main), and
@@ -613,7 +629,14 @@ void main() {
     // jaw's sides) hold more pigment in melanin-rich skin: darker still, unevenly (a dark
     // face of one even brown read as a plastic mask).
     albedo *= 1.0 - tone.r * mix(0.6, 1.3, patches) * 0.3 * melanin_rich * vec3(0.85, 1.0, 1.15);
-    albedo = mix(albedo, albedo * vec3(0.70, 0.72, 0.78), u_beard * detail.g * (1.0 - paint.g));
+    float stubble = u_beard * detail.g * (1.0 - paint.g);
+    vec2 stubble_uv = GRAIN_TURN * (skin_uv * STUBBLE_CELLS) + 11.0;
+    float stubble_px = cells_per_pixel(stubble_uv);   // (derivatives outside the branch)
+    // (A branch: llvmpipe skips it for the blocks of pixels outside a man's beard.)
+    if (stubble > 0.0) {
+        stubble *= clamp(1.0 + STUBBLE_GRAIN * pore_aggregate(stubble_uv, stubble_px), 0.0, 2.0);
+    }
+    albedo = mix(albedo, albedo * vec3(0.70, 0.72, 0.78), stubble);
     // Age spots (solar lentigines): sparse, soft tan patches a few millimetres to a centimetre
     // across where the sun reaches, growing with age. (Until session 20 they were the peaks of the
     // few-mm blotches, an orange multiplier: on george's forehead a rash of small red-brown dots.)
