@@ -586,7 +586,7 @@ void main() {
         alpha = mix(alpha, mix(share, smoothstep(curl_rank - curl_w, curl_rank + curl_w, share), curl_detail), u_coil);
         // (the texture's tufts, mipmapped, leave holes that drew the halo as lace: there the
         // coils cover evenly, thinning toward the outline)
-        float halo_cover = mix(max(alpha, 0.75) * (0.75 + 0.25 * halo), alpha, thinning) * thinning;
+        float halo_cover = mix(max(alpha, 0.75) * (0.75 + 0.25 * halo), alpha, thinning) * thinning * thinning;
         alpha = mix(alpha, halo_cover, u_coil);
         // A card's own cut edge (where the mass ends over the temples and the forehead) breaks
         // into curls and clumps of curls ending at different places, so the mass meets the
