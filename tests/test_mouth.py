@@ -267,15 +267,18 @@ def test_the_inside_of_the_arch_is_not_a_grey_wall(face_of):
 @pytest.mark.parametrize("character", ["ava", "kwame"])
 def test_the_cavity_falls_off_to_near_black_at_the_back(face_of, character):
     # The light an open mouth lets in, and what the cheeks scatter in, fades toward the
-    # throat: the lining seen through surprise's opening (mostly the back of the mouth and
-    # the palate) is near-black. (One flat dark red, luminance 15.3 on every lining pixel,
-    # read as "mouth interior flat".)
+    # throat: the lining seen through surprise's opening (the back of the mouth and the
+    # palate) is dark, near-black in its deepest parts, and graded, not one flat shade. (One
+    # flat dark red, luminance 15.3 on every lining pixel, read as "mouth interior flat";
+    # session 21 made it near-black, median < 8, but with the tongue's back filling the
+    # opening (session 23 sank it) that was a puppet's dark hole above the tongue. Now: ava
+    # 2011 px, 5-95 % 8.0-15.8; kwame 7.7-17.8.)
     image, interior = _part_render(face_of(character), "1+2+5+26", 512, "mouth_interior")
     lining = _luminance(image[interior])
-    # (Enough pixels to judge: ava's upper incisors, resting 3.5 mm lower since session 23, hide
-    # some of it under the upper lip: 92 px, was 100+.)
-    assert len(lining) > 60
-    assert np.median(lining) < 8
+    assert len(lining) > 500
+    low, middle, high = np.percentile(lining, [5, 50, 95])
+    assert low < 9 and middle < 14
+    assert high - low > 5
 
 
 def _part_render(face, expression, size, part, **view):
@@ -597,3 +600,35 @@ def test_the_teeths_biting_edge_is_shaded_as_the_front_it_faces(face_of):
             above = wall[np.argmin(np.linalg.norm(p[wall, ::2] - p[v, ::2], axis=1))]
             # The edge faces as the wall above it does, within 25 degrees (38-136 on main; 0.5-6 now).
             assert np.degrees(np.arccos(np.clip(normals[v] @ normals[above], -1, 1))) < 25
+
+
+@pytest.mark.parametrize("character", ["george", "mei"])
+def test_a_wide_open_mouth_shows_the_cavity_above_the_tongue(face_of, character):
+    # The jaw turns the tongue about a hinge behind it, so its back hardly drops: resting only
+    # squashed toward its underside, in 27 the root stood within 10 mm of the upper teeth's
+    # edge (george; mei 4.5 mm) and seen through the opening the tongue's dark back filled all
+    # of it above its lit front, a puppet's dark mouth. Its back sinks toward the throat.
+    face = face_of(character)
+    parts = _groups(face)
+    along = tongue_coordinates(face.head, face.data, face.base_positions)[parts["tongue"], 1]
+    moved = np.asarray(face.deform("27").positions)
+    upper_edge = moved[parts["upper"], 1].min()
+    root = moved[parts["tongue"]][along > 0.6]
+    assert root[:, 1].max() < upper_edge - 0.12   # george 20 mm, mei 14 mm below it
+
+
+def test_an_open_mouth_lets_light_onto_its_lining_by_distance(face_of):
+    # The bake on the closed mouth leaves the lining only a fall-off with depth behind the lips,
+    # whatever the opening: the back of 27's opening was one flat near-black. Through the
+    # parted lips the lining takes light by its distance from the opening, more as it widens.
+    from facsim.head.mouth import opening_light
+
+    face = face_of("george")
+    rim = face._mouth_rim
+    light = {code: opening_light(rim, face._in_head_frame(np.asarray(face.deform(code).positions)))
+             for code in ("0", "26", "27")}
+    assert light["0"].max() == 0.0
+    assert np.median(light["27"]) > np.median(light["26"]) > 0.0
+    p = face.neutral[rim.lining]
+    near, far = p[:, 2] > np.percentile(p[:, 2], 75), p[:, 2] < np.percentile(p[:, 2], 25)
+    assert np.median(light["27"][near]) > 2 * np.median(light["27"][far])

@@ -18,7 +18,7 @@ Examples
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -40,6 +40,14 @@ TONGUE_BELOW_TEETH = 0.012
 #: tongue lies low behind the lower teeth and the dark cavity opens above it.
 TONGUE_FALL = 0.8
 TONGUE_FALL_ALONG = (0.1, 0.5)
+#: Behind its front the tongue also sinks as a whole, by up to this much (dm) at the root:
+#: its back curves down toward the throat, as the root does toward the hyoid. Squashed toward
+#: its underside alone, the back still stood within 10 mm of the upper teeth's edge when the
+#: jaw dropped (27: george -10 mm, mei -4.5 mm at the root; the jaw turns the tongue about a
+#: hinge behind it, so its back hardly drops), and seen through the opening it filled all of
+#: it above the lit front: a dark wall, the "dark inside" of a puppet's mouth. With the root
+#: lower the opening shows the palate and the throat above the tongue.
+TONGUE_ROOT_DROP = 0.1
 #: The upper teeth rest this far (dm) lower than hm08 puts them: young adults first, the
 #: oldest last. hm08 hides the upper incisors 1 mm above the lips' meeting line, so a mouth
 #: that opened by the jaw alone (26, 27) showed no upper teeth; a relaxed young adult shows
@@ -87,7 +95,8 @@ def rest_mouth(base_positions: np.ndarray, data, *, age: float = 25.0) -> np.nda
 
     The tongue is squashed toward its underside (about its lowest point) until its top
     sits :data:`TONGUE_BELOW_TEETH` under the lower incisors' edge, and further behind the
-    tip so its dorsum falls toward the root (:data:`TONGUE_FALL`); its tip and sides
+    tip so its dorsum falls toward the root (:data:`TONGUE_FALL`), its back sunk as a whole
+    (:data:`TONGUE_ROOT_DROP`); its tip and sides
     stay where they are in plan, so it still fills the lower arch. Applied to the
     character's neutral mesh before any expression, so both engines carry the parts
     with the skull and the jaw as they carry hm08's own.
@@ -110,7 +119,7 @@ def rest_mouth(base_positions: np.ndarray, data, *, age: float = 25.0) -> np.nda
     start, end = TONGUE_FALL_ALONG
     fall = np.clip((along - start) / (end - start), 0.0, 1.0)
     fall = fall * fall * (3.0 - 2.0 * fall)
-    out[tongue, 1] = bottom + scale * (1.0 - TONGUE_FALL * fall) * (y - bottom)
+    out[tongue, 1] = bottom + scale * (1.0 - TONGUE_FALL * fall) * (y - bottom) - TONGUE_ROOT_DROP * fall
     return out
 
 
@@ -237,7 +246,7 @@ def tongue_coordinates(head, data, base_positions: np.ndarray) -> np.ndarray:
     return out
 
 
-def mouth_depth_visibility(head, neutral: np.ndarray, *, falloff: float = 0.12):
+def mouth_depth_visibility(head, neutral: np.ndarray, *, falloff: float = 0.18):
     """Mouth-interior vertices and a visibility (1 at the lips … ~0 deep inside) that falls
     off with depth behind the lips, so an open mouth shows a dark cavity, not a lit wall.
 
@@ -355,6 +364,8 @@ class MouthRim:
         The mouth's lining just inside the rim, ring by ring inward (:data:`LINING_RING_VISIBILITY`).
     lining_rest_gap : tuple of (K_i,) float
         Their rest gaps, as ``rest_gap``.
+    lining : (J,) int
+        Geometry indices of the whole mouth's lining (:func:`opening_light`).
     """
 
     upper: np.ndarray
@@ -368,6 +379,7 @@ class MouthRim:
     rest_gap_middle: float = 0.0
     lining_rings: tuple = ()
     lining_rest_gap: tuple = ()
+    lining: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
 
 
 def mouth_rim(head, data, neutral: np.ndarray) -> MouthRim:
@@ -411,7 +423,8 @@ def mouth_rim(head, data, neutral: np.ndarray) -> MouthRim:
     rim = MouthRim(upper=by_x(upper), lower=by_x(lower), rings=tuple(rings), upper_lip=upper_lip,
                    upper_teeth=head.group_geometry(data, UPPER_TEETH),
                    lower_teeth=head.group_geometry(data, LOWER_TEETH),
-                   tongue=head.group_geometry(data, TONGUE), lining_rings=tuple(lining_rings))
+                   tongue=head.group_geometry(data, TONGUE), lining_rings=tuple(lining_rings),
+                   lining=np.flatnonzero(lining))
     plane, upper_edge, lower_edge, middle = _lips(rim, p)
 
     def gaps(ring_list):
@@ -484,12 +497,61 @@ def _lips(rim: MouthRim, positions: np.ndarray):
     return plane, (lambda x: np.interp(x, ux, uy)), (lambda x: np.interp(x, lx, ly)), 0.5 * (ux[0] + ux[-1])
 
 
+#: The parted lips' opening is about this fraction of the rectangle of its width by its gap
+#: in the middle (an ellipse: pi / 4).
+OPENING_FILL = 0.78
+#: The light in front of the face is brighter than the room's average: the studio's large key
+#: and fill face the opening. What passes it lights the lining this many times the opening's
+#: share of the whole hemisphere of light.
+OPENING_GAIN = 3.0
+#: How the light through the opening grows with the rise of the direction to it (sine), and
+#: the least share left to lining that looks down at it.
+OPENING_RISE = 1.5
+OPENING_LOW = 0.15
+
+
+def opening_light(rim: MouthRim, positions: np.ndarray) -> np.ndarray:
+    """(J,) for ``rim.lining``: the share of the light from in front of the face that reaches
+    each lining vertex through the parted lips (``positions``, (N_geo, 3)): the opening's area
+    over pi times its squared distance from the opening's middle (the solid angle the opening
+    fills, over the hemisphere's), at most 1; 0 while the lips touch.
+
+    The bake on the closed mouth leaves the lining only a fall-off with depth behind the lips
+    (:func:`mouth_depth_visibility`), the same whatever the opening: an open mouth (27,
+    surprise) showed the back of its cavity as one flat near-black. Through a wide opening the
+    back of the mouth (6-8 cm in) catches the room's light by its distance from it, more below
+    the opening than above (:data:`OPENING_RISE`): a gradual fall-off to the throat's dark,
+    the palate's shade above.
+    """
+    p = np.asarray(positions, np.float64)
+    plane, upper_edge, lower_edge, middle = _lips(rim, p)
+    gap = max(float(upper_edge(middle) - lower_edge(middle)) - rim.rest_gap_middle, 0.0)
+    if gap <= 0.0 or not len(rim.lining):
+        return np.zeros(len(rim.lining), np.float32)
+    corners = plane(rim.upper)[0][[0, -1]]
+    area = OPENING_FILL * float(abs(corners[1] - corners[0])) * gap
+    rims = np.concatenate([rim.upper, rim.lower])
+    centre = p[rims].mean(axis=0)
+    towards = centre - p[rim.lining]
+    distance = np.maximum(np.linalg.norm(towards, axis=1), 1e-4)
+    # The light comes mostly from above the face (the key, the sky): lining below the opening
+    # looks up through it at them, lining above it (the palate, the top of the throat) down at
+    # the floor and the ground, in the shade of the upper teeth and lip.
+    rising = towards[:, 1] / distance
+    share = np.clip(area / (np.pi * distance ** 2), 0.0, 1.0) * np.clip(0.5 + OPENING_RISE * rising, OPENING_LOW, 1.0)
+    # The shader lights the lining by its visibility squared (``mouth_shade``): the square
+    # root makes that light the opening's share, times the studio's frontal light's gain.
+    return np.sqrt(np.clip(OPENING_GAIN * share, 0.0, 1.0)).astype(np.float32)
+
+
 def mouth_light(rim: MouthRim, positions: np.ndarray, occlusion: np.ndarray) -> None:
     """Light the mouth by where the lips are in this frame (in place on ``occlusion``,
     (N_geo,), as baked on the closed mouth):
 
     - the lips' inner surface, and the lining just inside it, open to the light as the
       lips part at its x (the bake buried it: an open mouth's lips had a black inner edge);
+    - the whole lining takes the light the opening lets in by its distance from it
+      (:func:`opening_light`);
     - each tooth vertex gets its height (dm) below the upper lip's edge at its x, not a
       visibility: interpolated across a triangle it is that height per fragment (the lip's
       edge is close to straight between the teeth's columns), so the teeth's shader draws
@@ -513,6 +575,8 @@ def mouth_light(rim: MouthRim, positions: np.ndarray, occlusion: np.ndarray) -> 
         parted = parted * parted * (3.0 - 2.0 * parted)
         touching = CLOSED_LIP_VISIBILITY if ring_index < len(rim.rings) else 0.0   # the lips' rings, not the lining's
         occlusion[ring] = np.maximum(occlusion[ring], visibility * (touching + (1.0 - touching) * parted))
+    if len(rim.lining):
+        occlusion[rim.lining] = np.maximum(occlusion[rim.lining], opening_light(rim, positions))
     lo, hi = TONGUE_LIT_GAP
     lit = np.clip((upper_edge(middle) - lower_edge(middle) - rim.rest_gap_middle - lo) / (hi - lo), 0.0, 1.0)
     occlusion[rim.tongue] = lit * lit * (3.0 - 2.0 * lit)

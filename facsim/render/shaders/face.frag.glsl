@@ -422,9 +422,9 @@ const float LOWER_TEETH[8] = float[8](0.0, 0.052, 0.108, 0.176, 0.246, 0.316, 0.
 // upper half of a wide-open mouth, as one flat black: "a dark hole" cut by the tongue's
 // crest in a hard line.)
 const float TONGUE_LIGHT_TIP = 0.36;
-const float TONGUE_LIGHT_FALLOFF = 0.22;
-const float TONGUE_LIGHT_FLOOR = 0.045;
-const vec3 DEEP_BOUNCE = vec3(1.0, 0.55, 0.5);
+const float TONGUE_LIGHT_FALLOFF = 0.3;
+const float TONGUE_LIGHT_FLOOR = 0.1;
+const vec3 DEEP_BOUNCE = vec3(1.0, 0.7, 0.65);
 // How much of the tongue's shading normal is its normal averaged over ~2 rings of its mesh.
 const float TONGUE_SMOOTHING = 0.8;
 vec3 tongue_depth_light(float along) {
@@ -440,14 +440,20 @@ vec3 tongue_depth_light(float along) {
 // the lining seen past the teeth at a wide mouth's corners as grey wedges, and the floor of
 // the mouth under the tongue's tip as a black diamond in the muscle engine's 27.)
 // That scattered light itself fades toward the throat: ``visibility`` (mouth_depth_visibility,
-// exp(-depth / 1.2 cm)) takes it from 0.4 of the lining's colour just inside the lips down to
-// CAVITY_BACK of that at the back of the mouth (~5 cm: 0.5 left at 1 cm, 0.3 at 3 cm), so the
-// back of an open mouth is near-black, as in photographs; uniform, the palate and the back
-// wall were one flat dark red ("mouth interior flat").
+// exp(-depth / 1.8 cm), or the light through the parted lips, mouth.opening_light) takes it
+// from 0.4 of the lining's colour just inside the lips down to CAVITY_BACK of that at the back
+// of the mouth (~5 cm: 0.6 left at 1 cm, 0.3 at 3 cm), so the back of an open mouth is dark,
+// as in photographs; uniform, the palate and the back wall were one flat dark red ("mouth
+// interior flat").
 const float CAVITY_BACK = 0.15;
 const float ROOF_LIGHT = 0.35;
+// Behind the lips, what light the opening lets in reaches the lining after bouncing off more
+// red lining and the tongue: warm. (Lit by the room's light as it is, the back of a wide-open
+// mouth, lit through the opening since session 23 (facsim.head.mouth.opening_light), was a
+// grey-mauve curtain.)
+const vec3 DEEP_LINING_BOUNCE = vec3(1.0, 0.7, 0.65);
 vec3 cavity_deep_colour(vec3 lining, float visibility) {
-    return 0.4 * lining * vec3(1.0, 0.9, 0.9) * mix(CAVITY_BACK, 1.0, sqrt(visibility));
+    return 0.4 * lining * vec3(1.0, 0.9, 0.9) * mix(CAVITY_BACK, 1.0, visibility);
 }
 #endif
 #ifdef REGION_TEETH
@@ -1277,7 +1283,7 @@ void main() {
     vec3 spec = specular_light(n, v, 30.0) * mix(0.04, 0.3, lip_side);
     vec3 deep = cavity_deep_colour(u_albedo, occ);
     vec3 albedo = mix(u_albedo * 0.45, MUCOSA * 0.8, lip_side);
-    radiance = (diffuse_light(n, vec3(0.3, 0.1, 0.1), 1.0) * albedo + spec) * mouth_shade
+    radiance = (diffuse_light(n, vec3(0.3, 0.1, 0.1), 1.0) * mix(DEEP_LINING_BOUNCE, vec3(1.0), lip_side) * albedo + spec) * mouth_shade
              + deep * (1.0 - mouth_shade);
 #endif
 
