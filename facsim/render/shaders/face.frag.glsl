@@ -345,12 +345,15 @@ const float IRIS_CAUSTIC = 0.3;    // how much brighter the iris's lower rim is 
 // The key's reflection in the cornea: the softbox's half-size (radians, across and up) and
 // strength; the room's faint reflection over the whole cornea. (Issue 13: at 0.22 x 0.19
 // with the fill's at 0.6, two large bright patches read as glossy doll's eyes.)
-const vec2 SOFTBOX = vec2(0.17, 0.14);
-// The key softbox is large: the cornea mirrors its lower part, ~16 degrees above the eye
+// (At 0.17 x 0.14, an even plate of ~1.1 mm² with a crisp edge, it still sat on the iris like a
+// sticker: now a ~30-cm box at 1.2 m, ~0.5 mm² on the cornea, brightest in its middle, its rim
+// fading out.)
+const vec2 SOFTBOX = vec2(0.1, 0.085);
+// The key softbox is tall: the cornea mirrors its lower part, ~16 degrees above the eye
 // rather than the key's ~30 (its middle's reflection lies under the upper lid of most eyes,
 // which then showed no catch-light at all: liam's did not).
 const float SOFTBOX_DROP = 0.22;
-const float KEY_REFLECTION = 0.65;   // (0.6 before dark irises kept their brown: the glint over them dimmed)
+const float KEY_REFLECTION = 1.6;   // (0.65 for a box 2.8 times the area: the same light from a smaller box is brighter)
 // The fill is a broad bounce card to the side: a larger, dimmer reflection (it shows where
 // a lowered lid hides the key's, as in photographs).
 const vec2 FILL_BOX = vec2(0.2, 0.3);
@@ -366,7 +369,7 @@ float softbox(vec3 refl, vec3 l, vec2 size) {
     float px = max(fwidth(q.x), fwidth(q.y));
     q *= q;
     float d = sqrt(sqrt(dot(q, q)));   // a superellipse: a rectangle with rounded corners
-    return (1.0 - smoothstep(0.2, 1.2 + px, d)) * (0.8 + 0.2 * (1.0 - min(d, 1.0))) * step(0.0, dot(refl, l));
+    return (1.0 - smoothstep(0.0, 1.3 + px, d)) * (0.7 + 0.3 * (1.0 - min(d, 1.0))) * step(0.0, dot(refl, l));
 }
 const float ROOM_REFLECTION = 0.035;
 // Along the lids (degrees of eyeball arc from the margins, facsim.render.geometry.lid_elevations):
