@@ -432,7 +432,7 @@ def test_the_afros_outline_is_a_soft_halo_not_a_cut_edge(face_of, name):
     into the background as a semi-transparent halo around a rounded mass instead of ending in
     its cards' polygonal, notched cut (blind review, session 22: "the afro's jagged outline").
     At 256², 2 px in from the background the hair's mean alpha was 0.49 (amara) and 0.50
-    (ngozi), now 0.34 and 0.32, the mass still solid further in (0.99 at 8 px); the solid
+    (ngozi), now 0.31 and 0.28, the mass still solid further in (0.99 at 8 px); the solid
     outline's jaggedness was 0.82 and 0.81 px, now 0.56 and 0.55."""
     (at_2, at_8), jagged = _afro_outline(face_of(name))
     assert at_2 < 0.42, at_2

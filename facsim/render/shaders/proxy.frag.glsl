@@ -576,9 +576,11 @@ void main() {
         // In the halo the coils are finer than a pixel and semi-transparent: their share, not
         // solid curls with gaps (which speckled it).
         float inside_mm = coily_inside_outline_mm(v_pos, v) + 2.0 * (coil_clump - 0.5) + 1.5 * (halo - 0.5);
-        // (the cards at the outline stand out edge-on past the volume's dome a centimetre and
-        // more, all a millimetre or so inside its outline by this measure: they are left out)
         float thinning = smoothstep(COILY_HALO_START_MM, COILY_HALO_START_MM + COILY_HALO_MM, inside_mm);
+        // Low on the sides, where the mass ends over the ears and meets the skin, it stays dense
+        // (thinned there, it showed its cards' corners as pale triangles beside the ears).
+        float below_dome = u_hair_apex.y - 1.25 * HAIR_VOLUME_RADIUS - v_pos.y;   // dm
+        thinning = mix(thinning, 1.0, smoothstep(0.4, 0.55, below_dome));
         curl_detail *= thinning;
         float curl_rank = clamp(0.5 + 2.2 * (curl_weight * halo + (1.0 - curl_weight) * coil_clump - 0.5), 0.02, 0.98);
         float share = alpha * mix(1.0, COILY_CAP_COVER, smoothstep(0.05, 0.4, v_edge) * (1.0 - smoothstep(0.1, 0.45, v_depth)));
