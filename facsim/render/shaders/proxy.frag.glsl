@@ -144,14 +144,13 @@ float strand_diffuse(vec3 t, vec3 l) {
 
 
 // Coily hair's outline is a halo: toward the mass's silhouette its fine coils thin out, so it
-// fades from solid into the background over a band of several millimetres, semi-transparent,
+// fades from solid into the background over a band of a few millimetres, semi-transparent,
 // rather than ending in the cards' polygonal cut (blind review, session 22: "the afro's jagged
 // outline"). The band is measured on the smooth volume the hair is shaded as (a dome over a
 // vertical axis, facsim.render.proxies.volume_normals, without the cards' own normals): how
 // far p lies inside its outline seen from the eye (mm; a sphere's radius r seen at
 // cos = n.v lies r (1 - sin) inside), so the fade follows a rounded outline, not the cards'.
 const float COILY_HALO_MM = 3.0;
-const float COILY_HALO_START_MM = 0.0;
 const float HAIR_VOLUME_RADIUS = 0.9;   // dm, facsim.render.proxies.VOLUME_RADIUS
 float coily_inside_outline_mm(vec3 p, vec3 v) {
     // (u_hair_apex lies a quarter radius above the crown, on the axis)
@@ -360,7 +359,7 @@ void main() {
     // Coily hair's coils thin out over the mass's halo as its cards do (coily_inside_outline_mm):
     // coils on the cards that stand out edge-on past it floated as a grey lace beside the mass.
     if (u_coil > 0.0)
-        alpha *= mix(1.0, smoothstep(COILY_HALO_START_MM - 1.0, COILY_HALO_START_MM + COILY_HALO_MM,
+        alpha *= mix(1.0, smoothstep(-1.0, COILY_HALO_MM,
                                      coily_inside_outline_mm(v_pos, v)), u_coil);
     if (alpha < 0.01) discard;
     vec3 n = normalize(v_normal);
@@ -445,7 +444,7 @@ void main() {
 #ifdef COILY
     // (coily hair fades over its halo band, coily_inside_outline_mm, not only where n.v is low)
     if (alpha < 0.02 || (alpha >= ALPHA_CUTOFF && v_edge < 0.1 && v_cover > 0.999 && dot(n, v) >= 0.28
-                         && coily_inside_outline_mm(v_pos, v) > COILY_HALO_START_MM + COILY_HALO_MM + 3.0)) discard;
+                         && coily_inside_outline_mm(v_pos, v) > COILY_HALO_MM + 3.0)) discard;
 #else
     if (alpha < 0.02 || (alpha >= ALPHA_CUTOFF && v_edge < 0.1 && v_cover > 0.999 && dot(n, v) >= 0.28)) discard;
 #endif
@@ -576,7 +575,7 @@ void main() {
         // In the halo the coils are finer than a pixel and semi-transparent: their share, not
         // solid curls with gaps (which speckled it).
         float inside_mm = coily_inside_outline_mm(v_pos, v) + 2.0 * (coil_clump - 0.5) + 1.5 * (halo - 0.5);
-        float thinning = smoothstep(COILY_HALO_START_MM, COILY_HALO_START_MM + COILY_HALO_MM, inside_mm);
+        float thinning = smoothstep(0.0, COILY_HALO_MM, inside_mm);
         // Low on the sides, where the mass ends over the ears and meets the skin, it stays dense
         // (thinned there, it showed its cards' corners as pale triangles beside the ears).
         float below_dome = u_hair_apex.y - 1.25 * HAIR_VOLUME_RADIUS - v_pos.y;   // dm
