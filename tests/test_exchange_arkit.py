@@ -58,7 +58,7 @@ def test_weights_are_the_registers_faceunits_targets():
                 name = reg["target"][len("faceunits/"):].replace("{Side}", "Left")
                 assert weights[name] >= min(reg["max"], 1.0) - 1e-9, (code, name)
     weights = arkit_weights(Activations({(12, "left"): 0.5}))
-    half = response(0.5)   # the engine's concave response: half intensity moves more than half-way
+    half = response(0.5, 12)   # 12's concave response: half intensity moves more than half-way
     smile_max = {r["target"]: r["max"] for r in register_table()["action_units"][12]["registers"]}
     assert weights["mouthSmileLeft"] == pytest.approx(half * smile_max["faceunits/mouthSmile{Side}"])
     assert weights["mouthSmileRight"] == 0.0

@@ -170,7 +170,7 @@ def test_animation_has_weights_head_and_eye_channels_sampled_per_frame(animated)
     frame = 5                                                       # t = 0.5 s
     act = sample(TIMELINE, frame / 10)
     # each target is its AU at E, weighted as the register engine moves it (its concave response)
-    assert weights[frame, names.index("AU12_L")] == pytest.approx(response(act[12, "left"]))
+    assert weights[frame, names.index("AU12_L")] == pytest.approx(response(act[12, "left"], 12))
     assert weights[frame, names.index("AU26")] == pytest.approx(response(act.level(26)))
     assert 0.0 < act.level(26) < response(act.level(26)) < 1.0
     quats = accessor(doc, blob, by_target["head", "rotation"]["output"])

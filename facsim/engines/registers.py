@@ -53,11 +53,17 @@ def simulated_codes() -> set[int]:
     return set(register_table()["action_units"]) | rigid_codes()
 
 
-def response(level: float) -> float:
-    """The share of its registers' maxima an AU reaches at intensity ``level`` (0..1).
+def stiffening(code: int | None = None) -> float:
+    """The ``k`` of :func:`response`: AU ``code``'s own ``stiffening`` in the table, else the table's."""
+    entry = register_table()["action_units"].get(code, {}) if code is not None else {}
+    return float(entry.get("stiffening", register_table()["response"]["stiffening"]))
 
-    ``ln(1 + k·level) / ln(1 + k)`` with ``k`` the table's ``response: stiffening``:
-    0 at 0, 1 at 1, concave, as skin that stiffens as it stretches moves under a
+
+def response(level: float, code: int | None = None) -> float:
+    """The share of its registers' maxima AU ``code`` reaches at intensity ``level`` (0..1).
+
+    ``ln(1 + k·level) / ln(1 + k)`` with ``k`` the table's ``response: stiffening`` (or the AU's
+    own): 0 at 0, 1 at 1, concave, as skin that stiffens as it stretches moves under a
     growing pull (the reasoning and the fit are in ``registers.yaml``).
 
     >>> response(0.0), response(1.0)
@@ -65,17 +71,17 @@ def response(level: float) -> float:
     >>> round(response(0.5), 2)
     0.62
     """
-    k = float(register_table()["response"]["stiffening"])
+    k = stiffening(code)
     return math.log1p(k * level) / math.log1p(k)
 
 
-def response_inverse(weight: float) -> float:
+def response_inverse(weight: float, code: int | None = None) -> float:
     """The intensity whose :func:`response` is ``weight`` (0..1): reads levels back from weights.
 
     >>> round(response_inverse(response(0.3)), 12)
     0.3
     """
-    k = float(register_table()["response"]["stiffening"])
+    k = stiffening(code)
     return math.expm1(weight * math.log1p(k)) / k
 
 
@@ -142,7 +148,7 @@ def register_weights(act: Activations, fitted: Mapping[tuple[int, str], float] |
         if table.get(code, {}).get("direction") and side == "right" and act[code, "left"] == level:
             continue  # a direction code given without a side (e.g. 30) moves to the left only
         scale = combination_scales(act, code, side)
-        weight = response(level)
+        weight = response(level, code)
         for reg in table.get(code, {}).get("registers", []):
             vmax = float(reg["max"]) * scale.get(reg["target"], 1.0) * fitted.get((code, reg["target"]), 1.0)
             contributions.setdefault(Column(reg["target"], side), []).append((weight, vmax))

@@ -220,7 +220,7 @@ def au_levels(weights: np.ndarray) -> np.ndarray:
     morphs = register_table()["action_units"]
     for j, (code, _) in enumerate(unknowns):
         if code in morphs:
-            out[:, j] = [response_inverse(u) for u in np.clip(out[:, j], 0.0, 1.0)]
+            out[:, j] = [response_inverse(u, code) for u in np.clip(out[:, j], 0.0, 1.0)]
     out[out < LEVEL_FLOOR] = 0.0
     return np.clip(out, 0.0, 1.0)
 

@@ -255,7 +255,7 @@ def target_weights(act, keys) -> np.ndarray:
     """
     from facsim.engines.registers import response
 
-    return np.array([response(act.level(code) if side == "both" else act[code, side]) for code, side in keys],
+    return np.array([response(act.level(code) if side == "both" else act[code, side], code) for code, side in keys],
                     np.float32)
 
 
