@@ -87,7 +87,8 @@ def test_each_eye_shows_one_catch_light(name):
     for side in (slice(0, SIZE // 2), slice(SIZE // 2, SIZE)):
         _, count = ndimage.label(bright[:, side], structure=np.ones((3, 3)))
         assert count == 1, count
-    assert bright.sum() < 0.05 * cornea.sum()   # small
+    # (Its size: test_the_catch_light_is_a_small_bright_reflection_not_a_sticker, at 768 px, in
+    # mm². Here, at 320, a catch-light about a pixel across spreads over its neighbours.)
 
 
 def test_the_upper_lid_and_lashes_shade_the_sclera_below_them(eye_pixels):
@@ -162,3 +163,28 @@ def test_the_catch_light_is_a_small_bright_reflection_not_a_sticker(name):
         core = eye & (lum > (peak + iris) / 2)
         assert peak > 200, peak
         assert core.sum() / px_per_mm ** 2 < 1.4, core.sum() / px_per_mm ** 2
+
+
+@pytest.mark.parametrize("name", ["george", "kwame"])
+def test_a_relaxed_or_hooded_lid_leaves_the_catch_light_in_view(name):
+    """At rest the upper lid covers 2 mm or more of the iris's top (lids.yaml), and on hooded
+    eyes reaches the pupil: the reflection of a key ~20 degrees above the eyes lay under it, and
+    george's, kwame's, liam's and noah's eyes showed no catch-light at 448² (dead eyes). The
+    cornea mirrors the softbox's lower part, near the eyes' level, as in studio portraits.
+    (With the default 4x MSAA: a catch-light about a pixel across falls between single samples.)"""
+    from scipy import ndimage
+
+    size = 448
+    character = preset(name)
+    renders = {}
+    for key, colors in (("normal", {}), ("cornea", {"iris": "#ff0000", "pupil": "#ff0000"}), ("sclera", {"sclera": "#00ff00"})):
+        with Face(character.with_(colors={**character.colors, **colors})) as face:
+            renders[key] = face.render("", size=size, antialias=4, background=(1.0, 1.0, 1.0))[..., :3].astype(int)
+    image = renders["normal"]
+    sclera = np.abs(renders["sclera"] - image).sum(-1) > 60
+    # (Grown by two pixels, less the white: a catch-light is near white in both renders, and at
+    # the lid's margin it mixes with the lashes: no hole in the cornea's mask.)
+    cornea = ndimage.binary_dilation(np.abs(renders["cornea"] - image).sum(-1) > 60, iterations=2) & ~sclera
+    lum = _luminance(image)
+    peaks = [lum[:, side][cornea[:, side]].max() for side in (slice(0, size // 2), slice(size // 2, size))]
+    assert min(peaks) > 165, peaks

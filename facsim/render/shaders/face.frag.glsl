@@ -349,10 +349,12 @@ const float IRIS_CAUSTIC = 0.3;    // how much brighter the iris's lower rim is 
 // sticker: now a ~30-cm box at 1.2 m, ~0.5 mm² on the cornea, brightest in its middle, its rim
 // fading out.)
 const vec2 SOFTBOX = vec2(0.1, 0.085);
-// The key softbox is tall: the cornea mirrors its lower part, ~16 degrees above the eye
-// rather than the key's ~30 (its middle's reflection lies under the upper lid of most eyes,
-// which then showed no catch-light at all: liam's did not).
-const float SOFTBOX_DROP = 0.22;
+// The key softbox is tall: the cornea mirrors its lower part, near the eyes' level, rather
+// than the key's middle ~30 degrees up, whose reflection lies under the upper lid. (At ~16
+// degrees up it still lay under the relaxed lids of most presets: george, kwame, liam and noah
+// showed no catch-light at 448², dead eyes; now about level with the eyes, as with the flash of
+// stimulus photographs.)
+const float SOFTBOX_DROP = 0.55;
 const float KEY_REFLECTION = 1.6;   // (0.65 for a box 2.8 times the area: the same light from a smaller box is brighter)
 // The fill is a broad bounce card to the side: a larger, dimmer reflection (it shows where
 // a lowered lid hides the key's, as in photographs).
