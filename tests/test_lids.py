@@ -115,6 +115,36 @@ def test_5E_bares_the_sclera_above_the_iris_on_every_preset(face_of, name):
     assert -_cover_mm(face, face.neutral) < 0.0                 # at rest the lid covers the iris's top
 
 
+def _over_iris_mm(face, expression) -> float:
+    """How far (iris-mm) the upper margin over the pupil stands above the iris's top in ``expression``."""
+    centre, radius = face.head.eye_pivot(face.base_positions, "left")
+    iris_mm = 100.0 * float(rest_table()["iris_radius"]) * radius / (0.5 * float(rest_table()["iris_mm"]))
+    positions = face.deform(expression).positions if expression else face.neutral
+    return -_cover_mm(face, positions) / iris_mm
+
+
+@pytest.mark.parametrize("name", ["george", "kwame"])
+def test_raised_brows_let_5_lift_a_hooded_lid_off_the_iris(face_of, name):
+    """FACS 1+2 stretch the skin between the brow and the lid's crease upward, lifting a hooded
+    lid's fold, and in surprise (1+2+5B) the eye looks widened. Session 23: george's and kwame's
+    lids (sculpted 5.4 and 4.8 mm over the iris) stayed 1.6 and 1.4 mm below the iris's top at
+    1+2+5B, as at 5B, and their surprise read as fear (lids.yaml `raise` `hood_lift`). The margin
+    itself still rises only with 5."""
+    face = face_of(name)
+    assert _over_iris_mm(face, "1+2+5B") > 0.5
+    assert _over_iris_mm(face, "1+2+5B") > _over_iris_mm(face, "5B") + 1.5
+    assert abs(_over_iris_mm(face, "1+2") - _over_iris_mm(face, "")) < 0.2
+    assert _over_iris_mm(face, "1+2+4+5B") < _over_iris_mm(face, "1+2+5B") - 1.0  # 4 brings the lid's skin down
+
+
+@pytest.mark.parametrize("name", ["ava", "amara"])
+def test_raised_brows_leave_open_lids_to_5(face_of, name):
+    """Open lids get no hood lift: 1+2+5B raises ava's and amara's margins as 5B does (session 19:
+    their lids raised further looked "bulging")."""
+    face = face_of(name)
+    assert abs(_over_iris_mm(face, "1+2+5B") - _over_iris_mm(face, "5B")) < 0.2
+
+
 def test_the_lids_shade_on_the_eyeball_follows_the_upper_lid(face_of):
     """Sclera just above the iris lies under the upper lid or in its shadow at rest (the shader
     shades the eyeball by its distance below the margin, Face.frame_lids), bared by 5, covered

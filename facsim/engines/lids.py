@@ -280,6 +280,19 @@ def raise_gain(lids: EyeLids, rest: np.ndarray, raising: np.ndarray, radius: flo
     return float(np.clip((iris_top + bare * mm - height) / lift, low, high))
 
 
+def hooded_share(lids: EyeLids, rest: np.ndarray, radius: float, spec: dict | None = None) -> float:
+    """How hooded this eye's upper lid is, 0 to 1: the smoothstep of its sculpted margin's cover of
+    the iris (mm, on ``rest`` (N, 3), over the pupil) over ``hooded``'s ``cover_mm`` (``lids.yaml``
+    ``raise``), as in :func:`bare_mm`. 0 where the eye has no upper margin to measure."""
+    table = load_yaml("lids.yaml")
+    rest_spec, spec = table["rest"], spec or table["raise"]
+    if not lids.ok:
+        return 0.0
+    _, height = _margin_over_pupil(lids, rest, float(rest_spec["ahead_degrees"]))
+    cover = (float(rest_spec["iris_radius"]) * radius - height) / _rest_mm(radius, rest_spec)
+    return float(smoothstep(*(float(c) for c in spec["hooded"]["cover_mm"]), cover))
+
+
 def squint_gain(lids: EyeLids, rest: np.ndarray, lifting: np.ndarray, squint: np.ndarray, spec: dict) -> float:
     """The factor on AU 6's lower-lid target that leaves this eye ``open_share`` of its aperture at 6E.
 

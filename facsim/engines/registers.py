@@ -474,6 +474,34 @@ class RegisterEngine:
         return frozenset(reg["target"] for reg in registers), float(np.mean(gains))
 
     @cached_property
+    def hooded(self) -> float:
+        """How hooded this character's upper lids are, 0 (open) to 1 (the mean of both eyes,
+        :func:`~facsim.engines.lids.hooded_share`)."""
+        from facsim.engines.lids import hooded_share
+
+        skin = self.head.skin_vertex_count
+        return float(np.mean([hooded_share(self.lids["faceunits/eyeBlink{Side}", side], self.sculpted[:skin],
+                                           self.head.eye_pivot(self.base_positions, side)[1])
+                              for side in ("left", "right")]))
+
+    def _hood_lifted(self, act: Activations) -> Activations:
+        """``act`` with a hooded lid's AU 5 raised further under 1+2 (``lids.yaml`` ``raise``
+        ``hood_lift``): by ``share`` of its own level times :attr:`hooded` and the smaller of 1's
+        and 2's levels on each side, at most to 5E; none with ``unless`` (4)."""
+        spec = load_yaml("lids.yaml")["raise"]
+        rule, code = spec.get("hood_lift"), int(spec["au"])
+        if not rule or not self.hooded:
+            return act
+        levels = dict(act)
+        for side in ("left", "right"):
+            own = act[code, side]
+            if own <= 0 or any(act[int(c), side] > 0 for c in rule.get("unless", ())):
+                continue
+            brows = min(act[int(c), side] for c in rule["with"])
+            levels[code, side] = min(own * (1.0 + float(rule["share"]) * self.hooded * brows), max(own, 1.0))
+        return Activations(levels)
+
+    @cached_property
     def brow_push(self) -> dict[tuple[int, str], float]:
         """The lowered brow's push on the upper lid fitted to the character (``lids.yaml``
         ``brow_push``): AU 4's share of the closing target, scaled so that at E it lowers the relaxed
@@ -530,7 +558,7 @@ class RegisterEngine:
         raising, raise_gain = self.lid_raise
         weights = {col: w * (1.0 if col.pattern in BONE_TARGETS else self.side_gain[col.side])
                    * (raise_gain if col.pattern in raising else 1.0)
-                   for col, w in register_weights(act, {**self.brow_push, **self.squint}).items()}
+                   for col, w in register_weights(self._hood_lifted(act), {**self.brow_push, **self.squint}).items()}
         for side in ("left", "right"):
             for pattern, share in ((rest_table()["target"], self.rest_lids.share(act, side)),
                                    (rest_table()["lower"]["target"], self.rest_lids.lower_share(act, side))):
