@@ -5,6 +5,7 @@ import dataclasses
 
 import numpy as np
 import pytest
+from scipy.ndimage import gaussian_filter
 
 from facsim.render.camera import project
 
@@ -651,3 +652,35 @@ def test_a_shaved_beards_shadow_is_a_stipple_of_stubble_not_an_even_tint(face_of
     assert face.appearance.beard > 0.5
     ratio = grain(face.appearance) / grain(dataclasses.replace(face.appearance, beard=0.0))
     assert ratio > 1.25, ratio
+
+
+def test_an_oily_forehead_shows_a_sharp_broken_highlight_not_one_broad_glaze(face_of, marks):
+    """Sebum lies in pools a few millimetres across with drier skin between them, so the forehead's
+    highlight is sharp and broken, and most of the forehead stays matte; the T-zone still shines
+    more than the cheeks. The specular light is what does not scale with the skin's colour (a
+    render with the skin's albedo halved). (On main 98c87e1 kwame's forehead at 448 px showed one
+    broad even glaze, "plastic": 10.2 % of it above half the highlight's peak.)"""
+    face = face_of("kwame")
+    size = 448
+    camera = face.camera(size=(size, size))
+
+    def luminance(colors):
+        image = face.renderer(size=size, body="none").render(
+            face.neutral, appearance=dataclasses.replace(face.appearance, colors=colors), camera=camera,
+            occlusion=face.shading_occlusion, proxies=face.proxy_draws(face.neutral))[..., :3] / 255.0
+        linear = np.where(image <= 0.04045, image / 12.92, ((image + 0.055) / 1.055) ** 2.4)
+        return linear @ np.array([0.2126, 0.7152, 0.0722])
+
+    colors = dict(face.appearance.colors)
+    darker = {k: tuple(np.array(colors[k]) * 0.5 ** (1 / 2.2)) for k in ("skin", "cheek", "eyelid", "lips")}
+    full, half = luminance(colors), luminance({**colors, **darker})
+    specular = np.clip(full - 2 * (full - half), 0, None)
+    forehead = face.neutral[marks["glabella"]] + np.array([0.0, 0.25, -0.03])
+    cheek = face.neutral[marks["cheek_left"]] + np.array([-0.08, 0.05, 0.1])
+    (x, y), (cx, cy) = project(camera, [forehead, cheek], size)[0].astype(int)
+    box = (slice(y - 25, y + 25), slice(x - 40, x + 40))       # ~5 x 8 cm of the forehead
+    highlight = gaussian_filter(specular, 1.5)[box]
+    assert np.mean(highlight > 0.5 * highlight.max()) < 0.09
+    share = specular[box].sum() / full[box].sum()
+    cheek_box = (slice(cy - 10, cy + 11), slice(cx - 10, cx + 11))
+    assert share > 3 * specular[cheek_box].sum() / full[cheek_box].sum()

@@ -923,6 +923,7 @@ void main() {
     float ndv = max(dot(n, v), 1e-4);
     float oil = detail.b * (1.0 - 0.35 * u_age) * mix(0.8, 1.15, patches) * (1.0 - lips);
     float film = smoothstep(0.75, 1.05, oil);
+    film *= film > 0.0 ? oil_pools(skin_uv) : 1.0;   // pooled, not an even glaze (skin_light.glsl)
     // Moist, but the film is broken by the furrows and by the lips' fine mottle: a continuous
     // glossy band along the lip read as rubber.
     // The film beads and dries in patches a millimetre or two across (moist), so the narrow
@@ -939,6 +940,10 @@ void main() {
     // (Times pi: the diffuse term here is albedo times N.L, without the Lambert 1/pi.)
     spec *= PI * (1.0 - hair) * (0.85 + 0.3 * grain) * spec_break
           * max(1.0 + PORE_SHEEN * (0.6 + tone.b) * (1.0 - lips) * pores, 0.0);
+    // The same surface mirrors the room (sky and ground) too, faintly and evenly, F0 of it: a
+    // thin veil of white over the skin's colour between the highlights (without it, the T-zone's
+    // sheen pooled into sharp highlights left the skin between them a more saturated paint).
+    spec += schlick(SKIN_F0, ndv) * (weight.x + weight.y) * hemisphere(reflect(-v, bumped)) * (1.0 - hair) * spec_break;
     // The mucosa's film of saliva mirrors the lights in a thin bright line where the lip's
     // inner edge turns toward them. (A branch: llvmpipe skips it for the blocks of pixels
     // away from the lips, nearly all of them.)

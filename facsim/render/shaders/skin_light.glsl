@@ -22,14 +22,29 @@ float scatter_reach(float curvature) {
 // film (``wet``: the lips' film and the mucosa) their own. (Until
 // session 18 one broad lobe of weight 0.6 and roughness 0.6 lay over the whole face.)
 struct SkinLobes { vec2 weight; vec2 roughness; };
+// Sebum pools on an oily T-zone: the film gathers in the skin's relief in pools a few
+// millimetres across (cells ~6 and ~2.5 mm on hm08's face UV) with drier skin between them, so
+// its highlight is broken and sharper, not one broad even glaze (kwame's "plastic" forehead,
+// session 22's blind review). Returns the film's thickness multiplier, 0 (dry) to OIL_POOL_PEAK,
+// a little over 1 on average: the tighter lobe keeps the T-zone shinier than the cheeks.
+const vec2 OIL_POOL_CELLS = vec2(60.0, 120.0);
+const float OIL_POOL_PEAK = 1.8;
+float oil_pools(vec2 skin_uv) {
+    float n = 0.65 * value_noise(skin_uv * OIL_POOL_CELLS + 53.0, 0)
+            + 0.35 * value_noise(GRAIN_TURN * skin_uv * (2.4 * OIL_POOL_CELLS) + 71.0, 0);
+    return OIL_POOL_PEAK * smoothstep(0.30, 0.60, n);
+}
+const float TZONE_BROAD_WEIGHT = 0.6;   // the horny layer's broad lobe on the T-zone (0.62 until session 23)
+const float OIL_FILM_WEIGHT = 0.26;     // the film's tight lobe where it lies, times oil_pools (0.22)
+const float OIL_FILM_ROUGHNESS = 0.36;  // (0.42 until session 23: one broad, even highlight)
 SkinLobes skin_lobes(float oil, float film, float lips, float wet, float blotch, float patches) {
     float tzone = smoothstep(0.4, 0.85, oil);
     float lip = max(lips, min(2.0 * wet, 1.0));   // the lips' lobes (LIP_LOBES in face.frag.glsl)
     float uneven = (0.7 + 0.6 * patches) * (0.8 + 0.4 * blotch);
     SkinLobes l;
-    l.weight = vec2(mix(mix(0.42, 0.62, tzone) * uneven, LIP_LOBES.x, lip),
-                    (0.08 * tzone + 0.22 * film) * uneven + LIP_LOBES.y * wet);
-    l.roughness = vec2(mix(mix(0.66, 0.54, tzone), LIP_BROAD_ROUGHNESS, lip), mix(mix(0.48, 0.42, film), LIP_ROUGHNESS, lip));
+    l.weight = vec2(mix(mix(0.42, TZONE_BROAD_WEIGHT, tzone) * uneven, LIP_LOBES.x, lip),
+                    (0.08 * tzone + OIL_FILM_WEIGHT * film) * uneven + LIP_LOBES.y * wet);
+    l.roughness = vec2(mix(mix(0.66, 0.54, tzone), LIP_BROAD_ROUGHNESS, lip), mix(mix(0.48, OIL_FILM_ROUGHNESS, min(film, 1.0)), LIP_ROUGHNESS, lip));
     return l;
 }
 #endif
