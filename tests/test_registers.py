@@ -885,3 +885,26 @@ def test_27_stretches_the_mouth_open_taller_not_wider(face_of, character):
     rest, open_ = mouth_shape(face, positions=face.neutral), mouth_shape(face, positions=face.deform("27E").positions)
     assert open_.width < rest.width - 4.0      # mm: the corners drawn in
     assert open_.gap > 0.6 * open_.width       # the opening's height against the mouth's width
+
+
+@pytest.mark.parametrize("character", ["george", "ava", "kwame", "mei"])
+def test_the_dropped_jaw_parts_the_lips_in_an_oval(face_of, character):
+    """FACS 26/27: the lower lip rests on the mandible and, as the jaw drops, follows the chin in a
+    rounded U. ARKit's jawOpen drops the lip's middle most, and the per-point limit to the chin's turn
+    cut that U's bottom flat, the lip's outer parts left high: a flat bottom between straight walls
+    (the "trapezoid mouth" of george's fear, session 22's blind reviewer). The lower rim's vertices
+    0.6-0.85 of the way to the corner rose 1.4-2.3 times as high as on an oval through the rim's
+    middle and corner on main 98c87e1 (26E: 1.56-2.29); now 0.6-1.2 at 26E, 0.9-1.7 at 27E."""
+    face = face_of(character)
+    rest = np.asarray(face.neutral, np.float64)
+    rim = face._mouth_rim.lower
+    left = rim[np.argsort(rest[rim, 0])]
+    left = left[len(left) // 2:]                       # the middle out to the left corner
+    for text, most, mean in (("26E", 1.4, 1.4), ("27E", 1.9, 1.6)):
+        moved = np.asarray(face.deform(text).positions, np.float64)
+        x, rise = moved[left, 0] - moved[left[0], 0], moved[left, 1] - moved[left[0], 1]
+        oval = rise[-1] * (1.0 - np.sqrt(np.clip(1.0 - (x / x[-1]) ** 2, 0.0, 1.0)))
+        near = (x > 0.6 * x[-1]) & (x < 0.85 * x[-1])
+        if near.any():   # ava's rim has no vertex there at 27E
+            ratio = rise[near] / oval[near]
+            assert ratio.max() < most and ratio.mean() < mean, (character, text, ratio)

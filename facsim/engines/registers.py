@@ -358,12 +358,38 @@ class RegisterEngine:
             share = self._on_the_bone(bone)
             carried = carried_by_the_bone(out[:skin], positions[:skin], hinge, marks[spec["reference"]])
             out[:skin] += share[:, None].astype(out.dtype) * (carried - out[:skin])
+        lower_lip = spec.get("lower_lip")
+        if lower_lip:
+            out[:skin] *= self._lower_lip_turn(out[:skin], positions[:skin], hinge, lower_lip)[:, None].astype(out.dtype)
         held = spec.get("maxilla")
         if held:
             lip_line = float(np.mean([positions[marks[f"{held['lip_line']}_{side}"], 1] for side in ("left", "right")]))
             band = (float(held["free_below_mm"]) / 100.0, float(held["held_above_mm"]) / 100.0)
             out[:skin] *= mandible_share(positions[:skin, 1], lip_line, band)[:, None].astype(out.dtype)
         return out
+
+    def _lower_lip_turn(self, offsets: np.ndarray, positions: np.ndarray, hinge: np.ndarray, spec: Mapping) -> np.ndarray:
+        """Per skin point (N_skin,), the factor on the jaw target's ``offsets`` (N_skin, 3) that turns the lower
+        lip and the lining behind it (below the corners' line) as far about ``hinge`` as the chin, in full
+        within ``spec["full_within"]`` of the mouth's half-width and fading to the target's own turn at the
+        corners (``mandible.lower_lip`` in the table). Points turning less than ``spec["min_share"]`` of the
+        chin's angle keep their own turn: mostly the upper lip's inner side, hanging below that line."""
+        from facsim.engines.muscle.net import MOUTH, anatomy, mask_per_vertex
+        from facsim.head.landmarks import landmarks
+
+        anat = anatomy(self.head)
+        marks = landmarks(self.head)
+        angles = turning_angles(offsets, positions, hinge)
+        chin = float(angles[marks[mandible_spec()["reference"]]])
+        corners = [positions[marks[f"lip_corner_{side}"]] for side in ("left", "right")]
+        half_width = float(np.mean([abs(c[0]) for c in corners]))
+        lip_line = float(np.mean([c[1] for c in corners]))
+        lips = mask_per_vertex(self.head, "lips")[: anat.skin_count]
+        lips = np.maximum(lips, lips[anat.mirror[: anat.skin_count]])
+        lower = (((lips > 0.5) | (anat.kind == MOUTH)) & (positions[:, 1] < lip_line)
+                 & (angles > float(spec["min_share"]) * chin) & (angles < chin))
+        taper = smoothstep(half_width, float(spec["full_within"]) * half_width, np.abs(positions[:, 0]))
+        return np.where(lower, 1.0 + taper * (chin / np.maximum(angles, 1e-12) - 1.0), 1.0)
 
     def _on_the_bone(self, spec: Mapping) -> np.ndarray:
         """How much of each skin point (N_skin,) moves rigidly with the mandible: the muscle engine's
