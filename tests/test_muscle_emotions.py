@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from facsim.engines.muscle import SETTLED_ITERATIONS
 from facsim.facs.activations import activations
 from facsim.facs.emotions import emotion
 from facsim.facs.notation import parse
@@ -34,7 +35,7 @@ def figures(face_of):
     engine = face.engine
     marks, gauge = landmarks(face.head), MouthGauge(face.head, face.neutral)
     rest = np.asarray(engine.neutral, float)
-    solved = engine.solve_many([activations(e) for e in EXPRESSIONS.values()])
+    solved = engine.solve_many([activations(e) for e in EXPRESSIONS.values()], iterations=SETTLED_ITERATIONS)
 
     def measure(p):
         def rise(name):

@@ -4,6 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from facsim.engines.muscle import SETTLED_ITERATIONS as SETTLED
 from facsim.facs.catalogue import catalogue
 from facsim.facs.activations import Activations, activations
 from facsim.facs.notation import parse
@@ -175,11 +176,6 @@ def test_smile_lifts_the_corners_not_the_lower_lip(single, marks):
     assert delta[marks["lower_lip"], Y] < 0.4 * corner
 
 
-#: Minimiser iterations per increment at which the checks below are settled. The static solve's
-#: 60 stop short, and where they stop depends on the batch: on session 21's main, noah's corner
-#: went 8.7 mm out in 12 and 6 after 12 lifted it 0.9 mm more in one batch (both checks failed),
-#: 10.3 and 0.3 in another, 11.1 and 0.07 settled (200 and 600 iterations alike).
-SETTLED = 200
 
 
 def test_smile_draws_the_corners_up_and_out(engine, marks):
