@@ -276,21 +276,24 @@ def raise_gain(lids: EyeLids, rest: np.ndarray, raising: np.ndarray, radius: flo
     low, high = (float(g) for g in spec["gain"])
     if lift <= 1e-9:
         return 1.0
-    bare = bare_mm((iris_top - height) / mm, spec)
+    bare = bare_mm(_cover_mm(lids, rest, radius, rest_spec), spec)
     return float(np.clip((iris_top + bare * mm - height) / lift, low, high))
 
 
 def hooded_share(lids: EyeLids, rest: np.ndarray, radius: float, spec: dict | None = None) -> float:
     """How hooded this eye's upper lid is, 0 to 1: the smoothstep of its sculpted margin's cover of
     the iris (mm, on ``rest`` (N, 3), over the pupil) over ``hooded``'s ``cover_mm`` (``lids.yaml``
-    ``raise``), as in :func:`bare_mm`. 0 where the eye has no upper margin to measure."""
+    ``raise``, :func:`hood_share`). 0 where the eye has no upper margin to measure."""
     table = load_yaml("lids.yaml")
-    rest_spec, spec = table["rest"], spec or table["raise"]
     if not lids.ok:
         return 0.0
+    return hood_share(_cover_mm(lids, rest, radius, table["rest"]), spec or table["raise"])
+
+
+def _cover_mm(lids: EyeLids, rest: np.ndarray, radius: float, rest_spec: dict) -> float:
+    """How much of the iris (iris-mm) the upper margin over the pupil covers on ``rest`` (N, 3)."""
     _, height = _margin_over_pupil(lids, rest, float(rest_spec["ahead_degrees"]))
-    cover = (float(rest_spec["iris_radius"]) * radius - height) / _rest_mm(radius, rest_spec)
-    return float(smoothstep(*(float(c) for c in spec["hooded"]["cover_mm"]), cover))
+    return (float(rest_spec["iris_radius"]) * radius - height) / _rest_mm(radius, rest_spec)
 
 
 def squint_gain(lids: EyeLids, rest: np.ndarray, lifting: np.ndarray, squint: np.ndarray, spec: dict) -> float:
@@ -332,8 +335,18 @@ def bare_mm(cover_mm: float, spec: dict) -> float:
     hooded = spec.get("hooded")
     if not hooded:
         return float(spec["bare_mm"])
-    share = float(smoothstep(*(float(c) for c in hooded["cover_mm"]), cover_mm))
-    return float(spec["bare_mm"]) + share * (float(hooded["bare_mm"]) - float(spec["bare_mm"]))
+    return float(spec["bare_mm"]) + hood_share(cover_mm, spec) * (float(hooded["bare_mm"]) - float(spec["bare_mm"]))
+
+
+def hood_share(cover_mm: float, spec: dict) -> float:
+    """How hooded (0 to 1) a lid whose sculpted margin covers ``cover_mm`` of the iris is: the smoothstep
+    over ``spec["hooded"]["cover_mm"]`` (``lids.yaml`` ``raise``).
+
+    >>> spec = {"hooded": {"cover_mm": [2.5, 4.0]}}
+    >>> [round(hood_share(c, spec), 2) for c in (1.0, 3.25, 5.0)]
+    [0.0, 0.5, 1.0]
+    """
+    return float(smoothstep(*(float(c) for c in spec["hooded"]["cover_mm"]), cover_mm))
 
 
 @dataclass(frozen=True)

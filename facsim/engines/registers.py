@@ -374,7 +374,7 @@ class RegisterEngine:
         within ``spec["full_within"]`` of the mouth's half-width and fading to the target's own turn at the
         corners (``mandible.lower_lip`` in the table). Points turning less than ``spec["min_share"]`` of the
         chin's angle keep their own turn: mostly the upper lip's inner side, hanging below that line."""
-        from facsim.engines.muscle.net import MOUTH, anatomy, mask_per_vertex
+        from facsim.engines.muscle.net import MOUTH, anatomy
         from facsim.head.landmarks import landmarks
 
         anat = anatomy(self.head)
@@ -384,23 +384,29 @@ class RegisterEngine:
         corners = [positions[marks[f"lip_corner_{side}"]] for side in ("left", "right")]
         half_width = float(np.mean([abs(c[0]) for c in corners]))
         lip_line = float(np.mean([c[1] for c in corners]))
-        lips = mask_per_vertex(self.head, "lips")[: anat.skin_count]
-        lips = np.maximum(lips, lips[anat.mirror[: anat.skin_count]])
-        lower = (((lips > 0.5) | (anat.kind == MOUTH)) & (positions[:, 1] < lip_line)
+        lower = (((self._lips > 0.5) | (anat.kind == MOUTH)) & (positions[:, 1] < lip_line)
                  & (angles > float(spec["min_share"]) * chin) & (angles < chin))
         taper = smoothstep(half_width, float(spec["full_within"]) * half_width, np.abs(positions[:, 0]))
         return np.where(lower, 1.0 + taper * (chin / np.maximum(angles, 1e-12) - 1.0), 1.0)
+
+    @cached_property
+    def _lips(self) -> np.ndarray:
+        """The lips' mask per skin point (N_skin,), 0 to 1, made symmetric (the larger of a point's and its
+        mirror's), so both halves of the mouth are treated alike."""
+        from facsim.engines.muscle.net import anatomy, mask_per_vertex
+
+        anat = anatomy(self.head)
+        lips = mask_per_vertex(self.head, "lips")[: anat.skin_count]
+        return np.maximum(lips, lips[anat.mirror[: anat.skin_count]])
 
     def _on_the_bone(self, spec: Mapping) -> np.ndarray:
         """How much of each skin point (N_skin,) moves rigidly with the mandible: the muscle engine's
         jaw attachment (:func:`~facsim.engines.muscle.net.anatomy`), less the lips and the mouth's lining,
         which stretch over the teeth and keep the target's own motion."""
-        from facsim.engines.muscle.net import MOUTH, adjacency, anatomy, mask_per_vertex, smooth_field
+        from facsim.engines.muscle.net import MOUTH, adjacency, anatomy, smooth_field
 
         anat = anatomy(self.head)
-        lips = mask_per_vertex(self.head, "lips")[: anat.skin_count]
-        lips = np.maximum(lips, lips[anat.mirror[: anat.skin_count]])
-        free = (anat.kind == MOUTH) | (lips > float(spec["lip_mask"]))
+        free = (anat.kind == MOUTH) | (self._lips > float(spec["lip_mask"]))
         share = np.where(free, 0.0, anat.jaw_weight)
         share = smooth_field(share, adjacency(anat.edges, anat.skin_count), int(spec["smoothing_passes"]))
         share[free] = 0.0
@@ -431,14 +437,12 @@ class RegisterEngine:
         averaged with its neighbours' ``passes`` times. The lips, the mouth's lining and the skin two rings
         off them keep their own motion (smoothed there, the lining showed through the skin at george's
         corners), as do the ``held`` points (N_base_geo,): the corner's skin and the still skin."""
-        from facsim.engines.muscle.net import MOUTH, adjacency, anatomy, mask_per_vertex
+        from facsim.engines.muscle.net import MOUTH, adjacency, anatomy
 
         anat = anatomy(self.head)
         skin = anat.skin_count
-        lips = mask_per_vertex(self.head, "lips")[:skin]
-        lips = np.maximum(lips, lips[anat.mirror[:skin]])
         neighbours = adjacency(anat.edges, skin)
-        mouth = ((anat.kind == MOUTH) | (lips > 0.5)).astype(np.float64)
+        mouth = ((anat.kind == MOUTH) | (self._lips > 0.5)).astype(np.float64)
         for _ in range(2):
             mouth = np.minimum(neighbours @ mouth + mouth, 1.0)
         keep = (mouth > 0.0) | held[:skin]

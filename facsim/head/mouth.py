@@ -510,7 +510,7 @@ OPENING_RISE = 1.5
 OPENING_LOW = 0.15
 
 
-def opening_light(rim: MouthRim, positions: np.ndarray) -> np.ndarray:
+def opening_light(rim: MouthRim, positions: np.ndarray, lips=None) -> np.ndarray:
     """(J,) for ``rim.lining``: the share of the light from in front of the face that reaches
     each lining vertex through the parted lips (``positions``, (N_geo, 3)): the opening's area
     over pi times its squared distance from the opening's middle (the solid angle the opening
@@ -521,18 +521,16 @@ def opening_light(rim: MouthRim, positions: np.ndarray) -> np.ndarray:
     surprise) showed the back of its cavity as one flat near-black. Through a wide opening the
     back of the mouth (6-8 cm in) catches the room's light by its distance from it, more below
     the opening than above (:data:`OPENING_RISE`): a gradual fall-off to the throat's dark,
-    the palate's shade above.
+    the palate's shade above. ``lips``: :func:`_lips` of these positions when the caller has it.
     """
-    p = np.asarray(positions, np.float64)
-    plane, upper_edge, lower_edge, middle = _lips(rim, p)
+    plane, upper_edge, lower_edge, middle = lips or _lips(rim, positions)
     gap = max(float(upper_edge(middle) - lower_edge(middle)) - rim.rest_gap_middle, 0.0)
     if gap <= 0.0 or not len(rim.lining):
         return np.zeros(len(rim.lining), np.float32)
     corners = plane(rim.upper)[0][[0, -1]]
     area = OPENING_FILL * float(abs(corners[1] - corners[0])) * gap
-    rims = np.concatenate([rim.upper, rim.lower])
-    centre = p[rims].mean(axis=0)
-    towards = centre - p[rim.lining]
+    centre = np.concatenate([positions[rim.upper], positions[rim.lower]]).astype(np.float64).mean(axis=0)
+    towards = centre - np.asarray(positions[rim.lining], np.float64)
     distance = np.maximum(np.linalg.norm(towards, axis=1), 1e-4)
     # The light comes mostly from above the face (the key, the sky): lining below the opening
     # looks up through it at them, lining above it (the palate, the top of the throat) down at
@@ -565,7 +563,8 @@ def mouth_light(rim: MouthRim, positions: np.ndarray, occlusion: np.ndarray) -> 
     Measured in the mouth's own frame (x from corner to corner, y up across it), so a
     turned or tilted head keeps it.
     """
-    plane, upper_edge, lower_edge, middle = _lips(rim, positions)
+    lips = _lips(rim, positions)
+    plane, upper_edge, lower_edge, middle = lips
     lo, hi = LIP_PARTING
     for ring_index, (ring, visibility, rest_gap) in enumerate(zip(
             rim.rings + rim.lining_rings, LIP_RING_VISIBILITY + LINING_RING_VISIBILITY, rim.rest_gap + rim.lining_rest_gap)):
@@ -576,14 +575,15 @@ def mouth_light(rim: MouthRim, positions: np.ndarray, occlusion: np.ndarray) -> 
         touching = CLOSED_LIP_VISIBILITY if ring_index < len(rim.rings) else 0.0   # the lips' rings, not the lining's
         occlusion[ring] = np.maximum(occlusion[ring], visibility * (touching + (1.0 - touching) * parted))
     if len(rim.lining):
-        occlusion[rim.lining] = np.maximum(occlusion[rim.lining], opening_light(rim, positions))
+        occlusion[rim.lining] = np.maximum(occlusion[rim.lining], opening_light(rim, positions, lips))
+    gap = upper_edge(middle) - lower_edge(middle) - rim.rest_gap_middle   # beyond the rest gap, mid-mouth
     lo, hi = TONGUE_LIT_GAP
-    lit = np.clip((upper_edge(middle) - lower_edge(middle) - rim.rest_gap_middle - lo) / (hi - lo), 0.0, 1.0)
+    lit = np.clip((gap - lo) / (hi - lo), 0.0, 1.0)
     occlusion[rim.tongue] = lit * lit * (3.0 - 2.0 * lit)
     lip_x, lip_y = plane(rim.upper_lip)
     corners = plane(rim.upper)[0][[0, -1]]
     lo, hi = SLIT_GAP
-    parted = np.clip((upper_edge(middle) - lower_edge(middle) - rim.rest_gap_middle - lo) / (hi - lo), 0.0, 1.0)
+    parted = np.clip((gap - lo) / (hi - lo), 0.0, 1.0)
     closed = 1.0 - parted * parted * (3.0 - 2.0 * parted)
     for teeth in (rim.upper_teeth, rim.lower_teeth):
         x, y = plane(teeth)

@@ -95,9 +95,8 @@ def teeth_normal_operator(topology: RenderTopology, faces: np.ndarray, n_vertice
     height = np.full(n_vertices, np.nan, np.float32)
     h = topology.uv[teeth, 1]
     height[topology.render_to_geo[teeth]] = h - LOWER_ROW_OFFSET * (h > 0.5 * LOWER_ROW_OFFSET)
-    with np.errstate(invalid="ignore"):
-        lingual_face = (height[faces] < -0.5).any(axis=1)
-        wall = height >= 0.0
+    lingual_face = (height[faces] < -0.5).any(axis=1)   # NaN (not teeth) compares false
+    wall = height >= 0.0
     keep = ~(lingual_face[operator.col] & wall[operator.row])
     return sp.csr_matrix((operator.data[keep], (operator.row[keep], operator.col[keep])),
                          shape=operator.shape, dtype=np.float32)

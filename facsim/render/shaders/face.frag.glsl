@@ -417,6 +417,11 @@ const vec3 MUCOSA = vec3(0.40, 0.075, 0.09);   // the lips' mucosa (linear; sRGB
 const float UPPER_TEETH[8] = float[8](0.0, 0.085, 0.150, 0.225, 0.295, 0.360, 0.460, 0.560);
 const float LOWER_TEETH[8] = float[8](0.0, 0.052, 0.108, 0.176, 0.246, 0.316, 0.426, 0.530);
 #endif
+#if defined(REGION_TONGUE) || defined(REGION_MOUTH_INTERIOR)
+// Light that reaches deep into the mouth has bounced off red lining: warmed (the tongue's back
+// and the cavity's walls alike).
+const vec3 DEEP_BOUNCE = vec3(1.0, 0.7, 0.65);
+#endif
 #ifdef REGION_TONGUE
 // The light an open mouth lets in falls off with depth behind the lips: about 1/e every
 // TONGUE_LIGHT_FALLOFF of the tongue's length (~8 cm tip to root, so ~1.8 cm) from
@@ -429,7 +434,6 @@ const float LOWER_TEETH[8] = float[8](0.0, 0.052, 0.108, 0.176, 0.246, 0.316, 0.
 const float TONGUE_LIGHT_TIP = 0.36;
 const float TONGUE_LIGHT_FALLOFF = 0.3;
 const float TONGUE_LIGHT_FLOOR = 0.1;
-const vec3 DEEP_BOUNCE = vec3(1.0, 0.7, 0.65);
 // How much of the tongue's shading normal is its normal averaged over ~2 rings of its mesh.
 const float TONGUE_SMOOTHING = 0.8;
 vec3 tongue_depth_light(float along) {
@@ -455,8 +459,7 @@ const float ROOF_LIGHT = 0.35;
 // Behind the lips, what light the opening lets in reaches the lining after bouncing off more
 // red lining and the tongue: warm. (Lit by the room's light as it is, the back of a wide-open
 // mouth, lit through the opening since session 23 (facsim.head.mouth.opening_light), was a
-// grey-mauve curtain.)
-const vec3 DEEP_LINING_BOUNCE = vec3(1.0, 0.7, 0.65);
+// grey-mauve curtain.) DEEP_BOUNCE, as on the tongue's back.
 vec3 cavity_deep_colour(vec3 lining, float visibility) {
     return 0.4 * lining * vec3(1.0, 0.9, 0.9) * mix(CAVITY_BACK, 1.0, visibility);
 }
@@ -737,7 +740,7 @@ void main() {
     // they would be narrower than about two pixels (a pre-filter: the slope is constant over
     // each 2x2 pixel quad, so narrower grooves would break into light and dark blocks).
     vec2 texel = v_uv * vec2(textureSize(u_folds, 0));
-    float groove_px = FOLD_TEXELS / max(max(length(dFdx(texel)), length(dFdy(texel))), 1e-6);
+    float groove_px = FOLD_TEXELS / cells_per_pixel(texel);
     vec2 depth = vec2(-0.018 * line_depth, -0.006 * u_age) * clamp(groove_px - 1.5, 0.0, 1.0);
     // The skin a groove gathers is pushed up beside it into rolls: the height is the grooves less
     // the same map blurred over ~4x their width (its mip level two up), so the surface between
@@ -1293,7 +1296,7 @@ void main() {
     vec3 spec = specular_light(n, v, 30.0) * mix(0.04, 0.3, lip_side);
     vec3 deep = cavity_deep_colour(u_albedo, occ);
     vec3 albedo = mix(u_albedo * 0.45, MUCOSA * 0.8, lip_side);
-    radiance = (diffuse_light(n, vec3(0.3, 0.1, 0.1), 1.0) * mix(DEEP_LINING_BOUNCE, vec3(1.0), lip_side) * albedo + spec) * mouth_shade
+    radiance = (diffuse_light(n, vec3(0.3, 0.1, 0.1), 1.0) * mix(DEEP_BOUNCE, vec3(1.0), lip_side) * albedo + spec) * mouth_shade
              + deep * (1.0 - mouth_shade);
 #endif
 
