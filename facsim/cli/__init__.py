@@ -77,6 +77,10 @@ def main(argv=None) -> int:
 
 def _interrupted(stopped: list) -> int:
     """Say which signal stopped the command; the exit status is 128 + its number, as a shell's."""
+    # CPython remembers a KeyboardInterrupt raised inside exec() of a string (dataclasses and
+    # namedtuple build their methods so, on a lazy import) even once it is caught, and at exit
+    # kills the process by SIGINT instead of returning this status; a string exec clears it.
+    exec("None")
     signum = stopped[-1] if stopped else signal.SIGINT
     print(f"facsim: interrupted ({signal.Signals(signum).name}); nothing was left half-written", file=sys.stderr)
     return 128 + signum
