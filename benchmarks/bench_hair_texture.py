@@ -15,6 +15,11 @@ count. On their luminance (Rec. 709 weights on the sRGB values) it prints
   background at all (alpha over 0.08 with hair, under 0.01 without), the share it covers only
   partly (alpha under 0.92): long hair ending in a translucent film (pale smears and streaks
   against a light background) gives a high figure, strands ending solid a low one;
+- ``streaks``: how far the hair's detail runs in streaks one way (strands) rather than in
+  blotches (clumps, mottled stone): the coherence (lambda1 - lambda2) / (lambda1 + lambda2) of the
+  luminance's structure tensor (Sobel gradients, Gaussian sigma 2 px), averaged over the hair
+  pixels weighted by the gradient energy; 0 for blotches that vary alike every way, 1 for
+  parallel streaks;
 - ``crown``: on the crown (hair pixels from the top of the image to 4 % of its height below the
   top of the skin, in the middle 40 % of its width), the standard deviation of the luminance's
   band-pass down the columns (Gaussian 1.5 px minus 6 px) over the mean: rows of cards drawn
@@ -54,6 +59,19 @@ def luminance_variation(image: np.ndarray, mask: np.ndarray, *, sigma: float = 2
     blurred = gaussian_filter(lum * mask, sigma) / np.maximum(weight, 1e-6)
     mean = float(lum[mask].mean())
     return float((lum - blurred)[mask].std() / mean), float(blurred[mask].std() / mean)
+
+
+def streak_coherence(image: np.ndarray, mask: np.ndarray, *, sigma: float = 2.0) -> float:
+    """The ``streaks`` figure (module docstring) of an (H, W, 4) uint8 render over ``mask``."""
+    from scipy.ndimage import gaussian_filter, sobel
+
+    lum = image[..., :3].astype(np.float32) @ np.array([0.2126, 0.7152, 0.0722], np.float32)
+    gx, gy = sobel(lum, axis=1), sobel(lum, axis=0)
+    jxx, jyy, jxy = (gaussian_filter(g, sigma) for g in (gx * gx, gy * gy, gx * gy))
+    energy = jxx + jyy
+    coherence = np.sqrt((jxx - jyy) ** 2 + 4.0 * jxy ** 2) / np.maximum(energy, 1e-6)
+    weight = energy[mask]
+    return float((coherence[mask] * weight).sum() / max(float(weight.sum()), 1e-6))
 
 
 def partial_cover_below_jaw(with_hair: np.ndarray, without_hair: np.ndarray) -> tuple[float, int]:
@@ -100,6 +118,7 @@ def main(argv=None) -> int:
     fine, mass = luminance_variation(images[0], mask)
     print(f"{args.character} {args.view}: fine {fine:.3f}, mass {mass:.3f} over {int(mask.sum())} hair pixels "
           f"({args.size}²)")
+    print(f"streaks: {streak_coherence(images[0], mask):.3f} coherence of the hair's detail")
     banding, pixels = crown_banding(images[0], mask, images[1])
     print(f"crown: {banding:.3f} band-pass down the columns over {pixels} crown pixels")
     share, pixels = partial_cover_below_jaw(*images)

@@ -438,3 +438,27 @@ def test_the_afros_outline_is_a_soft_halo_not_a_cut_edge(face_of, name):
     assert at_2 < 0.42, at_2
     assert at_8 > 0.9, at_8
     assert jagged < 0.68, jagged
+
+
+def test_short_grey_hair_shows_strands_along_its_flow_not_mottled_stone(face_of):
+    """Short styles whose strands run every way over the cards (short01, short02) take their
+    pixel-scale strands as streaks down the hair volume's meridians from the crown
+    (proxy.frag.glsl's flow_strands), not as a few samples smeared along each strand, which drew
+    cells two or three long: george's grey short01 read as "stone-like / clumpy grey hair"
+    (blind review, session 23, 12 of 26 images). On george at 384² the coherence of the hair's
+    detail (benchmarks/bench_hair_texture.py's ``streaks``) was 0.657; now 0.723."""
+    import sys
+    from pathlib import Path
+
+    from facsim.face import Face
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+    from bench_hair_texture import hair_mask, streak_coherence
+
+    face = face_of("george")
+    with Face(face.character.with_(hair="none")) as bald:
+        without = bald.render(None, size=384, background=None)
+    with_hair = face.render(None, size=384, background=None)
+    mask = hair_mask(with_hair, without)
+    assert mask.sum() > 5000
+    assert streak_coherence(with_hair, mask) > 0.69

@@ -467,6 +467,9 @@ class ProxyLayer:
         rest_tangents = np.zeros((self._n_corners, 3), np.float32)
         if mesh.kind == "hair" and mesh.rest is not None:
             rest_tangents = self._strand_tangents(np.asarray(mesh.rest, np.float32))
+        # (the apex the strands flow from on the neutral face: the shader's strand streaks run from it)
+        self._apex_rest = (tuple(float(x) for x in hair_apex(rest)) if mesh.kind == "hair" and mesh.rest is not None
+                           else (0.0, 0.0, 0.0))
         static = np.column_stack([np.asarray(mesh.uv, np.float32), cover[mesh.corner_vertex],
                                   rest[mesh.corner_vertex], rest_tangents])
         self._uv = track(ctx.buffer(np.ascontiguousarray(static, np.float32).tobytes()))
@@ -493,6 +496,7 @@ class ProxyLayer:
                                          _shader_source("proxy.frag.glsl", defines)))
             _set_uniform(prog, "u_texture", 1)
             _set_uniform(prog, "u_along_v", self._along_v)
+            _set_uniform(prog, "u_hair_apex_rest", self._apex_rest)
             _set_uniform(prog, "u_strand_width", float(mesh.strand_width))
             _set_uniform(prog, "u_end_height", -1e3 if mesh.end_height is None else float(mesh.end_height))
             _set_uniform(prog, "u_end_fade", END_FADE)

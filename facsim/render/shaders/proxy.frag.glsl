@@ -28,6 +28,7 @@ uniform float u_grey;         // ... and the fraction of white strands (u_color 
 uniform float u_end_height;   // hair, wisps: where long hair ends (y on the neutral face, dm) ...
 uniform float u_end_fade;     // ... its strands ending one by one over this height above it
 uniform vec3 u_hair_apex;     // hair: a point above the crown the strands flow down and out from (world)
+uniform vec3 u_hair_apex_rest; // ... the same on the neutral face (v_rest's space)
 // How much the strand highlight follows the hair's flow over the volume rather than each card's tangent.
 const float HIGHLIGHT_FLOW = 0.7;
 // Straight hair's locks (see main): cells per decimetre on the neutral head (~6 mm), and the light
@@ -113,6 +114,35 @@ float pixel_strands(vec3 rest, vec3 along, float cells_per_dm) {
     return mix(0.5, clamp(n, 0.0, 1.0), clamp(2.2 - 1.6 * cells, 0.0, 1.0));
 }
 
+const float HAIR_VOLUME_RADIUS = 0.9;   // dm, facsim.render.proxies.VOLUME_RADIUS
+
+// Strands a couple of pixels across and many long, running down the hair volume's meridians
+// from its axis (over the crown, then down the sides: facsim.render.proxies.volume_normals'
+// dome) on the neutral head (``rest``, dm): value noise over the horizontal direction from the
+// axis (``cells_per_dm`` cells across at the volume's radius) that changes only slowly with the
+// distance from the apex above the crown (``stretch`` times slower), so each cell is drawn out
+// into a streak along the flow. A smooth function of the place on the head: unlike a
+// coordinate along a direction that turns from pixel to pixel it never shears, and it costs
+// one noise per octave. (pixel_strands' few samples along the strands drew cells two or three
+// long: at stimulus sizes george's grey short hair read as mottled stone, blind review
+// session 23.) Octaves as in pixel_strands. [0, 1], mean 0.5.
+float flow_strands(vec3 rest, float cells_per_dm, float stretch) {
+    vec2 out_dir = rest.xz - u_hair_apex_rest.xz;
+    out_dir /= max(length(out_dir), 1e-4);
+    float along = length(rest - u_hair_apex_rest);
+    vec3 p = vec3(out_dir.x, 0.0, out_dir.y) * (HAIR_VOLUME_RADIUS * cells_per_dm)
+           + vec3(0.0, along * cells_per_dm / stretch, 0.0);
+    float cells = max(length(fwidth(p)), 1e-5);
+    float level = log2(0.6 / cells);
+    float k = clamp(floor(level), 0.0, 2.0);
+    float f = smoothstep(0.35, 0.65, clamp(level - k, 0.0, 1.0)) * step(k, 1.5);
+    float s0 = exp2(k);
+    float n0 = f < 0.999 ? lattice_noise3(p * s0 + 3.0) : 0.5;
+    float n1 = f > 0.001 ? lattice_noise3(p * (2.0 * s0) + 11.0) : 0.5;
+    float n = 0.5 + 1.1 * (mix(n0, n1, f) - 0.5) / sqrt(f * f + (1.0 - f) * (1.0 - f));
+    return mix(0.5, clamp(n, 0.0, 1.0), clamp(2.2 - 1.6 * cells, 0.0, 1.0));
+}
+
 #if defined(USE_SHADOW) && defined(KIND_HAIR)
 // How much of the key reaches p (world; n: the volume's normal) inside the hair's mass, a
 // cheap deep-opacity map: the shadow map holds the depth of the first thing the key meets,
@@ -151,7 +181,6 @@ float strand_diffuse(vec3 t, vec3 l) {
 // far p lies inside its outline seen from the eye (mm; a sphere's radius r seen at
 // cos = n.v lies r (1 - sin) inside), so the fade follows a rounded outline, not the cards'.
 const float COILY_HALO_MM = 3.0;
-const float HAIR_VOLUME_RADIUS = 0.9;   // dm, facsim.render.proxies.VOLUME_RADIUS
 float coily_inside_outline_mm(vec3 p, vec3 v) {
     // (u_hair_apex lies a quarter radius above the crown, on the axis)
     vec3 q = vec3(u_hair_apex.x, min(p.y, u_hair_apex.y - 1.25 * HAIR_VOLUME_RADIUS), u_hair_apex.z);
@@ -489,7 +518,24 @@ void main() {
     // running on from row to row; hanging lengths keep the cards' unbroken root-to-tip strands.
     vec3 along_rest = normalize(v_rest_tangent + vec3(0.0, 1e-4, 0.0));
     float on_head = mix(1.0, 1.0 - smoothstep(0.55, 0.8, abs(along_rest.y)), u_along_v);
-    float px = on_head > 0.999 ? pixel_strands(v_rest, along_rest, 60.0)
+    // Where the strands run down and out from the crown (most of a short style's mass), they are
+    // streaks along that flow (flow_strands); where they turn away from it (a fringe falling over
+    // the forehead, hair brushed sideways), short smears along their own direction (pixel_strands).
+    float flow_share = 0.0;
+    if (u_along_v < 0.5) {
+        vec3 axis_point = vec3(u_hair_apex_rest.x, min(v_rest.y, u_hair_apex_rest.y - 1.25 * HAIR_VOLUME_RADIUS),
+                               u_hair_apex_rest.z);
+        vec3 nv = normalize(v_rest - axis_point);
+        vec3 meridian = cross(nv, normalize(cross(vec3(0.0, 1.0, 0.0), nv) + vec3(1e-5, 0.0, 0.0)));
+        flow_share = smoothstep(0.75, 0.92, abs(dot(meridian, along_rest)));
+    }
+    // (strands pointing at the eye are seen end-on: their streaks shrink to dots, which
+    // speckled a fringe brushed forward; there the streaks fade to their mean)
+    float tv = dot(normalize(v_tangent), normalize(u_cam_pos - v_pos));
+    float seen_along = smoothstep(0.45, 0.8, sqrt(max(1.0 - tv * tv, 0.0)));
+    float px_flow = flow_share > 0.001 ? mix(0.5, flow_strands(v_rest, 60.0, 8.0), seen_along) : 0.5;
+    float px = flow_share > 0.999 ? px_flow
+             : on_head > 0.999 ? mix(pixel_strands(v_rest, along_rest, 60.0), px_flow, flow_share)
              : on_head < 0.001 ? pixel_strands_uv(v_uv, vec2(40.0, 1.5), vec2(5.0, 5.0) + 2.0 * phase)
              : mix(pixel_strands_uv(v_uv, vec2(40.0, 1.5), vec2(5.0, 5.0) + 2.0 * phase),
                    pixel_strands(v_rest, along_rest, 60.0), on_head);
