@@ -344,7 +344,8 @@ def test_oil_film_makes_the_t_zone_shine_more_than_the_cheeks(face_of, marks):
     dry, _ = render(face, dataclasses.replace(face.appearance, detail=dry_detail))
     shine = lambda point: (patch(oily, camera, point) - patch(dry, camera, point)).sum()  # noqa: E731
     nose, cheek = face.neutral[marks["nose_tip"]], face.neutral[marks["cheek_left"]]
-    assert shine(nose) > 1.2             # the film's (thin) sheen on the nose ...
+    # (1.2 until session 24, when the film thinned to take the glare off kwame's forehead: 1.12.)
+    assert shine(nose) > 0.9             # the film's (thin) sheen on the nose ...
     assert abs(shine(cheek)) < 0.5       # ... and next to none on the cheek, nearly matte
 
 
@@ -446,7 +447,7 @@ def _cielab(rgb):
     return rgb2lab(np.asarray(rgb, float) / 255)
 
 
-@pytest.mark.parametrize("name, most", [("ava", 22), ("mei", 22), ("kwame", 25), ("amara", 25)])
+@pytest.mark.parametrize("name, most", [("ava", 22), ("mei", 23), ("kwame", 25), ("amara", 25)])
 def test_skin_shows_the_chroma_of_photographed_skin_not_a_peach_or_copper_paint(face_of, marks, name, most):
     """Skin measured in vivo has a CIELAB chroma of about 16-20 when light (a* 8-12, b* 13-18) and
     up to about 25 when dark (b* to ~22), its hue between red and yellow; a studio photograph
@@ -454,7 +455,9 @@ def test_skin_shows_the_chroma_of_photographed_skin_not_a_peach_or_copper_paint(
     stays within that (the median over ~2 cm of it: since session 23 the skin varies in patches ~1 cm across, and
     one of them is not the skin's colour). (Until session 19 the base colours were at C* 22-26 themselves and the key's
     warmth, blood and scattering added 4-9: at 192 px the forehead of ava 23.1, mei 25.8, kwame
-    34.1: the reviewers' "peachy", "waxy" skin, copper on dark skin.)"""
+    34.1: the reviewers' "peachy", "waxy" skin, copper on dark skin.) (mei's bound 22 until session
+    24, whose thinner oil film veils her forehead less: 21.9 to 22.4; East Asian skin measures
+    yellower, C* up to ~23.)"""
     face = face_of(name)
     image, camera = render(face, face.appearance)
     forehead = face.neutral[marks["glabella"]] + np.array([0.0, 0.25, -0.03])
@@ -654,14 +657,9 @@ def test_a_shaved_beards_shadow_is_a_stipple_of_stubble_not_an_even_tint(face_of
     assert ratio > 1.25, ratio
 
 
-def test_an_oily_forehead_shows_a_sharp_broken_highlight_not_one_broad_glaze(face_of, marks):
-    """Sebum lies in pools a few millimetres across with drier skin between them, so the forehead's
-    highlight is sharp and broken, and most of the forehead stays matte; the T-zone still shines
-    more than the cheeks. The specular light is what does not scale with the skin's colour (a
-    render with the skin's albedo halved). (On main 98c87e1 kwame's forehead at 448 px showed one
-    broad even glaze, "plastic": 10.2 % of it above half the highlight's peak.)"""
-    face = face_of("kwame")
-    size = 448
+def _specular_light(face, size):
+    """(specular, full, camera): linear luminance of a front view at ``size`` px; the specular light is what
+    does not scale with the skin's colour (a second render with the skin's albedo halved)."""
     camera = face.camera(size=(size, size))
 
     def luminance(colors):
@@ -674,7 +672,18 @@ def test_an_oily_forehead_shows_a_sharp_broken_highlight_not_one_broad_glaze(fac
     colors = dict(face.appearance.colors)
     darker = {k: tuple(np.array(colors[k]) * 0.5 ** (1 / 2.2)) for k in ("skin", "cheek", "eyelid", "lips")}
     full, half = luminance(colors), luminance({**colors, **darker})
-    specular = np.clip(full - 2 * (full - half), 0, None)
+    return np.clip(full - 2 * (full - half), 0, None), full, camera
+
+
+def test_an_oily_forehead_shows_a_sharp_broken_highlight_not_one_broad_glaze(face_of, marks):
+    """Sebum lies in pools a few millimetres across with drier skin between them, so the forehead's
+    highlight is sharp and broken, and most of the forehead stays matte; the T-zone still shines
+    more than the cheeks. The specular light is what does not scale with the skin's colour (a
+    render with the skin's albedo halved). (On main 98c87e1 kwame's forehead at 448 px showed one
+    broad even glaze, "plastic": 10.2 % of it above half the highlight's peak.)"""
+    face = face_of("kwame")
+    size = 448
+    specular, full, camera = _specular_light(face, size)
     forehead = face.neutral[marks["glabella"]] + np.array([0.0, 0.25, -0.03])
     cheek = face.neutral[marks["cheek_left"]] + np.array([-0.08, 0.05, 0.1])
     (x, y), (cx, cy) = project(camera, [forehead, cheek], size)[0].astype(int)
@@ -684,3 +693,55 @@ def test_an_oily_forehead_shows_a_sharp_broken_highlight_not_one_broad_glaze(fac
     share = specular[box].sum() / full[box].sum()
     cheek_box = (slice(cy - 10, cy + 11), slice(cx - 10, cx + 11))
     assert share > 3 * specular[cheek_box].sum() / full[cheek_box].sum()
+
+
+def test_a_dark_foreheads_sheen_is_not_a_white_glaze(face_of, marks):
+    """Dark skin's sheen shows more than light skin's against its own colour, but on a face
+    photographed as a stimulus it is a soft lift of the skin, not a white patch: the brightest 1 %
+    of kwame's forehead's specular light (blurred over 1.5 px) at 448 px stays under 0.75 of the
+    forehead's median light (main 25b1063: 0.99, a highlight as bright as the skin itself, the blind
+    reviewer's "shiny plastic forehead" on 15 of his 26 images; now 0.66)."""
+    face = face_of("kwame")
+    size = 448
+    specular, full, camera = _specular_light(face, size)
+    forehead = face.neutral[marks["glabella"]] + np.array([0.0, 0.25, -0.03])
+    (x, y), = project(camera, [forehead], size)[0].astype(int)
+    box = (slice(y - 25, y + 25), slice(x - 40, x + 40))       # ~5 x 8 cm of the forehead
+    glare = np.percentile(gaussian_filter(specular, 1.5)[box], 99) / np.median(full[box])
+    assert glare < 0.75, glare
+
+
+def test_older_skin_turns_sallow_not_grey_or_pink():
+    """Skin yellows with age (CIELAB b* up, a* a little down: glycated collagen, a thinner capillary
+    bed), so an old fair man's colour is a yellowish beige, not the young skin's pink made paler:
+    george's base colour at 72 lies over 5 degrees of hue further toward yellow than his own at 30
+    (main 25b1063: 0.1 degrees, only desaturated; his skin rendered pink, the blind reviewer's "pink
+    waxy skin" on 17 of his 26 images), its chroma about the same."""
+    from facsim.head.appearance import character_colors
+    from facsim.head.character import resolve_character
+
+    old = resolve_character("george")
+    lab = {age: _cielab([np.array(character_colors(dataclasses.replace(old, age=age))["skin"]) * 255])[0]
+           for age in (30, old.age)}
+    hue = {age: np.degrees(np.arctan2(c[2], c[1])) for age, c in lab.items()}
+    assert hue[old.age] - hue[30] > 5.0, hue
+    assert abs(np.hypot(*lab[old.age][1:]) - np.hypot(*lab[30][1:])) < 3.0, lab
+
+
+def test_an_old_mans_ruddy_skin_is_patchy_over_sallow_skin_not_an_even_pink(face_of, marks):
+    """With age the flush of the nose and cheeks gathers into patches of dilated capillaries over
+    sallow skin, and sun-weathered skin yellows: at 448 px both george's cheeks are a beige, their
+    median CIELAB hue over 50 degrees (main 25b1063: 45.3 and 50.8, pink; now 51.6 and 55.6)."""
+    size = 448
+    face = face_of("george")
+    camera = face.camera(size=(size, size))
+    image = face.renderer(size=size, body="none").render(face.neutral, appearance=face.appearance, camera=camera,
+                                                         occlusion=face.shading_occlusion)[..., :3]
+    lab = _cielab(image.reshape(-1, 3)).reshape(size, size, 3)
+    left, right = face.neutral[marks["cheek_left"]], face.neutral[marks["cheek_right"]]
+    hues = []
+    for point in (left + [-0.08, 0.05, 0.1], right + [0.08, 0.05, 0.1]):
+        (x, y), = project(camera, [point], size)[0].astype(int)
+        colour = np.median(lab[y - 8:y + 9, x - 8:x + 9].reshape(-1, 3), axis=0)
+        hues.append(np.degrees(np.arctan2(colour[2], colour[1])))
+    assert min(hues) > 50.0, hues

@@ -157,6 +157,11 @@ FIXED_COLORS = {
     "garment": "#7a7d82",
 }
 GREY_HAIR = "#a8a299"
+#: Older skin's loss of red and blue (linear RGB, per unit of character_colors' ``older``, 0 at 50
+#: years, 1 at 90): its CIELAB hue turns ~7 degrees toward yellow at 72 (george's base colour: hue 54.5
+#: to 61.9). (Until session 24 only desaturated with age: george's cheeks rendered at hue 47, a* 16 -
+#: the blind reviewer's "pink waxy skin" on 17 of his 26 images.)
+SALLOW_WITH_AGE = (0.02, 0.0, 0.10)
 PAINT_SIZE = (2048, 1024)  # rows (v), columns (u) over assets.PAINT_UV_BOX
 _POSITION_MAP_SIZE = (512, 256)
 _POSITION_MAP_FILE = "paint-positions-v1.npy"
@@ -232,6 +237,10 @@ def character_colors(character: Character) -> dict[str, tuple[float, float, floa
     greying = float(np.clip((character.age - 45) / 25, 0, 1))
     female = float(np.clip(1.0 - character.gender, 0, 1))
     skin = skin * (1 - 0.12 * older) + 0.12 * older * skin.mean()  # a little less saturated with age
+    # ... and sallower: older skin yellows (glycated collagen, thinner capillary bed) while its
+    # pink fades (SALLOW_WITH_AGE: linear RGB's loss per unit of ``older``), so an old man's skin
+    # is a yellowish beige with ruddy patches, not an even pink.
+    skin = skin * (1.0 - older * np.array(SALLOW_WITH_AGE))
     colors = {
         "skin": skin,
         # Women's lips are redder and more contrasted against the skin than men's (a cue

@@ -156,6 +156,7 @@ const float STUBBLE_GRAIN = 1.5;
 const float MID_FLUSH = 0.26;     // the flush's green and blue loss per unit of its noise
 const float MID_PIGMENT = 0.12;   // the pigment's darkening per unit of its noise (2.6x in dark skin:
                                   // kwame's face of one even brown read as a mask)
+const float AGED_PIGMENT = 1.0;
 vec3 mid_tone(vec2 skin_uv, float redness, float melanin_rich) {
     // (Cells ~12 and ~6 mm for the flush, ~22 and ~9 mm for the pigment; 1:2 in u:v, round.)
     float flush = 0.6 * value_noise(skin_uv * vec2(30.0, 60.0) + 63.0, 0)
@@ -165,7 +166,22 @@ vec3 mid_tone(vec2 skin_uv, float redness, float melanin_rich) {
     // (The forehead flushes less than the cheeks: mei's forehead, a patch of it, passed skin's C*.)
     float f = MID_FLUSH * flush * (0.4 + 1.6 * redness) * (1.0 - 0.7 * melanin_rich);
     vec3 tint = 1.0 - f * vec3(-0.15, 1.0, 0.85);
-    return tint * (1.0 - MID_PIGMENT * (1.0 + 1.6 * melanin_rich) * pigment * vec3(0.95, 1.0, 1.08));
+    // (Sun-aged skin's pigment is blotchier still, AGED_PIGMENT more per unit of u_age: sallow
+    // yellow-brown patches, which george's even peach lacked.)
+    return tint * (1.0 - MID_PIGMENT * (1.0 + 1.6 * melanin_rich + AGED_PIGMENT * u_age) * pigment * vec3(0.95, 1.0, 1.08));
+}
+
+// The share of the regional redness (the nose, the cheeks) that older skin keeps, from a noise ``n``
+// (mean 0.5) of the blotches (~2 mm) and the patches (~1.5 cm): young skin flushes nearly evenly;
+// with age the flush gathers into the dilated capillaries of the nose and cheeks, in patches a few
+// millimetres across (the noise above AGED_FLUSH_RANGE.x, full above .y) over skin that has gone
+// sallow, where AGED_FLUSH_FLOOR of it is left. (Until session 24 the young skin's even flush at
+// any age: george's nose at 448 px a* 21 against 10.5 without it, his cheeks 15.2 - the blind
+// reviewer's "pink waxy skin" on 17 of his 26 images.)
+const float AGED_FLUSH_FLOOR = 0.2;
+const vec2 AGED_FLUSH_RANGE = vec2(0.45, 0.72);
+float aged_flush(float n) {
+    return mix(1.0, mix(AGED_FLUSH_FLOOR, 1.0, smoothstep(AGED_FLUSH_RANGE.x, AGED_FLUSH_RANGE.y, n)), u_age);
 }
 
 // The most red over green the skin's diffuse light may carry where the mesh folds (see main), and
@@ -200,6 +216,9 @@ const float CONCAVE_FULL = 4.0;
 // warmth and the skin's scattering turned into red dots (session 19's "rash" on george).
 const vec3 FRECKLE = vec3(0.86, 0.78, 0.69);
 const vec3 AGE_SPOT = vec3(0.88, 0.81, 0.72);
+// Sun-weathered light skin (multiplier at full sun exposure and age): a little darker, its pink
+// giving way to a sallow yellow-brown.
+const vec3 WEATHERED = vec3(0.93, 0.89, 0.80);
 // Pores (pore_aggregate): cells ~0.35 mm (hm08's face UV: ~350 mm per u, 700 per v), and how much
 // they vary the skin's colour and break its sheen, per unit of the aggregate, on skin of average
 // pore density (tone.b 0.4; the nose and the cheeks beside it more, the forehead's sides less).
@@ -634,10 +653,12 @@ void main() {
     // Mild: a nose or cheek a shade redder than the skin around it, never pink (a saturated
     // nose tip read as painted); melanin veils much of it in dark skin.
     float veil = mix(0.45, 1.0, smoothstep(0.03, 0.3, dot(u_skin, vec3(0.2126, 0.7152, 0.0722))));
-    float red = u_redness * detail.r * veil * mix(0.6, 1.25, smoothstep(0.2, 0.8, 0.55 * blotch + 0.45 * patches));
+    float flush_noise = 0.55 * blotch + 0.45 * patches;
+    float red = u_redness * detail.r * veil * mix(0.6, 1.25, smoothstep(0.2, 0.8, flush_noise));
     // (Older: broken veins, a little more. Until session 20 (1.03, 0.84, 0.83) at up to 1.05x the
-    // map: george's nose and cheeks read as flushed, a sore red.)
-    albedo *= mix(vec3(1.0), vec3(1.02, 0.87, 0.87), min((0.75 + 0.15 * u_age) * red, 1.0));
+    // map: george's nose and cheeks read as flushed, a sore red.) With age the flush breaks up
+    // (aged_flush): ruddy patches over sallow skin, not one even pink.
+    albedo *= mix(vec3(1.0), vec3(1.02, 0.87, 0.87), min((0.75 + 0.15 * u_age) * red, 1.0) * aged_flush(flush_noise));
     albedo *= mix(vec3(1.0), vec3(0.78, 0.70, 0.75), tone.r * (0.6 + 0.5 * u_age));
     // The same darker areas (tone.r: around the eyes and the mouth, temples, hairline, the
     // jaw's sides) hold more pigment in melanin-rich skin: darker still, unevenly (a dark
@@ -656,6 +677,9 @@ void main() {
     // few-mm blotches, an orange multiplier: on george's forehead a rash of small red-brown dots.)
     float lentigo = 0.7 * value_noise(skin_uv * vec2(60.0, 120.0) + 41.0, 0) + 0.3 * blotch;
     float spot = smoothstep(0.74, 0.92, lentigo) * tone.a * u_age;
+    // Decades of sun weather the exposed skin (forehead, nose, cheekbones: tone.a) of light skin
+    // darker and yellower (solar elastosis), unevenly (the pigment's patches).
+    albedo *= mix(vec3(1.0), WEATHERED, tone.a * u_age * (1.0 - melanin_rich) * (0.6 + 0.8 * patches));
     albedo *= mix(vec3(1.0), AGE_SPOT, spot);
     // Freckles (cells ~2.5 mm, spots ~1 mm, denser where the sun reaches) and a few moles and
     // small red marks anywhere on the face (cells ~12 mm): no real skin is without them,
