@@ -363,9 +363,35 @@ class RegisterEngine:
             out[:skin] *= self._lower_lip_turn(out[:skin], positions[:skin], hinge, lower_lip)[:, None].astype(out.dtype)
         held = spec.get("maxilla")
         if held:
-            lip_line = float(np.mean([positions[marks[f"{held['lip_line']}_{side}"], 1] for side in ("left", "right")]))
-            band = (float(held["free_below_mm"]) / 100.0, float(held["held_above_mm"]) / 100.0)
-            out[:skin] *= mandible_share(positions[:skin, 1], lip_line, band)[:, None].astype(out.dtype)
+            out[:skin] = self._held_by_the_maxilla(out[:skin], positions[:skin], held, share if bone else None)
+        return out
+
+    def _held_by_the_maxilla(self, offsets: np.ndarray, positions: np.ndarray, spec: Mapping, bound) -> np.ndarray:
+        """The jaw target's skin ``offsets`` (N_skin, 3) kept below the lip corners' line and stilled above it,
+        where the skin lies on the maxilla (:func:`mandible_share`, ``mandible.maxilla`` in the table). Beside
+        the mouth (``spec["beside"]``) the band between the two grows taller - the cheek hangs between the
+        zygoma and the mandible - and the skin in it follows smoothly from the moving to the still skin."""
+        from facsim.head.landmarks import landmarks
+
+        marks = landmarks(self.head)
+        corners = [positions[marks[f"{spec['lip_line']}_{side}"]] for side in ("left", "right")]
+        lip_line = float(np.mean([c[1] for c in corners]))
+        below, above = float(spec["free_below_mm"]) / 100.0, float(spec["held_above_mm"]) / 100.0
+        beside = spec.get("beside")
+        if beside:
+            half_width = float(np.mean([abs(c[0]) for c in corners]))
+            lateral = smoothstep(float(beside["from"]) * half_width, float(beside["full"]) * half_width, np.abs(positions[:, 0]))
+            below = below + lateral * (float(beside["free_below_mm"]) / 100.0 - below)
+            above = above + lateral * (float(beside["held_above_mm"]) / 100.0 - above)
+        share = mandible_share(positions[:, 1], lip_line, (below, above))
+        out = offsets * share[:, None].astype(offsets.dtype)
+        passes = int(beside.get("smoothing_passes", 0)) if beside else 0
+        if passes:
+            zone = (positions[:, 1] < lip_line + above) & (positions[:, 1] > lip_line - float(beside["smooth_below_mm"]) / 100.0)
+            if bound is not None:
+                zone &= bound < float(beside["bound"])
+            # the height only: the depth keeps the target's, so the skin stays in front of the mouth's lining
+            out[:, 1] = self._relaxed(out[:, 1:2], passes, ~zone, int(beside.get("lip_rings", 0)))[:, 0]
         return out
 
     def _lower_lip_turn(self, offsets: np.ndarray, positions: np.ndarray, hinge: np.ndarray, spec: Mapping) -> np.ndarray:
@@ -437,22 +463,27 @@ class RegisterEngine:
         averaged with its neighbours' ``passes`` times. The lips, the mouth's lining and the skin two rings
         off them keep their own motion (smoothed there, the lining showed through the skin at george's
         corners), as do the ``held`` points (N_base_geo,): the corner's skin and the still skin."""
+        skin = self.head.skin_vertex_count
+        out = np.array(offsets, np.float64, copy=True)
+        out[:skin] = self._relaxed(out[:skin], passes, held[:skin], 2)
+        return out
+
+    def _relaxed(self, offsets: np.ndarray, passes: int, held: np.ndarray, rings: int) -> np.ndarray:
+        """Skin ``offsets`` (N_skin, 3) averaged with their neighbours' ``passes`` times, the ``held`` points
+        (N_skin,), the lips, the mouth's lining and ``rings`` rings of skin off them keeping their own."""
         from facsim.engines.muscle.net import MOUTH, adjacency, anatomy
 
         anat = anatomy(self.head)
-        skin = anat.skin_count
-        neighbours = adjacency(anat.edges, skin)
+        neighbours = adjacency(anat.edges, anat.skin_count)
         mouth = ((anat.kind == MOUTH) | (self._lips > 0.5)).astype(np.float64)
-        for _ in range(2):
+        for _ in range(rings):
             mouth = np.minimum(neighbours @ mouth + mouth, 1.0)
-        keep = (mouth > 0.0) | held[:skin]
+        keep = (mouth > 0.0) | held
         degree = np.asarray(neighbours.sum(axis=1)).ravel() + 1.0
-        out = np.array(offsets, np.float64, copy=True)
-        field = out[:skin]
+        field = np.array(offsets, np.float64, copy=True)
         for _ in range(passes):
             field = np.where(keep[:, None], field, (neighbours @ field + field) / degree[:, None])
-        out[:skin] = field
-        return out
+        return field
 
     @cached_property
     def lids(self) -> dict:
