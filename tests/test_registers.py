@@ -422,6 +422,27 @@ def test_anger_glares_under_knitted_brows(engine, marks, level, table):
     assert knit(anger) < knit(disgust) < 0.0
 
 
+@pytest.mark.parametrize("character", ["ava", "mei", "george"])
+def test_9_narrows_the_eye_from_above_as_well_as_below(face_of, marks, character):
+    """FACS 9 lowers the brows' inner part and raises the infraorbital triangle: the eye narrows
+    from below AND the lowered brow pushes the upper lid down, as 4's does (lids.yaml `brow_push`).
+    Until session 24 9's upper lid stayed where it rests (0.1 mm down) while 9's lower lid rose
+    2.3 mm, so disgust's eyes kept the wide stare of anger's glare (FER2013 named disgust anger).
+    The push is fitted like 4's: an open eye (ava, mei) narrows from above, a hooded one (george),
+    whose lid rests low over the iris already, is not pushed further."""
+    engine = face_of(character).engine
+    moved = engine.deform(activations(parse("9"))).positions - engine.neutral
+    upper, lower = moved[marks["upper_lid_left"], Y], moved[marks["lower_lid_left"], Y]
+    assert lower > 0.015
+    if character == "george":
+        assert upper > -0.005
+    else:
+        assert upper < -0.01, upper
+    # With 5 (HapFACS anger's 5+7+9+...) the levator holds the lid up against the push.
+    glare = engine.deform(activations(parse("5+9"))).positions - engine.deform(activations(parse("5"))).positions
+    assert glare[marks["upper_lid_left"], Y] > -0.003
+
+
 @pytest.mark.parametrize("level", [1.0, 0.5])
 def test_default_anger_has_none_of_disgusts_lower_face(engine, marks, level):
     """Session 18 (HapFACS anger named disgust 5 times in 12 by a blind reviewer, for its nose

@@ -565,21 +565,25 @@ class RegisterEngine:
     @cached_property
     def brow_push(self) -> dict[tuple[int, str], float]:
         """The lowered brow's push on the upper lid fitted to the character (``lids.yaml``
-        ``brow_push``): AU 4's share of the closing target, scaled so that at E it lowers the relaxed
-        lid to cover at most ``cover_mm`` of the iris (none on lids that rest that low already)."""
+        ``brow_push``): each brow-lowering AU's share of the closing target, scaled so that at E it
+        lowers the relaxed lid to cover at most ``cover_mm`` of the iris (none on lids that rest that
+        low already)."""
         from facsim.engines.lids import rest_lid_weight, rest_table
 
         spec = load_yaml("lids.yaml")["brow_push"]
-        code, pattern = int(spec["au"]), spec["target"]
-        vmax = next(float(reg["max"]) for reg in register_table()["action_units"][code]["registers"]
-                    if reg["target"] == pattern)
+        pattern = spec["target"]
         skin = self.head.skin_vertex_count
         relaxed = self.sculpted[:skin] + self.rest_lids.offsets(Activations(), skin)
-        limits = {**rest_table(), "cover_mm": float(spec["cover_mm"]), "max_weight": vmax}
-        shares = [rest_lid_weight(self.lids[pattern, side], relaxed, self.column(Column(pattern, side))[:skin],
-                                  self.head.eye_pivot(self.base_positions, side)[1], limits)
-                  for side in ("left", "right")]
-        return {(code, pattern): float(np.mean(shares)) / vmax}
+        fitted = {}
+        for code in map(int, spec["aus"]):
+            vmax = next(float(reg["max"]) for reg in register_table()["action_units"][code]["registers"]
+                        if reg["target"] == pattern)
+            limits = {**rest_table(), "cover_mm": float(spec["cover_mm"]), "max_weight": vmax}
+            shares = [rest_lid_weight(self.lids[pattern, side], relaxed, self.column(Column(pattern, side))[:skin],
+                                      self.head.eye_pivot(self.base_positions, side)[1], limits)
+                      for side in ("left", "right")]
+            fitted[code, pattern] = float(np.mean(shares)) / vmax
+        return fitted
 
     @cached_property
     def squint(self) -> dict[tuple[int, str], float]:
