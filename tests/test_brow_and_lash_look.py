@@ -45,3 +45,24 @@ def test_lower_lashes_are_a_fine_row_not_a_fringe_of_spikes():
     share = lashes[below].sum() / lashes[above].sum()
     assert 0.1 < share < 0.3, share
 
+
+def test_a_brows_head_fades_in_rather_than_ending_square():
+    """A brow's head is a few sparse hairs growing upward, skin showing between them, not the
+    square end of a pencil stroke: mei's eyebrow004 kept 0.78-0.89 of its body's cover over its
+    inner tenth at 448 px (blind review, session 23: "painted brows" on 7 of mei's images); now
+    0.56-0.62. Its outline is broken by single hairs (proxy.frag.glsl, brow_feather)."""
+    from scipy import ndimage
+
+    mei = preset("mei")
+    _, cover = _coverage(mei, "brows")
+    labels, count = ndimage.label(cover > 0.05)
+    sizes = ndimage.sum(np.ones_like(cover), labels, range(1, count + 1))
+    for label in np.argsort(sizes)[::-1][:2] + 1:   # the two brows
+        brow = labels == label
+        columns = np.flatnonzero(brow.any(axis=0))
+        along = np.array([(cover[:, x] * brow[:, x]).sum() for x in columns])
+        if abs(columns[-1] - 224) < abs(columns[0] - 224):   # head first (the end nearer the midline)
+            along = along[::-1]
+        n = len(along)
+        assert n > 50, n
+        assert along[: n // 10].mean() < 0.7 * along[n // 4: n // 2].mean(), along
