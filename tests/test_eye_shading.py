@@ -188,3 +188,43 @@ def test_a_relaxed_or_hooded_lid_leaves_the_catch_light_in_view(name):
     lum = _luminance(image)
     peaks = [lum[:, side][cornea[:, side]].max() for side in (slice(0, size // 2), slice(size // 2, size))]
     assert min(peaks) > 165, peaks
+
+
+
+def test_the_two_irises_are_not_one_pattern_twice():
+    """Two eyes of one person share a colour, not a pattern: one noise drew both irises, the
+    right a copy of the left (their fine detail correlated 0.78 on a symmetric face at 768 px;
+    issue 13, "glassy, doll eyes"). Neither a copy nor a mirror image now (0.59 at most).
+    The iris's own pattern: a render with a white iris less one with a black iris (the light
+    on it times its pattern; the catch-light and the sclera cancel), high-passed."""
+    from scipy import ndimage
+
+    size = 768
+    ava = preset("ava").with_(symmetric=True)
+    renders = []
+    for colour in ("#ffffff", "#000000"):
+        with Face(ava.with_(colors={**ava.colors, "iris": colour})) as face:
+            renders.append(face.render("", size=size, antialias=1, background=(1.0, 1.0, 1.0))[..., :3].astype(float))
+    pattern = _luminance(renders[0] - renders[1])
+    iris = pattern > 20
+    detail = pattern - ndimage.gaussian_filter(pattern, 1.0)
+    inner = ndimage.binary_erosion(iris, iterations=2)   # (not the pupil's nor the limbus's edge)
+    reach = size // 30
+    crops = []
+    for side in (slice(0, size // 2), slice(size // 2, size)):
+        eye = np.zeros_like(iris)
+        eye[:, side] = iris[:, side]
+        ys, xs = np.nonzero(eye)
+        cy, cx = int(round(ys.mean())), int(round((xs.min() + xs.max()) / 2))
+        window = (slice(cy - reach, cy + reach + 1), slice(cx - reach, cx + reach + 1))
+        crops.append((detail[window], inner[window]))
+    (left, left_in), (right, right_in) = crops
+    for flip in (False, True):
+        other, other_in = (right[:, ::-1], right_in[:, ::-1]) if flip else (right, right_in)
+        best = -1.0
+        for dy in range(-2, 3):      # (the two eyes' centres are found to a pixel or so)
+            for dx in range(-2, 3):
+                shifted, shifted_in = (np.roll(np.roll(a, dy, 0), dx, 1) for a in (other, other_in))
+                both = left_in & shifted_in
+                best = max(best, np.corrcoef(left[both], shifted[both])[0, 1])
+        assert best < 0.7, (flip, best)

@@ -360,6 +360,7 @@ const int IRIS_FIBRES = 96;        // radial noise cells around the iris
 const float COLLARETTE = 0.33;     // where the collarette lies across the iris annulus (0 pupil, 1 rim)
 const vec2 CARUNCLE = vec2(0.46, 0.56);   // nasal e.x where the caruncle begins and is full
 const float SCLERA_MOTTLE = 0.1;    // the sclera's patchiness (relative, about its mean)
+const float IRIS_SECTORS = 0.22;   // how much lighter or darker the iris's broad sectors are (about its mean)
 const float IRIS_CAUSTIC = 0.3;    // how much brighter the iris's lower rim is (the key is above; 0.5 glowed as in a glass marble)
 // The key's reflection in the cornea: the softbox's half-size (radians, across and up) and
 // strength; the room's faint reflection over the whole cornea. (Issue 13: at 0.22 x 0.19
@@ -421,6 +422,14 @@ const vec2 UPPER_LID_CAST = vec2(0.45, 8.0);
 const vec2 ORBIT_SHADE = vec2(0.4, 0.5);   // how much darker at hy = ORBIT_SHADE.y; from hy 0.3
 float orbit_shade(float hy) {
     return 1.0 - ORBIT_SHADE.x * smoothstep(0.3, ORBIT_SHADE.y, hy);
+}
+// The brow ridge and the upper lid's overhang hide the key above from the iris's upper half:
+// its light falls off upward from below its middle (how much darker at its top, hy ~0.35).
+// An iris lit evenly to its top (its top third 0.8-0.88 of its bottom's under 5) glowed as a
+// lit disc in a ring of shaded white: a doll's glass eye (issue 13).
+const float SOCKET_TOP_SHADE = 0.3;
+float socket_top_shade(float hy) {
+    return 1.0 - SOCKET_TOP_SHADE * smoothstep(-0.15, 0.35, hy);
 }
 #endif
 
@@ -1017,30 +1026,34 @@ void main() {
     float t = clamp((ri - pupil_radius) / (IRIS_RADIUS - pupil_radius), 0.0, 1.0);
     float angle = atan(seen.y, seen.x);
     float turns = (angle / (2.0 * PI) + 0.5) * float(IRIS_FIBRES);
+    // Each iris its own pattern: the other eye's frame is a reflection, so one noise drew the
+    // two irises as mirror twins, a cast pair (issue 13: "glassy, doll eyes"). Its noise is
+    // read elsewhere along the radius-like axis (which keeps the angular wrap seamless).
+    float iris_seed = on_a ? 0.0 : 23.0;
     // Stroma: fine radial fibres (long along the radius, narrow around it), coarser bundles,
     // faded to their mean where they would be finer than a pixel (small images stay calm).
     float fibre_detail = clamp(1.6 - 0.6 * fwidth(turns), 0.0, 1.0);
     // (The fibres wander: evenly spaced straight spokes read as a wheel of glass.)
-    float wander = 1.6 * (value_noise(vec2(turns * 0.125, t * 4.0 + 21.0), IRIS_FIBRES / 8) - 0.5);
+    float wander = 1.6 * (value_noise(vec2(turns * 0.125, t * 4.0 + 21.0 + iris_seed), IRIS_FIBRES / 8) - 0.5);
     // The coarse bundles (a quarter as many around) fade only where they in turn would be finer
     // than a pixel: at 448² the fine fibres are gone, and a disc of one even colour read as a
     // glass or doll's eye (issue 13); a photographed iris there still shows its streaks.
     // (Where the fibres show, the bundles keep their old share, 0.15; where the fibres have
     // faded, twice that. The mean stays 0.5.)
-    float fibre = 0.55 * value_noise(vec2(turns + wander, t * 3.0), IRIS_FIBRES)
-                + 0.3 * value_noise(vec2(turns * 2.0 + 2.0 * wander, t * 1.5 + 3.0), IRIS_FIBRES * 2);
+    float fibre = 0.55 * value_noise(vec2(turns + wander, t * 3.0 + iris_seed), IRIS_FIBRES)
+                + 0.3 * value_noise(vec2(turns * 2.0 + 2.0 * wander, t * 1.5 + 3.0 + iris_seed), IRIS_FIBRES * 2);
     fibre = mix(0.425, fibre, fibre_detail);
     float bundle_detail = clamp(1.6 - 0.6 * fwidth(turns * 0.25), 0.0, 1.0);
-    float bundle = mix(0.5, value_noise(vec2(turns * 0.25, t * 6.0 + 11.0), IRIS_FIBRES / 4), bundle_detail);
+    float bundle = mix(0.5, value_noise(vec2(turns * 0.25, t * 6.0 + 11.0 + iris_seed), IRIS_FIBRES / 4), bundle_detail);
     fibre += 0.075 + mix(0.3, 0.15, fibre_detail) * (bundle - 0.5);
     // The collarette, a third of the way out, is a wavy ridge (it zigzags around the iris):
     // inside it the pupillary zone is darker and warmer, outside it the ciliary zone is
     // broken by darker crypts; a dark ruff rims the pupil and a dark limbal ring the iris.
-    float wave = 0.05 * (value_noise(vec2(turns * 0.33, 0.5), IRIS_FIBRES / 3) - 0.5);
+    float wave = 0.05 * (value_noise(vec2(turns * 0.33, 0.5 + iris_seed), IRIS_FIBRES / 3) - 0.5);
     float collar_t = t - COLLARETTE - wave;
     float inner = 1.0 - smoothstep(-0.03, 0.03, collar_t);
     float ridge = exp(-pow(collar_t / 0.035, 2.0));
-    float crypt = smoothstep(0.68, 0.9, value_noise(vec2(turns * 0.5, t * 5.0 + 5.0), IRIS_FIBRES / 2))
+    float crypt = smoothstep(0.68, 0.9, value_noise(vec2(turns * 0.5, t * 5.0 + 5.0 + iris_seed), IRIS_FIBRES / 2))
                 * smoothstep(0.0, 0.1, collar_t) * (1.0 - smoothstep(0.7, 0.9, t)) * fibre_detail;
     // Less saturated than the base colour: a real iris is a greyish stroma over its pigment,
     // and a clean saturated colour read as a glass or doll's eye (issue: "glassy eyes",
@@ -1055,6 +1068,11 @@ void main() {
     iris *= mix(vec3(1.0), vec3(0.72, 0.64, 0.52), 0.6 * inner);      // darker, warmer pupillary zone
     iris *= 1.0 - 0.3 * ridge * fibre_detail;                          // the collarette's dark fold
     iris *= 1.0 - 0.3 * crypt;
+    // Broad sectors, a few around the iris, lighter or darker and a little warmer where darker
+    // (pigment lies unevenly in the stroma): they outlast the fibres at 448-512², where an iris
+    // of even spokes round a wheel read as glass.
+    float sector = value_noise(vec2(turns / 12.0, 2.0 * t + 40.0 + iris_seed), IRIS_FIBRES / 12) - 0.5;
+    iris *= 1.0 + IRIS_SECTORS * 2.0 * sector * vec3(0.9, 1.0, 1.15);
     iris *= mix(0.45, 1.0, smoothstep(0.0, 0.08, t));                 // pupillary ruff
     iris *= mix(1.0, LIMBAL_RING, smoothstep(1.0 - LIMBUS_WIDTH, 1.0, t));    // limbal ring
     // The cornea gathers the key's light from above onto the iris's lower part (the limbal
@@ -1102,7 +1120,12 @@ void main() {
     sclera *= 1.0 - 0.25 * limbal;
     float iris_soft = front * (1.0 - smoothstep(IRIS_RADIUS - aa - 0.015, IRIS_RADIUS + aa, r));
     sclera *= orbit_shade(hy);   // (the white only: the lids hide the iris's top but where 5 bares it)
-    vec3 albedo = mix(sclera, iris, max(iris_mask, 0.6 * iris_soft));
+    iris *= socket_top_shade(hy);   // (the iris only: the white above it keeps 5's sign, orbit_shade)
+    // The limbus is a band, not a line: the iris's dark rim fades into the white over ~0.5 mm
+    // (the cornea's edge is clouded), where a cut-out disc read as a doll's inset eye. (Mostly
+    // inward: the white that 5 bares above the iris stays white.)
+    float limbus_blend = front * (1.0 - smoothstep(IRIS_RADIUS - 0.022, IRIS_RADIUS + 0.01 + aa, r));
+    vec3 albedo = mix(sclera, iris, max(limbus_blend, 0.6 * iris_soft));
 #ifdef USE_LIDS
     // Along the lids (v_lids: degrees of arc from each margin; ~1.7 px per degree at 1024²):
     // the lower lid's wet inner rim, its margin rolled in against the eyeball, shows as a

@@ -408,6 +408,25 @@ void main() {
     f_color = vec4(finish(albedo * lit * 0.75 + spec).rgb, alpha);
 }
 #else
+#ifdef KIND_EYEBROWS
+// The brow's outline is hairs, not a drawn contour: each texture column (a few hairs wide on
+// screen, slanted as brow hairs grow, up and toward the tail) is read a little above or below
+// its place, so single hairs stick out past the band's edge and gaps open in it. MakeHuman's
+// brow textures are ~10x finer than a 448-px brow: minified, their own stray hairs blur into
+// a smooth band with a crisp contour, a brow painted on (issue 13, mei's eyebrow004).
+// Two sizes of column (per texture unit along u), the finer faded where it would be under a
+// pixel; BROW_FEATHER: the largest shift across the brow (texture v; a brow is ~0.1 tall).
+const vec2 BROW_HAIR_COLUMNS = vec2(45.0, 150.0);
+const float BROW_HAIR_SLANT = 0.6;   // how far a column leans toward the tail per unit it rises
+const float BROW_FEATHER = 0.022;
+vec2 brow_feather(vec2 uv) {
+    vec2 q = vec2(uv.x + BROW_HAIR_SLANT * uv.y, 0.0);
+    float coarse = value_noise(vec2(q.x * BROW_HAIR_COLUMNS.x, 17.5), 0) - 0.5;
+    float fine = value_noise(vec2(q.x * BROW_HAIR_COLUMNS.y, 3.5), 0) - 0.5;
+    float fine_detail = clamp(1.5 - fwidth(q.x * BROW_HAIR_COLUMNS.y), 0.0, 1.0);
+    return uv + vec2(0.0, BROW_FEATHER * (coarse + fine_detail * fine));
+}
+#endif
 #if defined(KIND_HAIR) && !defined(COILY)
 // MakeHuman's straight-hair textures fade their strands' tips over the last centimetre or two
 // of a card: where cards end over the skin (a fringe over the forehead, short01's front edge)
@@ -420,7 +439,13 @@ float dense_tips(float alpha) {
 #endif
 
 void main() {
+#ifdef KIND_EYEBROWS
+    // (The shifted lookup keeps the unshifted one's filter footprint: its columns' jumps
+    // would otherwise pick blurred mip levels.)
+    vec4 tex = textureGrad(u_texture, brow_feather(v_uv), dFdx(v_uv), dFdy(v_uv));
+#else
     vec4 tex = texture(u_texture, v_uv);
+#endif
     float alpha = tex.a;
 #if defined(KIND_HAIR) && !defined(COILY)
     alpha = dense_tips(alpha);
@@ -436,7 +461,9 @@ void main() {
 #ifdef KIND_EYEBROWS
     // v_depth: 0 at the brow's head ... 1 at its tail. The head's hairs grow upward, spaced,
     // so skin shows through (a solid dark head reads as a frown); the tail thins out.
-    float thin = mix(0.5, 1.0, smoothstep(0.0, 0.35, v_depth)) * mix(1.0, 0.55, smoothstep(0.7, 1.0, v_depth));
+    // (The head fades in over its first ~4 mm: at half strength to its end, its cut edge drew
+    // the square end of a pencil stroke.)
+    float thin = mix(0.25, 1.0, smoothstep(0.0, 0.22, v_depth)) * mix(1.0, 0.55, smoothstep(0.7, 1.0, v_depth));
     // The texture's own strokes keep their contrast (doubling alpha filled dense brows such
     // as eyebrow012 into a flat painted strip, issue 13), with a fine breakup across them.
     float grain = value_noise(v_uv * vec2(260.0, 260.0), 0);
