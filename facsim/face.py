@@ -273,7 +273,7 @@ class Face:
         """What the renderer draws of the head: hm08's lash strips give way to a lash proxy,
         and the teeth get coordinates for separate crowns and gums."""
         from facsim.head.mesh import REGIONS, RenderTopology
-        from facsim.head.mouth import teeth_coordinates, tongue_coordinates
+        from facsim.head.mouth import cavity_coordinates, teeth_coordinates, tongue_coordinates
 
         topo = self.head.topology
         faces = topo.faces
@@ -287,8 +287,14 @@ class Face:
             coords = coordinates(self.head, self.data, self.base_positions)
             on = np.flatnonzero(topo.region == REGIONS.index(region))
             uv[on] = coords[topo.render_to_geo[on]]
+        # The lining keeps its skin UVs (the paint's mucosa); its place in the mouth (across,
+        # up the back wall, depth), for the throat's opening and the uvula, rides in the eyes'
+        # slot, which only the eyeballs read otherwise.
+        eye_coord = np.array(topo.eye_coord, copy=True)
+        on = np.flatnonzero(topo.region == REGIONS.index("mouth_interior"))
+        eye_coord[on] = cavity_coordinates(self.head, self.neutral)[topo.render_to_geo[on]]
         return RenderTopology(faces=faces, render_to_geo=topo.render_to_geo, uv=uv,
-                              region=topo.region, eye_coord=topo.eye_coord)
+                              region=topo.region, eye_coord=eye_coord)
 
     @cached_property
     def shading_occlusion(self) -> np.ndarray:

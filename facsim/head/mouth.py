@@ -246,6 +246,30 @@ def tongue_coordinates(head, data, base_positions: np.ndarray) -> np.ndarray:
     return out
 
 
+def cavity_coordinates(head, neutral: np.ndarray) -> np.ndarray:
+    """(N_geo, 3) per vertex of the mouth's lining: (across, -1 right … +1 left, by the
+    lining's half-width; up, -1 … +1 over the back wall's height, 0 at its middle; depth
+    behind the lips, 0 at the lips' rim … 1 at the back wall); zeros elsewhere. Measured on the
+    character's rest mesh (``neutral``, (N_geo, 3)), so the shader's throat, soft palate and
+    uvula stay put on the lining whatever the jaw does. (The back wall: the lining's deepest
+    tenth.)"""
+    from facsim.head.mesh import REGIONS
+
+    out = np.zeros((head.vertex_count, 3), np.float32)
+    lining = np.flatnonzero(head.region == REGIONS.index("mouth_interior"))
+    if not len(lining):
+        return out
+    p = np.asarray(neutral, np.float64)[lining]
+    front, back = float(p[:, 2].max()), float(p[:, 2].min())
+    depth = (front - p[:, 2]) / max(front - back, 1e-6)
+    wall = p[depth > 0.9]
+    bottom, top = float(wall[:, 1].min()), float(wall[:, 1].max())
+    half = max(float(np.abs(p[:, 0]).max()), 1e-6)
+    up = (p[:, 1] - 0.5 * (top + bottom)) / max(0.5 * (top - bottom), 1e-6)
+    out[lining] = np.stack([p[:, 0] / half, up, depth], axis=1)
+    return out
+
+
 def mouth_depth_visibility(head, neutral: np.ndarray, *, falloff: float = 0.18):
     """Mouth-interior vertices and a visibility (1 at the lips … ~0 deep inside) that falls
     off with depth behind the lips, so an open mouth shows a dark cavity, not a lit wall.
@@ -556,7 +580,8 @@ def mouth_light(rim: MouthRim, positions: np.ndarray, occlusion: np.ndarray) -> 
       the lip's soft contact shadow right under its edge, millimetres wide, where the
       band's vertices lie 8 mm apart. (The bake under closed lips means nothing for them.)
       Toward the mouth's corners the height is capped (:data:`COMMISSURE_SHADE`): the
-      teeth there sit in the lips' and cheeks' shade.
+      teeth there sit in the lips' and cheeks' shade. The lower row's edge is the upper
+      teeth's biting edge where that is lower than the lip's: the upper crowns shade it.
     - the tongue takes the light the parted lips let in (:data:`TONGUE_LIT_GAP`): seen
       through the gaps between barely parted teeth it is dark, not a pink dot.
 
@@ -585,11 +610,18 @@ def mouth_light(rim: MouthRim, positions: np.ndarray, occlusion: np.ndarray) -> 
     lo, hi = SLIT_GAP
     parted = np.clip((gap - lo) / (hi - lo), 0.0, 1.0)
     closed = 1.0 - parted * parted * (3.0 - 2.0 * parted)
+    upper_x, upper_y = plane(rim.upper_teeth)
     for teeth in (rim.upper_teeth, rim.lower_teeth):
         x, y = plane(teeth)
         # The upper lip's lowest point within a tooth column's reach of x.
         over = np.abs(x[:, None] - lip_x[None]) < COLUMN_REACH
         edge = np.where(over.any(axis=1), np.where(over, lip_y[None], np.inf).min(axis=1), upper_edge(x))
+        if teeth is rim.lower_teeth and len(upper_x):
+            # The lower row also lies in the upper teeth's shade: their biting edge (the upper
+            # row's lowest point over it) overhangs it in the bite, and a parted smile lit the
+            # lower crowns up to that edge: the two rows ran together into one pale grille.
+            above = np.abs(x[:, None] - upper_x[None]) < COLUMN_REACH
+            edge = np.minimum(edge, np.where(above, upper_y[None], np.inf).min(axis=1))
         from_corner = np.minimum(x - corners.min(), corners.max() - x)
         slope, offset = COMMISSURE_SHADE
         occlusion[teeth] = np.minimum(edge - y, slope * from_corner - offset) - SLIT_SHIFT * closed

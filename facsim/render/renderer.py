@@ -100,7 +100,7 @@ PORES_MIN_SIZE = 1024
 _PASSES = {
     "skin": ("REGION_SKIN", "USE_UV", "USE_WRINKLE"),
     "skin_brows": ("REGION_SKIN", "USE_UV", "USE_WRINKLE", "USE_BROWS"),
-    "mouth_interior": ("REGION_MOUTH_INTERIOR",),
+    "mouth_interior": ("REGION_MOUTH_INTERIOR", "USE_EYE"),   # v_eye: the lining's place (Face.topology)
     "teeth": ("REGION_TEETH", "USE_UV"),
     "tongue": ("REGION_TONGUE", "USE_UV"),
     "eyeball": ("REGION_EYEBALL", "USE_EYE", "USE_LIDS"),
@@ -464,6 +464,8 @@ class Renderer:
             _set_uniform(prog, "u_age", appearance.age)   # (the pupil narrows with age)
         else:
             _set_uniform(prog, "u_albedo", lin(_SINGLE_COLOR[name]))
+            if name == "mouth_interior":   # its rim is the lips' mucosa, as dark as the lips are
+                _set_uniform(prog, "u_lips", lin("lips"))
 
     # -- per frame -----------------------------------------------------------------------
     def render(self, positions: np.ndarray, *, appearance: Appearance, camera: Camera,

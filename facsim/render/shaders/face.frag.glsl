@@ -435,6 +435,16 @@ float socket_top_shade(float hy) {
 
 #if defined(REGION_SKIN) || defined(REGION_MOUTH_INTERIOR)
 const vec3 MUCOSA = vec3(0.40, 0.075, 0.09);   // the lips' mucosa (linear; sRGB ~ #aa4d54)
+// The mucosa of darker lips: lighter and pinker than their vermilion, but by about this much in
+// luminance, not by MUCOSA's own (darker skin carries melanin into the lips' lining too). Drawn
+// in MUCOSA's one pink, 2.7 times as light as amara's lips, the lower lip's inner face over her
+// lower teeth read as "red texture artifact in mouth" (blind review, session 23); lips lighter
+// than the mucosa (light skin) keep MUCOSA.
+const float MUCOSA_OVER_DARK_LIPS = 1.4;
+vec3 mucosa_colour(vec3 lips) {
+    const vec3 Y = vec3(0.2126, 0.7152, 0.0722);
+    return MUCOSA * min(1.0, MUCOSA_OVER_DARK_LIPS * dot(lips, Y) / dot(MUCOSA, Y));
+}
 #endif
 #if defined(REGION_TEETH) || defined(REGION_TONGUE)
 #define ONE_ALBEDO
@@ -481,8 +491,11 @@ vec3 tongue_depth_light(float along) {
 // from 0.4 of the lining's colour just inside the lips down to CAVITY_BACK of that at the back
 // of the mouth (~5 cm: 0.6 left at 1 cm, 0.3 at 3 cm), so the back of an open mouth is dark,
 // as in photographs; uniform, the palate and the back wall were one flat dark red ("mouth
-// interior flat").
-const float CAVITY_BACK = 0.15;
+// interior flat"). (At 0.15 the back wall was near-black, luminance ~4-8 of 255, and with
+// the throat's opening darker still the back of kwame's surprise read as a black hole; lit
+// to CAVITY_BACK 0.45 the walls round the throat stay a dark red and the throat's opening
+// (throat_shape) is the darkest part, as in photographs.)
+const float CAVITY_BACK = 0.45;
 const float ROOF_LIGHT = 0.35;
 // Behind the lips, what light the opening lets in reaches the lining after bouncing off more
 // red lining and the tongue: warm. (Lit by the room's light as it is, the back of a wide-open
@@ -490,6 +503,35 @@ const float ROOF_LIGHT = 0.35;
 // grey-mauve curtain.) DEEP_BOUNCE, as on the tongue's back.
 vec3 cavity_deep_colour(vec3 lining, float visibility) {
     return 0.4 * lining * vec3(1.0, 0.9, 0.9) * mix(CAVITY_BACK, 1.0, visibility);
+}
+// The back wall of the mouth is not one even surface: in its middle the throat opens (the
+// oropharynx, under the soft palate's arch between its pillars), and from the arch's top the
+// uvula hangs in front of that dark. A wide-open mouth in photographs shows that shape: the
+// lining round it dark red, the opening near black, the uvula a lighter lobe at its top. Drawn
+// as one even dark red the back read as a "dark flat mouth hole" (blind review, session 23: 9 of
+// 156 images). In the back wall's coordinates (cavity_coordinates: across -1..1, up -1..1):
+// the arch's centre and half-sizes, the uvula's length down from the arch's top and half-width.
+const vec2 THROAT_CENTRE = vec2(0.0, -0.95);
+const vec2 THROAT_SIZE = vec2(0.34, 0.8);
+const vec2 UVULA = vec2(0.5, 0.11);
+// The light left in the throat's opening, and on the uvula (its rounded front faces the opening).
+const float THROAT_DARK = 0.3;
+const float UVULA_LIGHT = 1.1;
+// How the back of the mouth differs from an even wall at ``c`` (cavity_coordinates): x how much
+// of the throat's dark opening is there (0..1), y how much uvula, z the soft palate's rim round
+// the arch (lit a little more, its edge turned toward the opening).
+vec3 throat_shape(vec3 c) {
+    float back = smoothstep(0.75, 0.92, c.z);
+    vec2 q = (c.xy - THROAT_CENTRE) / THROAT_SIZE;
+    float r = length(q);
+    float aa = max(fwidth(r), 0.02);
+    float opening = 1.0 - smoothstep(0.7, 1.1 + aa, r);
+    float top = THROAT_CENTRE.y + THROAT_SIZE.y;             // the arch's top
+    float hang = (top - c.y) / UVULA.x;                      // 0 at the arch .. 1 at the tip
+    float half_width = UVULA.y * (1.0 - 0.2 * hang) * sqrt(max(1.0 - pow(hang, 4.0), 0.0));   // a pendant, round-tipped
+    float uvula = (1.0 - smoothstep(0.8 * half_width, half_width + 0.01, abs(c.x))) * step(0.0, hang) * step(hang, 1.0);
+    float rim = smoothstep(0.75, 1.0, r) * (1.0 - smoothstep(1.0, 1.25, r));
+    return back * vec3(opening * (1.0 - uvula), uvula * opening, rim);
 }
 #endif
 #ifdef REGION_TEETH
@@ -541,10 +583,10 @@ const float ENAMEL_GLOW = 0.06;
 // edge; with the edge lit as the front it faces (render.geometry.teeth_normal_operator), 0.9
 // drew a smile's teeth at L* ~83, 1.39 times the cheek's: glowing. Natural teeth in
 // photographs are L* ~65-80, lighter than the skin but not by a third.)
-const float TEETH_DIFFUSE = 0.65;
+const float TEETH_DIFFUSE = 0.58;
 // What light reaches the enamel inside the mouth has partly bounced off the lips, gums and
 // tongue: warm. (Dimmed without it, the crowns turned grey, not ivory: C* ~11 at L* ~73.)
-const vec3 INSIDE_WARMTH = vec3(1.0, 0.96, 0.88);
+const vec3 INSIDE_WARMTH = vec3(1.0, 0.98, 0.95);
 // How far the biting edge's translucent band turns to the blue-grey of the dark behind it
 // (0.65 drew the upper laterals and canines, whose edges are cut back, as grey-blue slabs).
 const float INCISAL_TRANSLUCENCY = 0.4;
@@ -552,7 +594,7 @@ const vec3 DEEP_TEETH_BOUNCE = vec3(1.0, 0.42, 0.38);
 // Natural teeth differ: each crown's value by up to TOOTH_SHADE_SPREAD.x (a quarter of it brighter
 // or darker than the albedo) and its yellowing toward TOOTH_YELLOW by up to TOOTH_SHADE_SPREAD.y;
 // toward the gum the dentin shows through the thinner enamel (TOOTH_CERVICAL, at the neck).
-const vec2 TOOTH_SHADE_SPREAD = vec2(0.16, 0.7);
+const vec2 TOOTH_SHADE_SPREAD = vec2(0.16, 0.4);
 const vec3 TOOTH_YELLOW = vec3(1.0, 0.95, 0.84);
 const vec3 TOOTH_CERVICAL = vec3(0.97, 0.87, 0.7);
 // Where the gum begins on each crown's outer wall (band units up from the biting edge): upper row
@@ -577,14 +619,31 @@ vec3 crown_normal(vec3 n, vec3 along, float slope) {
 // (EMBRASURE_SHADE 0.35, up the crowns 0.6 of it: the crowns ran together into one strip; the
 // lower row's, seen from above, keep less up the crowns or the row reads as a grille.)
 const float EMBRASURE_SHADE = 0.5;
+// Up the upper crowns, where two teeth touch, their embrasure keeps this much of its shade at the
+// edge. (0.75 drew a grey line the crown's full height between every pair of teeth, evenly
+// spaced: at 448 px the row read as "smeared like a grille"; the crowns now part by their
+// own sheen and rounding, ENAMEL_SHEEN.)
+const float EMBRASURE_UP_CROWN = 0.4;
+// Wet enamel mirrors the studio's large frontal lights: a soft vertical sheen down the middle of
+// each crown (ENAMEL_SHEEN_WIDTH of its width), where its bulge faces the light, fading onto the
+// flanks and toward the gum, and only where the crown faces the camera. (The crowns' normals
+// never come within ~20 degrees of the view, the labial faces leaning back, so a mirror lobe
+// about the view missed them.) Without it the crowns were matte, one flat beige from the edge
+// to the lip ("teeth blurry", "yellow blur", 14 of the blind reviewer's 156 images); the sheen
+// parts the crowns where grey lines between them read as a grille.
+const float ENAMEL_SHEEN = 0.18;
+const float ENAMEL_SHEEN_WIDTH = 0.22;
 float embrasure_shade(float to_gap, float aa, float h, float lower) {
     float at_edge = mix(1.0, 0.5, lower);
     return EMBRASURE_SHADE * (1.0 - smoothstep(0.0, aa + 0.008, to_gap)) * clamp(1.5 - 120.0 * aa, 0.3, 1.0)
-         * mix(at_edge, mix(0.75, 0.4, lower), smoothstep(0.04, 0.25, h));
+         * mix(at_edge, mix(EMBRASURE_UP_CROWN, 0.4, lower), smoothstep(0.04, 0.25, h));
 }
 #endif
 #if defined(ONE_ALBEDO) || defined(REGION_MOUTH_INTERIOR) || defined(REGION_LASHES) || defined(REGION_GARMENT)
 uniform vec3 u_albedo;
+#endif
+#ifdef REGION_MOUTH_INTERIOR
+uniform vec3 u_lips;         // the lining just inside the lips is their mucosa (mucosa_colour)
 #endif
 
 #ifdef REGION_LASHES
@@ -731,7 +790,7 @@ void main() {
     float lips_soft = textureLod(u_paint, v_uv, LIP_BORDER_LOD).g;
     albedo = mix(albedo, lip_col, smoothstep(0.0, 1.0, mix(lips, lips_soft, LIP_BORDER_SOFTNESS)));
     albedo *= 1.0 + 0.03 * border * (1.0 - u_age);   // (faint: a bright rim outlined the lips)
-    albedo = mix(albedo, mix(u_lips, MUCOSA, 0.8) * (0.9 + 0.2 * blotch), mucosa);
+    albedo = mix(albedo, mix(u_lips, mucosa_colour(u_lips), 0.8) * (0.9 + 0.2 * blotch), mucosa);
 #ifdef USE_BROWS
     vec2 brow = brow_hair(v_uv, paint.r);
 #else
@@ -1282,12 +1341,16 @@ void main() {
     float depth_shade = mix(1.0, 0.09, smoothstep(mix(0.12, 0.08, lower), mix(0.36, 0.28, lower), arc));
     float slit_light = mix(CLOSED_LIPS_DARK, 1.0, smoothstep(-1.3, -0.7, v_occlusion));
     float lip_shadow = mix(LIP_SHADOW_FLOOR, 1.0, smoothstep(-0.002, 0.022, v_occlusion)) * slit_light;
-    float row_light = mix(1.0, 0.62, lower);
+    float row_light = mix(1.0, 0.55, lower);
     // The inside of the arch faces the tongue and throat: it only catches light scattered in.
     float mouth_shade = depth_shade * lip_shadow * row_light * mix(1.0, 0.12, smoothstep(0.0, 0.1, lingual))
                       * mix(1.0, 0.5, lingual_gum);
     float wet = specular_light(n, v, 120.0).r * 0.35 + specular_light(n, v, 30.0).r * 0.05;
     vec3 spec = vec3(wet) * (1.0 - 0.6 * gum) * schlick(0.05, max(dot(n, v), 0.0)) * 3.0;
+    // (Each crown's its own: off its middle by up to a tenth of its width, and stronger or weaker.)
+    float sheen_across = (w - 0.5 - 0.2 * (vary - 0.5)) / ENAMEL_SHEEN_WIDTH;
+    spec += ENAMEL_SHEEN * (0.7 + 0.6 * yellowing) * exp(-sheen_across * sheen_across) * pow(max(dot(n, v), 0.0), 4.0)
+          * (1.0 - smoothstep(0.1, gum_edge, h)) * (1.0 - lower) * float(shaped);
     // Enamel scatters light inside the tooth: a little of its own brightness beyond the lighting.
     radiance = ((diffuse_light(n, vec3(0.3, 0.25, 0.2), TEETH_AMBIENT) * TEETH_DIFFUSE + ENAMEL_GLOW) * albedo * mix(INSIDE_WARMTH, vec3(1.0), gum)
                 + spec) * mouth_shade;
@@ -1320,7 +1383,10 @@ void main() {
     vec3 mouth_shade = tongue_depth_light(along) * mix(1.0, 0.5, smoothstep(0.4, 1.0, abs(across)))
                      * mix(0.1, 1.0, occ);
     // Moist: a soft sheen broken by the papillae, and a tighter glint on the film of saliva.
-    vec3 spec = specular_light(n, v, 40.0) * 0.12 * papillae + specular_light(n, v, 90.0) * 0.22 * smoothstep(0.8, 1.1, papillae);
+    // (A broad lobe, shininess 40 at 0.12, laid one smooth highlight over the whole dome: "the
+    // tongue has a plastic sheen". The papillae make the surface velvety: little broad sheen,
+    // the glints where the film pools between them.)
+    vec3 spec = specular_light(n, v, 60.0) * 0.06 * papillae + specular_light(n, v, 120.0) * 0.3 * smoothstep(0.8, 1.1, papillae);
     // The film mirrors the key through the opening wherever the tongue's front faces it: the
     // sheen is dimmed by how far back it lies and by the light the lips let in, not by the
     // shade that scattered light falls into (there it was lost, a matte tongue).
@@ -1342,9 +1408,13 @@ void main() {
     float mouth_shade = occ * occ * mix(ROOF_LIGHT, 1.0, max(smoothstep(-0.7, 0.0, n.y), lip_side));
     vec3 spec = specular_light(n, v, 30.0) * mix(0.04, 0.3, lip_side);
     vec3 deep = cavity_deep_colour(u_albedo, occ);
-    vec3 albedo = mix(u_albedo * 0.45, MUCOSA * 0.8, lip_side);
+    vec3 albedo = mix(u_albedo * 0.45, mucosa_colour(u_lips) * 0.8, lip_side);
     radiance = (diffuse_light(n, vec3(0.3, 0.1, 0.1), 1.0) * mix(DEEP_BOUNCE, vec3(1.0), lip_side) * albedo + spec) * mouth_shade
              + deep * (1.0 - mouth_shade);
+    // The back wall's shape: the throat's dark opening, the uvula hanging in it, the arch's rim.
+    vec3 throat = throat_shape(v_eye);
+    float uvula_round = 1.0 - 0.6 * pow(clamp(abs(v_eye.x) / UVULA.y, 0.0, 1.0), 2.0);
+    radiance *= mix(1.0, THROAT_DARK, throat.x) * mix(1.0, UVULA_LIGHT * uvula_round, throat.y) * (1.0 + 0.3 * throat.z);
 #endif
 
 #ifdef REGION_GARMENT
