@@ -20,6 +20,10 @@ count. On their luminance (Rec. 709 weights on the sRGB values) it prints
   luminance's structure tensor (Sobel gradients, Gaussian sigma 2 px), averaged over the hair
   pixels weighted by the gradient energy; 0 for blotches that vary alike every way, 1 for
   parallel streaks;
+- ``hairline``: in the middle fifth of the columns, the mean luminance of the hair 2-9 px
+  above the forehead's hairline (the lowest pixel above 35 % of the height darker than 0.6 of
+  the forehead there; for hair darker than the skin) over the hair's mean luminance: hair drawn
+  in the shade of the cards' edge, a dark brim along the forehead, gives a low figure;
 - ``crown``: on the crown (hair pixels from the top of the image to 4 % of its height below the
   top of the skin, in the middle 40 % of its width), the standard deviation of the luminance's
   band-pass down the columns (Gaussian 1.5 px minus 6 px) over the mean: rows of cards drawn
@@ -74,6 +78,23 @@ def streak_coherence(image: np.ndarray, mask: np.ndarray, *, sigma: float = 2.0)
     return float((coherence[mask] * weight).sum() / max(float(weight.sum()), 1e-6))
 
 
+def hairline_band(image: np.ndarray, mask: np.ndarray, *, rows: tuple[int, int] = (2, 9)) -> tuple[float, int]:
+    """(figure, columns): the ``hairline`` figure (module docstring) of an (H, W, 4) uint8 render
+    with its hair ``mask`` (:func:`hair_mask`), and over how many columns it was taken."""
+    lum = image[..., :3].astype(np.float32) @ np.array([0.2126, 0.7152, 0.0722], np.float32) / 255.0
+    h, w = lum.shape
+    forehead = int(0.35 * h)
+    band = []
+    for x in range(int(0.4 * w), int(0.6 * w)):
+        dark = np.nonzero(lum[:forehead, x] < 0.6 * lum[forehead, x])[0]
+        if len(dark) and dark.max() > rows[1]:
+            edge = dark.max()
+            band.append(lum[edge - rows[1]:edge - rows[0] + 1, x])
+    if not band or not mask.any():
+        return 0.0, 0
+    return float(np.mean(band) / lum[mask].mean()), len(band)
+
+
 def partial_cover_below_jaw(with_hair: np.ndarray, without_hair: np.ndarray) -> tuple[float, int]:
     """(share, pixels): of the pixels in the lowest 3/8 of two (H, W, 4) uint8 RGBA renders on a
     transparent background where the hair covers the background (see the module docstring),
@@ -119,6 +140,8 @@ def main(argv=None) -> int:
     print(f"{args.character} {args.view}: fine {fine:.3f}, mass {mass:.3f} over {int(mask.sum())} hair pixels "
           f"({args.size}²)")
     print(f"streaks: {streak_coherence(images[0], mask):.3f} coherence of the hair's detail")
+    band, columns = hairline_band(images[0], mask)
+    print(f"hairline: {band:.3f} the hair just above the forehead's hairline over the hair's mean, {columns} columns")
     banding, pixels = crown_banding(images[0], mask, images[1])
     print(f"crown: {banding:.3f} band-pass down the columns over {pixels} crown pixels")
     share, pixels = partial_cover_below_jaw(*images)

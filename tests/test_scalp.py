@@ -354,3 +354,27 @@ def test_a_grey_hairline_at_1024_is_strands_not_a_translucent_film(face_of):
     band = _hairline_band(alpha, blur=7)
     assert band.sum() > 10000
     assert ((alpha[band] >= 0.05) & (alpha[band] < 0.5)).mean() < 0.19
+
+
+def test_the_hairline_is_hair_in_the_open_not_a_dark_brim(face_of):
+    """The scalp's hairs within about a centimetre of the hairline grow in the open: the cards'
+    edge stands a few millimetres off the forehead, and its shadow and the roots' shade drew the
+    hairs under it as a dark brim along the forehead ("helmet hair / hair cap edge", blind review
+    session 23, 13 of ava's 26 images). On ava at 384² the hair 2-9 px above the forehead's
+    hairline over the hair's mean luminance (benchmarks/bench_hair_texture.py's ``hairline``)
+    was 1.03; now 1.26."""
+    import sys
+    from pathlib import Path
+
+    from facsim.face import Face
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+    from bench_hair_texture import hair_mask, hairline_band
+
+    face = face_of("ava")
+    with Face(face.character.with_(hair="none")) as bald:
+        without = bald.render(None, size=384, background=None)
+    with_hair = face.render(None, size=384, background=None)
+    band, columns = hairline_band(with_hair, hair_mask(with_hair, without))
+    assert columns > 50
+    assert band > 1.15, band

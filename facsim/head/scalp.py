@@ -42,7 +42,8 @@ HAIRLINE_WIDTH = 0.06
 #: Height (dm) of the layer over the skin: enough not to fight it in the depth buffer.
 LIFT = 0.004
 #: Bump when the layer a character gets changes (its disk cache is keyed by it).
-VERSION = 12  # 2: afro01's cards stand off the skull (volume_mm in hair.yaml); 12: crops' anatomical, rounded hairline
+VERSION = 13  # 2: afro01's cards stand off the skull (volume_mm in hair.yaml); 12: crops' anatomical, rounded hairline;
+#   13: every layer carries its height above the hairline
 #: Close crops (:func:`crop_hairline`): the radius (dm) over which the hairline is rounded off
 #: (the skin's vertices lie about a centimetre apart: an edge along them runs in steps) ...
 CROP_ROUNDING = 0.07
@@ -254,10 +255,12 @@ class ScalpLayer:
     normals : (K, 3) float32
         The skin's outward normals there at neutral (the layer is lifted along them).
     hairline : (K,) float32 or None
-        A close crop's: each vertex's distance from its hairline along the skin, in
-        :data:`CROP_EDGE` widths, positive inside (:func:`crop_hairline`); the renderer thins
-        the hair over the band from 0 to 1 per pixel, so the hairline is a smooth curve however
-        coarse the skin's triangles. None under a hairstyle's cards.
+        Each vertex's distance inside the hairline in :data:`CROP_EDGE` widths. A close crop's:
+        along the skin from its own hairline (:func:`crop_hairline`); the renderer thins the hair
+        over the band from 0 to 1 per pixel, so the hairline is a smooth curve however coarse the
+        skin's triangles. Under a hairstyle's cards: the height above :func:`hairline_height`;
+        the renderer lights the hairs near it in the open (the cards' edge stands off the skin
+        there, and its shadow on the hairs under it drew a dark brim along the forehead).
     """
 
     vertices: np.ndarray
@@ -385,8 +388,11 @@ def scalp_layer(head, neutral_geometry: np.ndarray, cards: np.ndarray, card_tria
     """
     n_skin = head.skin_vertex_count
     skin, tris, normals = outward_skin(head, neutral_geometry)
-    density = scalp_density(skin, normals, cards, card_triangles, floor_y=hairline_height(normals, skin[:, 2], eye_y, eye_z, hairline))
-    above = None
+    floor_y = hairline_height(normals, skin[:, 2], eye_y, eye_z, hairline)
+    density = scalp_density(skin, normals, cards, card_triangles, floor_y=floor_y)
+    # Under cards: the height above the table's hairline, in the same widths (the hairs
+    # there grow in the open, however full their density: the shader lights them so).
+    above = np.clip((skin[:, 1] - floor_y) / CROP_EDGE, -6.0, 6.0).astype(np.float32)
     if crop is not None:
         # The hairline: the table's, on the skin off the ears, rounded off.
         grown = skin[:, 1] > crop_hairline_height(skin, normals, eye_y, crop)
@@ -409,7 +415,7 @@ def scalp_layer(head, neutral_geometry: np.ndarray, cards: np.ndarray, card_tria
     uv = strand_coordinates(skin[vertices], normals[vertices], flow, triangles) / np.asarray(TILE, np.float32)
     return ScalpLayer(vertices=vertices, triangles=triangles.astype(np.int32), density=density[vertices],
                       uv=uv.astype(np.float32), normals=normals[vertices].astype(np.float32),
-                      hairline=None if above is None else above[vertices])
+                      hairline=above[vertices])
 
 
 def card_cover(cards: np.ndarray, skin: np.ndarray, density: np.ndarray, *, reach: float = 0.06) -> np.ndarray:

@@ -88,7 +88,9 @@ class ProxyMesh:
         A crop's scalp layer: each vertex's distance inside the crop's hairline in widths of the
         band over which its hair thins (facsim.head.scalp.crop_hairline; linear across the
         skin's triangles): the shader thins the hair over 0 … 1 per pixel, so the hairline is a
-        smooth, soft curve however coarse the triangles.
+        smooth, soft curve however coarse the triangles. Other scalp layers: the height above
+        the hairline in those widths (facsim.head.scalp.ScalpLayer.hairline): the hairs near it
+        are lit in the open.
     """
 
     name: str

@@ -340,8 +340,14 @@ void main() {
     vec3 t = normalize(v_tangent);
     float kl = clamp(dot(n, u_key_dir) * 0.5 + 0.5, 0.0, 1.0);
     float dk = mix(strand_diffuse(t, u_key_dir), 1.0, 0.3) * kl * kl * 1.25;
+    // The hairs within about a centimetre of the hairline (v_cover: the height above it in
+    // centimetres, facsim.head.scalp.ScalpLayer.hairline) grow in the open, as the cards' outer
+    // strands do: the cards' edge stands a few millimetres off the forehead, and its shadow
+    // and the roots' shade drew the hairs under it as a dark brim along the hairline ("helmet
+    // hair / hair cap edge", blind review session 23). They take the key light unshadowed.
+    float in_open = 1.0 - smoothstep(0.6, 1.5, v_cover);
 #ifdef USE_SHADOW
-    dk *= key_visibility(v_pos, n);   // under the cards' shadow, as the skin it lies on
+    dk *= mix(key_visibility(v_pos, n), 1.0, in_open);   // under the cards' shadow, as the skin it lies on
 #endif
     float df = clamp(dot(n, u_fill_dir) * 0.5 + 0.5, 0.0, 1.0);
     vec3 lit = dk * u_key_col + df * u_fill_col + hemisphere(n) * 0.8;
@@ -368,7 +374,7 @@ void main() {
         light_hair *= 0.4;
     }
 #endif
-    float shade = mix(0.9, mix(0.35, 0.7, light_hair), smoothstep(0.3, 1.0, v_depth));
+    float shade = mix(0.9, mix(0.35, 0.7, light_hair), smoothstep(0.3, 1.0, v_depth) * (1.0 - in_open));
     vec3 albedo = hair_colour(suv * vec2(8.0, 2.0)) * (0.55 + 0.9 * tex.r) * shade * strand_shade;
     f_color = vec4(finish(albedo * lit).rgb, alpha);
 #endif
