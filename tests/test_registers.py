@@ -443,6 +443,20 @@ def test_9_narrows_the_eye_from_above_as_well_as_below(face_of, marks, character
     assert glare[marks["upper_lid_left"], Y] > -0.003
 
 
+def test_9_raises_the_upper_lip_in_an_inverted_u(engine, marks):
+    """FACS 9 and 10 raise the upper lip's centre most and its outer parts less, an inverted U.
+    ARKit's mouthUpperUp (9's 0.45 until session 24) lifts the lip evenly over the canines: halfway
+    to the corner it rose 0.70 of the middle's 3.7 mm, a flat-topped box of upper teeth over the lower
+    that read as anger's clenched snarl in disgust (9+15+16). Now 0.52 of 3.1 mm."""
+    moved = _moved(engine, "9")
+    rest = engine.neutral
+    skin = rest[: engine.head.skin_vertex_count]
+    middle, corner = rest[marks["upper_lip"]], rest[marks["lip_corner_left"]]
+    halfway = int(np.argmin(((skin - (middle + corner) / 2) ** 2).sum(1)))
+    assert moved[marks["upper_lip"], Y] > 0.025
+    assert moved[halfway, Y] < 0.6 * moved[marks["upper_lip"], Y]
+
+
 @pytest.mark.parametrize("level", [1.0, 0.5])
 def test_default_anger_has_none_of_disgusts_lower_face(engine, marks, level):
     """Session 18 (HapFACS anger named disgust 5 times in 12 by a blind reviewer, for its nose
