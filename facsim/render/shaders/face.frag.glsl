@@ -146,6 +146,16 @@ float pore_aggregate(vec2 p) {
 // at 1-mm cells and 3.0 the stubble drew a camouflage of blotches.)
 const vec2 STUBBLE_CELLS = vec2(700.0, 1400.0);
 const float STUBBLE_GRAIN = 1.5;
+// The stubble's shade over the skin (a multiplier where it is full): dark hairs seen in and through
+// the skin are a blue-grey shadow (DARK_STUBBLE); grey and white ones (brows as light as george's,
+// linear luminance ~0.13: the beard greys with them) a fainter, neutral one (GREY_STUBBLE). (Until
+// session 24 the dark hairs' blue-grey on every man: over george's sallow skin his lower face drew
+// lilac.)
+const vec3 DARK_STUBBLE = vec3(0.70, 0.72, 0.78);
+const vec3 GREY_STUBBLE = vec3(0.79, 0.78, 0.77);
+vec3 stubble_shade() {
+    return mix(DARK_STUBBLE, GREY_STUBBLE, smoothstep(0.05, 0.15, dot(u_brows, vec3(0.2126, 0.7152, 0.0722))));
+}
 
 // The skin's unevenness between the blotches and the regional maps (5-30 mm, what a photograph of
 // a face at 448 px shows most): blood flushes the skin in irregular patches (more where the
@@ -673,7 +683,7 @@ void main() {
     if (stubble > 0.0) {
         stubble *= clamp(1.0 + STUBBLE_GRAIN * pore_aggregate(stubble_uv, stubble_px), 0.0, 2.0);
     }
-    albedo = mix(albedo, albedo * vec3(0.70, 0.72, 0.78), stubble);
+    albedo = mix(albedo, albedo * stubble_shade(), stubble);
     // Age spots (solar lentigines): sparse, soft tan patches a few millimetres to a centimetre
     // across where the sun reaches, growing with age. (Until session 20 they were the peaks of the
     // few-mm blotches, an orange multiplier: on george's forehead a rash of small red-brown dots.)
