@@ -183,16 +183,16 @@ vec3 mid_tone(vec2 skin_uv, float redness, float melanin_rich) {
 
 // The share of the regional redness (the nose, the cheeks) that older skin keeps: young skin flushes
 // nearly evenly; with age the flush gathers into the dilated capillaries of the nose and cheeks, in
-// patches a few millimetres across (a noise of cells ~4 mm and the blotches', ~2 mm, ``blotch``:
+// patches a few millimetres across (a noise of cells ~7 mm and the blotches', ~2 mm, ``blotch``:
 // the flush's own 1.5-cm patches left a whole nose one pink) over skin that has gone sallow, where
 // AGED_FLUSH_FLOOR of it is left (the noise under AGED_FLUSH_RANGE.x; all of it over .y). It scales
 // both the regional redness and the mid-scale flush's (mid_tone). (Until session 24 the young
 // skin's even flush at any age: george's nose tip at 448 px a* 21.7 (10.5 without the redness; now
-// 15.0), his cheeks 16.0 - the blind reviewer's "pink waxy skin" on 17 of his 26 images.)
+// 14.6), his cheeks 16.0 (now 14.1) - the blind reviewer's "pink waxy skin" on 17 of his 26 images.)
 const float AGED_FLUSH_FLOOR = 0.2;
 const vec2 AGED_FLUSH_RANGE = vec2(0.45, 0.72);
 float aged_flush(vec2 skin_uv, float blotch) {
-    float n = 0.6 * value_noise(skin_uv * vec2(90.0, 180.0) + 37.0, 0) + 0.4 * blotch;
+    float n = 0.6 * value_noise(skin_uv * vec2(50.0, 100.0) + 37.0, 0) + 0.4 * blotch;
     return mix(1.0, mix(AGED_FLUSH_FLOOR, 1.0, smoothstep(AGED_FLUSH_RANGE.x, AGED_FLUSH_RANGE.y, n)), u_age);
 }
 
