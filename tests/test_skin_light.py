@@ -95,7 +95,9 @@ def test_the_oily_t_zone_shines_more_than_the_dry_cheeks():
     key = (-0.3, 0.3, 0.9)
     dry, oily = render_sphere(0.8, oil=90, key=key), render_sphere(0.8, oil=255, key=key)
     highlight = (slice(30, 42), slice(30, 42))
-    assert oily[highlight][..., :3].mean() > dry[highlight][..., :3].mean() + 4
+    # (+4 until session 24 (main 25b1063: +4.9), whose thinner oil film took the white glare off dark
+    # foreheads: +2.8.)
+    assert oily[highlight][..., :3].mean() > dry[highlight][..., :3].mean() + 2
     rim = (slice(44, 52), slice(84, 90))   # facing away from the key's reflection
     assert oily[rim][..., :3].mean() == pytest.approx(dry[rim][..., :3].mean(), abs=3)
 

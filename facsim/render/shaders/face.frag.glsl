@@ -146,6 +146,16 @@ float pore_aggregate(vec2 p) {
 // at 1-mm cells and 3.0 the stubble drew a camouflage of blotches.)
 const vec2 STUBBLE_CELLS = vec2(700.0, 1400.0);
 const float STUBBLE_GRAIN = 1.5;
+// The stubble's shade over the skin (a multiplier where it is full): dark hairs seen in and through
+// the skin are a blue-grey shadow (DARK_STUBBLE); grey and white ones (brows as light as george's,
+// linear luminance ~0.13: the beard greys with them) a fainter, neutral one (GREY_STUBBLE). (Until
+// session 24 the dark hairs' blue-grey on every man: over george's sallow skin his lower face drew
+// lilac.)
+const vec3 DARK_STUBBLE = vec3(0.70, 0.72, 0.78);
+const vec3 GREY_STUBBLE = vec3(0.79, 0.78, 0.77);
+vec3 stubble_shade() {
+    return mix(DARK_STUBBLE, GREY_STUBBLE, smoothstep(0.05, 0.15, dot(u_brows, vec3(0.2126, 0.7152, 0.0722))));
+}
 
 // The skin's unevenness between the blotches and the regional maps (5-30 mm, what a photograph of
 // a face at 448 px shows most): blood flushes the skin in irregular patches (more where the
@@ -171,16 +181,18 @@ vec3 mid_tone(vec2 skin_uv, float redness, float melanin_rich) {
     return tint * (1.0 - MID_PIGMENT * (1.0 + 1.6 * melanin_rich + AGED_PIGMENT * u_age) * pigment * vec3(0.95, 1.0, 1.08));
 }
 
-// The share of the regional redness (the nose, the cheeks) that older skin keeps, from a noise ``n``
-// (mean 0.5) of the blotches (~2 mm) and the patches (~1.5 cm): young skin flushes nearly evenly;
-// with age the flush gathers into the dilated capillaries of the nose and cheeks, in patches a few
-// millimetres across (the noise above AGED_FLUSH_RANGE.x, full above .y) over skin that has gone
-// sallow, where AGED_FLUSH_FLOOR of it is left. (Until session 24 the young skin's even flush at
-// any age: george's nose at 448 px a* 21 against 10.5 without it, his cheeks 15.2 - the blind
-// reviewer's "pink waxy skin" on 17 of his 26 images.)
+// The share of the regional redness (the nose, the cheeks) that older skin keeps: young skin flushes
+// nearly evenly; with age the flush gathers into the dilated capillaries of the nose and cheeks, in
+// patches a few millimetres across (a noise of cells ~7 mm and the blotches', ~2 mm, ``blotch``:
+// the flush's own 1.5-cm patches left a whole nose one pink) over skin that has gone sallow, where
+// AGED_FLUSH_FLOOR of it is left (the noise under AGED_FLUSH_RANGE.x; all of it over .y). It scales
+// both the regional redness and the mid-scale flush's (mid_tone). (Until session 24 the young
+// skin's even flush at any age: george's nose tip at 448 px a* 21.7 (10.5 without the redness; now
+// 14.6), his cheeks 16.0 (now 14.1) - the blind reviewer's "pink waxy skin" on 17 of his 26 images.)
 const float AGED_FLUSH_FLOOR = 0.2;
 const vec2 AGED_FLUSH_RANGE = vec2(0.45, 0.72);
-float aged_flush(float n) {
+float aged_flush(vec2 skin_uv, float blotch) {
+    float n = 0.6 * value_noise(skin_uv * vec2(50.0, 100.0) + 37.0, 0) + 0.4 * blotch;
     return mix(1.0, mix(AGED_FLUSH_FLOOR, 1.0, smoothstep(AGED_FLUSH_RANGE.x, AGED_FLUSH_RANGE.y, n)), u_age);
 }
 
@@ -714,19 +726,19 @@ void main() {
     float haem = 0.55 * value_noise(skin_uv * vec2(55.0, 110.0) + 5.0, 0) + 0.45 * blotch;
     albedo *= mix(vec3(1.0), vec3(1.01, 0.86, 0.87), (0.9 - 0.5 * melanin_rich) * smoothstep(0.4, 0.85, haem));
     albedo *= 1.0 - (0.05 + 0.07 * melanin_rich) * (patches - 0.5) * vec3(0.85, 1.0, 1.15);
-    albedo *= mid_tone(skin_uv, detail.r * u_redness, melanin_rich);
+    float capillaries = aged_flush(skin_uv, blotch);   // (older skin's flush in patches)
+    albedo *= mid_tone(skin_uv, detail.r * u_redness * capillaries, melanin_rich);
     // Regional colour: redder nose, cheeks and ears (blood close to the surface), in broken
     // capillary patches rather than an airbrushed blob; darker, cooler skin around the eyes
     // (thin skin over vessels and muscle), more so with age; a shaved beard's blue-grey shadow.
     // Mild: a nose or cheek a shade redder than the skin around it, never pink (a saturated
     // nose tip read as painted); melanin veils much of it in dark skin.
     float veil = mix(0.45, 1.0, smoothstep(0.03, 0.3, dot(u_skin, vec3(0.2126, 0.7152, 0.0722))));
-    float flush_noise = 0.55 * blotch + 0.45 * patches;
-    float red = u_redness * detail.r * veil * mix(0.6, 1.25, smoothstep(0.2, 0.8, flush_noise));
+    float red = u_redness * detail.r * veil * mix(0.6, 1.25, smoothstep(0.2, 0.8, 0.55 * blotch + 0.45 * patches));
     // (Older: broken veins, a little more. Until session 20 (1.03, 0.84, 0.83) at up to 1.05x the
     // map: george's nose and cheeks read as flushed, a sore red.) With age the flush breaks up
     // (aged_flush): ruddy patches over sallow skin, not one even pink.
-    albedo *= mix(vec3(1.0), vec3(1.02, 0.87, 0.87), min((0.75 + 0.15 * u_age) * red, 1.0) * aged_flush(flush_noise));
+    albedo *= mix(vec3(1.0), vec3(1.02, 0.87, 0.87), min((0.75 + 0.15 * u_age) * red, 1.0) * capillaries);
     albedo *= mix(vec3(1.0), vec3(0.78, 0.70, 0.75), tone.r * (0.6 + 0.5 * u_age));
     // The same darker areas (tone.r: around the eyes and the mouth, temples, hairline, the
     // jaw's sides) hold more pigment in melanin-rich skin: darker still, unevenly (a dark
@@ -739,7 +751,7 @@ void main() {
     if (stubble > 0.0) {
         stubble *= clamp(1.0 + STUBBLE_GRAIN * pore_aggregate(stubble_uv, stubble_px), 0.0, 2.0);
     }
-    albedo = mix(albedo, albedo * vec3(0.70, 0.72, 0.78), stubble);
+    albedo = mix(albedo, albedo * stubble_shade(), stubble);
     // Age spots (solar lentigines): sparse, soft tan patches a few millimetres to a centimetre
     // across where the sun reaches, growing with age. (Until session 20 they were the peaks of the
     // few-mm blotches, an orange multiplier: on george's forehead a rash of small red-brown dots.)

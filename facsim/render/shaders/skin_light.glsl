@@ -38,7 +38,8 @@ float oil_pools(vec2 skin_uv) {
 // carried a white patch, its brightest specular light 0.99 of the forehead's median light, the
 // blind reviewer's "shiny plastic forehead" on 15 of his 26 images; now 0.66 (tests/test_skin.py).
 // A face photographed as a stimulus shows a soft lift of its T-zone, not a glaze. The T-zone's
-// broad lobe weighs as the cheeks' but is narrower (TZONE_BROAD_ROUGHNESS): a brighter peak.)
+// broad lobe weighs as the cheeks' but is narrower (TZONE_BROAD_ROUGHNESS; the cheeks' 0.66): its
+// peak still brighter.)
 const float TZONE_BROAD_WEIGHT = 0.42;  // the horny layer's broad lobe on the T-zone
 const float TZONE_BROAD_ROUGHNESS = 0.54;
 const float OIL_FILM_WEIGHT = 0.14;     // the film's tight lobe where it lies, times oil_pools
