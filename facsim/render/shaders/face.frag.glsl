@@ -645,6 +645,12 @@ const float EMBRASURE_UP_CROWN = 0.4;
 // parts the crowns where grey lines between them read as a grille.
 const float ENAMEL_SHEEN = 0.18;
 const float ENAMEL_SHEEN_WIDTH = 0.22;
+// The lower crowns face up into the mouth: their sheen is this share of the upper's (before the
+// row's shade), and what light reaches them has bounced off the tongue and the lower lip, pink.
+// (Dimmed ivory alone is olive: with no sheen and that cast, fear's bared lower row read as a
+// khaki band of evenly parted slabs, "odd gum colour".)
+const float LOWER_ROW_SHEEN = 0.6;
+const vec3 LOWER_ROW_BOUNCE = vec3(1.0, 0.95, 0.96);
 float embrasure_shade(float to_gap, float aa, float h, float lower) {
     float at_edge = mix(1.0, 0.5, lower);
     return EMBRASURE_SHADE * (1.0 - smoothstep(0.0, aa + 0.008, to_gap)) * clamp(1.5 - 120.0 * aa, 0.3, 1.0)
@@ -1362,7 +1368,7 @@ void main() {
     // (Each crown's its own: off its middle by up to a tenth of its width, and stronger or weaker.)
     float sheen_across = (w - 0.5 - 0.2 * (vary - 0.5)) / ENAMEL_SHEEN_WIDTH;
     spec += ENAMEL_SHEEN * (0.7 + 0.6 * yellowing) * exp(-sheen_across * sheen_across) * pow(max(dot(n, v), 0.0), 4.0)
-          * (1.0 - smoothstep(0.1, gum_edge, h)) * (1.0 - lower) * float(shaped);
+          * (1.0 - smoothstep(0.1, gum_edge, h)) * mix(1.0, LOWER_ROW_SHEEN, lower) * float(shaped);
     // Enamel scatters light inside the tooth: a little of its own brightness beyond the lighting.
     radiance = ((diffuse_light(n, vec3(0.3, 0.25, 0.2), TEETH_AMBIENT) * TEETH_DIFFUSE + ENAMEL_GLOW) * albedo * mix(INSIDE_WARMTH, vec3(1.0), gum)
                 + spec) * mouth_shade;
@@ -1370,6 +1376,7 @@ void main() {
     // So does what reaches the inside of the arch.
     radiance *= mix(vec3(1.0, 0.6, 0.5), vec3(1.0), depth_shade * (1.0 - 0.8 * smoothstep(0.0, 0.3, lingual)));
     radiance += DEEP_TEETH_LIGHT * DEEP_TEETH_BOUNCE * albedo * (1.0 - mouth_shade) * slit_light;
+    radiance *= mix(vec3(1.0), LOWER_ROW_BOUNCE, lower);
 #endif
 
 #ifdef REGION_TONGUE
