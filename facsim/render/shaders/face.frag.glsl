@@ -1110,8 +1110,9 @@ void main() {
     // Stroma: fine radial fibres (long along the radius, narrow around it), coarser bundles,
     // faded to their mean where they would be finer than a pixel (small images stay calm).
     float fibre_detail = clamp(1.6 - 0.6 * fwidth(turns), 0.0, 1.0);
-    // (The fibres wander: evenly spaced straight spokes read as a wheel of glass.)
-    float wander = 1.6 * (value_noise(vec2(turns * 0.125, t * 4.0 + 21.0 + iris_seed), IRIS_FIBRES / 8) - 0.5);
+    // (The fibres wander: evenly spaced straight spokes read as a wheel of glass. At 1.6 cells
+    // across the iris they still ran as straight spokes: now 3, bending twice as often.)
+    float wander = 3.0 * (value_noise(vec2(turns * 0.125, t * 8.0 + 21.0 + iris_seed), IRIS_FIBRES / 8) - 0.5);
     // The coarse bundles (a quarter as many around) fade only where they in turn would be finer
     // than a pixel: at 448² the fine fibres are gone, and a disc of one even colour read as a
     // glass or doll's eye (issue 13); a photographed iris there still shows its streaks.
