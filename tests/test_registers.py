@@ -741,7 +741,7 @@ def test_the_cheeks_lengthen_smoothly_when_the_jaw_drops(face_of, marks, charact
     to 8 mm above the corners' line across the whole face, so the cheeks beside the mouth took the drop in
     one narrow band and stretched 2-3 times their length (1 % of the edges 2.5-3.1 at 27E, 2.0-2.4 at
     26E; george, amara, liam and kwame's fear and surprise, "jaw and cheeks distorted", "face geometry
-    warped", session 23's blind reviewer); with the band growing taller beside the mouth, 1.7-2.0 and 1.5-1.7."""
+    warped", session 23's blind reviewer); with the band growing taller beside the mouth, 1.5-1.8 and 1.3-1.6."""
     face = face_of(character)
     for text, most in (("26E", 1.9), ("27E", 2.2)):
         stretch = _cheek_stretch(face, marks, text)
