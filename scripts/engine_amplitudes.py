@@ -13,8 +13,8 @@ midline, the rise of the nasolabial fold beside the nose (the skin over the maxi
 about 0 when the jaw drops), the forward motion of the lips, how far the upper lip's inner
 edge lies above the upper incisors' edge (positive: that much upper tooth
 shows when the lips are parted; about -1 at rest), and how far on average the skin over the
-mandible's body lies off a rigid turn of the chin about the jaw's hinge ("bone": about 0 when it
-turns with the bone).
+mandible's body lies off the rigid motion that fits it best, a turn about the jaw's hinge and a shift
+("bone": about 0 when it moves with the bone).
 
 Usage::
 
@@ -88,26 +88,34 @@ def amplitudes(face, expression) -> dict[str, float]:
 
 
 def off_the_bone(face, positions, marks) -> tuple[float, np.ndarray]:
-    """The chin's turn (radians) about the jaw's hinge, and the distance (dm) of each point of the
-    skin over the mandible's body (the muscle engine's jaw attachment, 12 mm or more below the lip
-    corners) from where that rigid turn, with the chin's own shift, would take it."""
+    """The mandible's turn (radians, + opening) and the distance (dm) of each point of the skin over
+    its body (the muscle engine's jaw attachment, 12 mm or more below the lip corners) from where the
+    bone's rigid motion (:func:`bone_motion`) would take it."""
+    turn, _, off = bone_motion(face, positions, marks)
+    return turn, off
+
+
+def bone_motion(face, positions, marks) -> tuple[float, np.ndarray, np.ndarray]:
+    """The mandible's rigid motion in the midsagittal plane, fitted to the skin over its body (the muscle
+    engine's jaw attachment, 12 mm or more below the lip corners): its turn about the jaw's hinge (radians,
+    + opening), the shift (dm, height and depth) that goes with it - the condyles gliding forward - and
+    each of those points' distance (dm) from where that motion takes it."""
     from facsim.engines.muscle.net import OUTER, anatomy
 
     anat = anatomy(face.head)
     count = anat.skin_count
     rest = np.asarray(face.neutral, float)[:count]
     moved = np.asarray(positions, float)[:count]
-    hinge = np.asarray(face.head.joint(face.engine.base_positions, "joint-mouth"), float)[1:]
     corners = np.mean([rest[marks[f"lip_corner_{s}"], 1] for s in ("left", "right")])
     on_the_bone = (anat.jaw_weight > 0.99) & (anat.kind == OUTER) & (rest[:, 1] < corners - 0.12)
-    chin = marks["chin"]
-    before, after = rest[chin, 1:] - hinge, moved[chin, 1:] - hinge
-    angle = np.arctan2(before[0], before[1]) - np.arctan2(after[0], after[1])
-    radial = rest[:, 1:] - hinge
-    turned = np.stack([radial[:, 0] * np.cos(angle) - radial[:, 1] * np.sin(angle),
-                       radial[:, 0] * np.sin(angle) + radial[:, 1] * np.cos(angle)], axis=1) + hinge
-    turned += moved[chin, 1:] - turned[chin]
-    return float(angle), np.linalg.norm(moved[on_the_bone, 1:] - turned[on_the_bone], axis=1)
+    hinge = np.asarray(face.head.joint(face.engine.base_positions, "joint-mouth"), float)[[2, 1]]
+    before, after = rest[on_the_bone][:, [2, 1]] - hinge, moved[on_the_bone][:, [2, 1]] - hinge  # (depth, height)
+    b, a = before - before.mean(axis=0), after - after.mean(axis=0)
+    turn = np.arctan2((b[:, 0] * a[:, 1] - b[:, 1] * a[:, 0]).sum(), (b * a).sum())  # 2-D Procrustes
+    c, s = np.cos(turn), np.sin(turn)
+    turned = np.stack([before[:, 0] * c - before[:, 1] * s, before[:, 0] * s + before[:, 1] * c], axis=1)
+    shift = (after - turned).mean(axis=0)
+    return float(-turn), shift[::-1], np.linalg.norm(after - turned - shift, axis=1)
 
 
 def main(argv=None) -> None:

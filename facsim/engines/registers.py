@@ -353,14 +353,21 @@ class RegisterEngine:
         out = np.array(offsets, copy=True)
         hinge = self.head.joint(self.base_positions, spec["hinge"])
         out[:skin] = turn_no_further_than(offsets[:skin], positions[:skin], hinge, marks[spec["reference"]])
+        # how far each point rides the mandible: its own turn as a share of the chin's, or its binding to the bone
+        angles = turning_angles(out, positions, hinge)
+        riding = np.clip(angles / float(angles[marks[spec["reference"]]]), 0.0, 1.0)
         bone = spec.get("rigid")
         if bone:
             share = self._on_the_bone(bone)
+            riding[:skin] += share * (1.0 - riding[:skin])
             carried = carried_by_the_bone(out[:skin], positions[:skin], hinge, marks[spec["reference"]])
             out[:skin] += share[:, None].astype(out.dtype) * (carried - out[:skin])
         lower_lip = spec.get("lower_lip")
         if lower_lip:
             out[:skin] *= self._lower_lip_turn(out[:skin], positions[:skin], hinge, lower_lip)[:, None].astype(out.dtype)
+        glide = spec.get("glide")
+        if glide:
+            out[:, 2] += (float(glide["forward_mm"]) / 100.0 * riding).astype(out.dtype)
         held = spec.get("maxilla")
         if held:
             out[:skin] = self._held_by_the_maxilla(out[:skin], positions[:skin], held, share if bone else None)
