@@ -473,3 +473,43 @@ def test_short_grey_hair_shows_strands_along_its_flow_not_mottled_stone(face_of)
     mask = hair_mask(with_hair, without)
     assert mask.sum() > 5000
     assert streak_coherence(with_hair, mask) > 0.69
+
+
+def _face_frame_band(face, size: int = 256) -> float:
+    """``face``'s neutral front view: at the cheeks and temples (rows 40-62 % down), the mean
+    luminance of the hair in the 5 % of the width next to the face over that of the hair
+    5-18 % further out (benchmarks/bench_hair_texture.py's hair mask)."""
+    import sys
+    from pathlib import Path
+
+    from facsim.face import Face
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+    from bench_hair_texture import hair_mask
+
+    with Face(face.character.with_(hair="none")) as bald:
+        without = bald.render(None, size=size, background=None)
+    with_hair = face.render(None, size=size, background=None)
+    mask = hair_mask(with_hair, without)
+    lum = (with_hair[..., :3].astype(np.float32) / 255.0) @ np.array([0.2126, 0.7152, 0.0722], np.float32)
+    near, far = [], []
+    width = max(2, round(0.02 * size))
+    for m, l in ((mask, lum), (mask[:, ::-1], lum[:, ::-1])):   # left half, then the right mirrored
+        for row in range(int(0.40 * size), int(0.62 * size)):
+            cols = np.flatnonzero(m[row, : size // 2])
+            if not len(cols):
+                continue
+            edge = cols.max()   # the hair next to the face
+            near += [l[row, c] for c in range(edge - width + 1, edge + 1) if c >= 0 and m[row, c]]
+            far += [l[row, c] for c in range(edge - 4 * width, edge - 2 * width) if c >= 0 and m[row, c]]
+    return float(np.mean(near) / np.mean(far))
+
+
+def test_long_hair_framing_the_face_is_not_a_dark_band(face_of):
+    """The under-layer of long hair beside the cheeks faces the open air over the face: lit only
+    through the outer cards (hair_exposure marching outward from the hairstyle's centre), it drew
+    as a dark band round the face, a helmet's rim (blind review s23: ava's "helmet hair / hair cap
+    edge", 13 of 13). Marching toward the face's midline too, ava's (long01) band next to the face
+    over the hair further out at 256² was 0.678 (mei 0.593, margaret 0.735); now 0.768 (0.695,
+    0.789), the shade of a curtain of hair, not a rim."""
+    assert _face_frame_band(face_of("ava")) > 0.72

@@ -657,6 +657,14 @@ def bind_wisps(hair: BoundProxy, head, neutral_geometry: np.ndarray) -> BoundPro
                       strand_points=wisps.per_strand, strand_width=0.01 * style.width_mm)
 
 
+#: How far (dm) in front of the hairstyle's centre the cards begin … end to face the open air
+#: over the face sideways (:func:`hair_exposure`).
+FACE_FRAME_DEPTH = (0.2, 0.6)
+#: How open the face-framing under-layer lies at most (the outer cards still keep the key
+#: from above off it).
+FACE_FRAME_OPEN = 0.5
+
+
 def hair_exposure(points: np.ndarray, triangles: np.ndarray, *, reach: float = 0.3,
                   steps: int = 8, radius: float = 0.035) -> np.ndarray:
     """(V,) how open each hair vertex lies: 1 on the outermost layer … 0 under other cards.
@@ -666,6 +674,8 @@ def hair_exposure(points: np.ndarray, triangles: np.ndarray, *, reach: float = 0
     scalp, the long hair's under-layers far from it). For each vertex this marches outward
     from the hairstyle's centre (``steps`` points up to ``reach`` dm) and counts the points
     that pass within ``radius`` of a card (cards sampled densely over their triangles).
+    Cards in front of the centre (``FACE_FRAME_DEPTH``) also march toward the face's midline:
+    the under-layer framing the face is that open sideways (at most ``FACE_FRAME_OPEN``).
 
     Parameters
     ----------
@@ -682,11 +692,28 @@ def hair_exposure(points: np.ndarray, triangles: np.ndarray, *, reach: float = 0
     centre = top.mean(axis=0) - np.array([0.0, 0.25 * np.ptp(top[:, 1]), 0.0])
     out = points - centre
     out /= np.linalg.norm(out, axis=1, keepdims=True) + 1e-12
-    blocked = np.zeros(len(points))
-    for d in np.linspace(2.0 * radius, reach, steps):
-        near = tree.query(points + d * out, k=1, distance_upper_bound=2.0 * radius)[0]
-        blocked += np.clip((2.0 * radius - near) / radius, 0.0, 1.0)
-    return np.clip(1.0 - blocked / 2.5, 0.0, 1.0).astype(np.float32)
+
+    def openness(direction: np.ndarray) -> np.ndarray:
+        blocked = np.zeros(len(points))
+        for d in np.linspace(2.0 * radius, reach, steps):
+            near = tree.query(points + d * direction, k=1, distance_upper_bound=2.0 * radius)[0]
+            blocked += np.clip((2.0 * radius - near) / radius, 0.0, 1.0)
+        return np.clip(1.0 - blocked / 2.5, 0.0, 1.0)
+
+    exposure = openness(out)
+    # The under-layer framing the face (long hair beside the cheeks and temples) lies under
+    # the outer cards seen from the centre, but sideways it faces the open air over the face:
+    # marched outward only, it drew as a dark band round the face ("helmet hair", blind
+    # review s23). March toward the face's midline too, for the cards in front of the centre
+    # only: further back that march runs through the head, and every under-layer would light
+    # up (the depth between the locks over the whole head went flat). Half open at most:
+    # fully open, the band turned into a pale strip with no depth beside the cheek.
+    toward_midline = np.zeros_like(points)
+    toward_midline[:, 0] = -np.sign(points[:, 0] - centre[0])
+    in_front = np.clip((points[:, 2] - centre[2] - FACE_FRAME_DEPTH[0]) / np.ptp(FACE_FRAME_DEPTH), 0.0, 1.0)
+    sideways = FACE_FRAME_OPEN * in_front * in_front * (3.0 - 2.0 * in_front) * openness(toward_midline)
+    exposure = np.maximum(exposure, sideways)
+    return exposure.astype(np.float32)
 
 
 #: Height (dm) over the skin from which hair casts a shadow (:func:`hair_shadow`).
