@@ -477,8 +477,8 @@ def test_short_grey_hair_shows_strands_along_its_flow_not_mottled_stone(face_of)
 
 def _face_frame_band(face, size: int = 256) -> float:
     """``face``'s neutral front view: at the cheeks and temples (rows 40-62 % down), the mean
-    luminance of the hair in the 5 % of the width next to the face over that of the hair
-    5-18 % further out (benchmarks/bench_hair_texture.py's hair mask)."""
+    luminance of the hair in the 2 % of the width next to the face over that of the hair
+    4-8 % of the width further out (benchmarks/bench_hair_texture.py's hair mask)."""
     import sys
     from pathlib import Path
 

@@ -686,6 +686,8 @@ def hair_exposure(points: np.ndarray, triangles: np.ndarray, *, reach: float = 0
     """
     from scipy.spatial import cKDTree
 
+    from facsim.head.surface import smoothstep
+
     points = np.asarray(points, np.float64)
     tree = cKDTree(card_samples(points, triangles))
     top = points[points[:, 1] >= np.percentile(points[:, 1], 50)]
@@ -710,8 +712,8 @@ def hair_exposure(points: np.ndarray, triangles: np.ndarray, *, reach: float = 0
     # fully open, the band turned into a pale strip with no depth beside the cheek.
     toward_midline = np.zeros_like(points)
     toward_midline[:, 0] = -np.sign(points[:, 0] - centre[0])
-    in_front = np.clip((points[:, 2] - centre[2] - FACE_FRAME_DEPTH[0]) / np.ptp(FACE_FRAME_DEPTH), 0.0, 1.0)
-    sideways = FACE_FRAME_OPEN * in_front * in_front * (3.0 - 2.0 * in_front) * openness(toward_midline)
+    in_front = smoothstep(*(centre[2] + np.asarray(FACE_FRAME_DEPTH)), points[:, 2])
+    sideways = FACE_FRAME_OPEN * in_front * openness(toward_midline)
     exposure = np.maximum(exposure, sideways)
     return exposure.astype(np.float32)
 

@@ -2,7 +2,8 @@
 // own program, so a fragment runs only its region's code: on llvmpipe both sides of a branch
 // cost, even when a uniform switches one off). Variants:
 //   REGION_SKIN (+ USE_UV, USE_WRINKLE; + USE_BROWS for triangles under painted brows),
-//   REGION_EYEBALL (+ USE_EYE, USE_LIDS), REGION_TEETH, REGION_TONGUE, REGION_MOUTH_INTERIOR,
+//   REGION_EYEBALL (+ USE_EYE, USE_LIDS), REGION_TEETH, REGION_TONGUE,
+//   REGION_MOUTH_INTERIOR (+ USE_EYE: v_eye carries the cavity coordinates),
 //   REGION_LASHES (+ USE_LASH), REGION_GARMENT (+ USE_UV: cloth coordinates; the body's clothes).
 // All colour uniforms are linear RGB (render.py linearises the appearance's sRGB colours).
 
@@ -628,13 +629,13 @@ vec3 crown_normal(vec3 n, vec3 along, float slope) {
     t *= sign(dot(t, along) + 1e-12);
     return normalize(n - slope * t);
 }
-// (EMBRASURE_SHADE 0.35, up the crowns 0.6 of it: the crowns ran together into one strip; the
-// lower row's, seen from above, keep less up the crowns or the row reads as a grille.)
+// (EMBRASURE_SHADE 0.35, up the crowns 0.6 of it: the crowns ran together into one strip.)
 const float EMBRASURE_SHADE = 0.5;
 // Up the upper crowns, where two teeth touch, their embrasure keeps this much of its shade at the
 // edge. (0.75 drew a grey line the crown's full height between every pair of teeth, evenly
 // spaced: at 448 px the row read as "smeared like a grille"; the crowns now part by their
-// own sheen and rounding, ENAMEL_SHEEN.)
+// own sheen and rounding, ENAMEL_SHEEN. The lower row's, seen from above, keeps as little or
+// it reads as a grille.)
 const float EMBRASURE_UP_CROWN = 0.4;
 // Wet enamel mirrors the studio's large frontal lights: a soft vertical sheen down the middle of
 // each crown (ENAMEL_SHEEN_WIDTH of its width), where its bulge faces the light, fading onto the
@@ -654,7 +655,7 @@ const vec3 LOWER_ROW_BOUNCE = vec3(1.0, 0.95, 0.96);
 float embrasure_shade(float to_gap, float aa, float h, float lower) {
     float at_edge = mix(1.0, 0.5, lower);
     return EMBRASURE_SHADE * (1.0 - smoothstep(0.0, aa + 0.008, to_gap)) * clamp(1.5 - 120.0 * aa, 0.3, 1.0)
-         * mix(at_edge, mix(EMBRASURE_UP_CROWN, 0.4, lower), smoothstep(0.04, 0.25, h));
+         * mix(at_edge, EMBRASURE_UP_CROWN, smoothstep(0.04, 0.25, h));
 }
 #endif
 #if defined(ONE_ALBEDO) || defined(REGION_MOUTH_INTERIOR) || defined(REGION_LASHES) || defined(REGION_GARMENT)
@@ -1097,7 +1098,6 @@ void main() {
     vec2 seen = e.xy + into.xy * chamber / max(-into.z, 0.25);
     float ri = length(seen);
     float aai = max(fwidth(ri), 1e-4);
-    float iris_mask = front * (1.0 - smoothstep(IRIS_RADIUS - aa, IRIS_RADIUS + aa, r));
     float pupil_radius = mix(PUPIL_RADIUS.x, PUPIL_RADIUS.y, u_age);
     float pupil_mask = front * (1.0 - smoothstep(pupil_radius - aai, pupil_radius + aai, ri));
     float t = clamp((ri - pupil_radius) / (IRIS_RADIUS - pupil_radius), 0.0, 1.0);

@@ -96,22 +96,31 @@ float smeared_noise(vec3 p, vec3 step) {
             + lattice_noise3(p + step) + lattice_noise3(p + 2.0 * step)) * 0.2;
 }
 
+// The strands' octave for a noise of ``cells`` base cells per pixel: (scale s0, blend f toward
+// the next octave). Two octaves are blended only near the switch from one to the next (each
+// costs llvmpipe twenty-four hashes); elsewhere one is taken.
+vec2 strand_octave(float cells) {
+    float level = log2(0.6 / cells);
+    float k = clamp(floor(level), 0.0, 2.0);
+    return vec2(exp2(k), smoothstep(0.35, 0.65, clamp(level - k, 0.0, 1.0)) * step(k, 1.5));
+}
+
+// The two octaves' noises n0, n1 blended by f, their contrast restored by ``contrast``; where
+// even the coarsest octave is finer than a pixel, their mean.
+float strand_blend(float n0, float n1, float f, float contrast, float cells) {
+    float n = 0.5 + contrast * (mix(n0, n1, f) - 0.5) / sqrt(f * f + (1.0 - f) * (1.0 - f));
+    return mix(0.5, clamp(n, 0.0, 1.0), clamp(2.2 - 1.6 * cells, 0.0, 1.0));
+}
+
 float pixel_strands(vec3 rest, vec3 along, float cells_per_dm) {
     vec3 p = rest * cells_per_dm;
     float cells = max(length(fwidth(p)), 1e-5);  // base cells per pixel
-    float level = log2(0.6 / cells);
-    float k = clamp(floor(level), 0.0, 2.0);
-    // Two octaves are blended only near the switch from one to the next (each costs
-    // llvmpipe twenty-four hashes); elsewhere one is taken.
-    float f = smoothstep(0.35, 0.65, clamp(level - k, 0.0, 1.0)) * step(k, 1.5);
-    float s0 = exp2(k);
-    float n0 = f < 0.999 ? smeared_noise(p * s0 + 3.0, 1.2 * along) : 0.5;
-    float n1 = f > 0.001 ? smeared_noise(p * (2.0 * s0) + 11.0, 1.2 * along) : 0.5;
+    vec2 octave = strand_octave(cells);
+    float n0 = octave.y < 0.999 ? smeared_noise(p * octave.x + 3.0, 1.2 * along) : 0.5;
+    float n1 = octave.y > 0.001 ? smeared_noise(p * (2.0 * octave.x) + 11.0, 1.2 * along) : 0.5;
     // (a mean of three samples along a few cells varies ~1/1.5 as much as one; most of that
     // is given back, not all, so the darkest strands do not stand out as dots)
-    float n = 0.5 + 1.35 * (mix(n0, n1, f) - 0.5) / sqrt(f * f + (1.0 - f) * (1.0 - f));
-    // Where even the coarsest octave is finer than a pixel, its mean.
-    return mix(0.5, clamp(n, 0.0, 1.0), clamp(2.2 - 1.6 * cells, 0.0, 1.0));
+    return strand_blend(n0, n1, octave.y, 1.35, cells);
 }
 
 const float HAIR_VOLUME_RADIUS = 0.9;   // dm, facsim.render.proxies.VOLUME_RADIUS
@@ -133,14 +142,10 @@ float flow_strands(vec3 rest, float cells_per_dm, float stretch) {
     vec3 p = vec3(out_dir.x, 0.0, out_dir.y) * (HAIR_VOLUME_RADIUS * cells_per_dm)
            + vec3(0.0, along * cells_per_dm / stretch, 0.0);
     float cells = max(length(fwidth(p)), 1e-5);
-    float level = log2(0.6 / cells);
-    float k = clamp(floor(level), 0.0, 2.0);
-    float f = smoothstep(0.35, 0.65, clamp(level - k, 0.0, 1.0)) * step(k, 1.5);
-    float s0 = exp2(k);
-    float n0 = f < 0.999 ? lattice_noise3(p * s0 + 3.0) : 0.5;
-    float n1 = f > 0.001 ? lattice_noise3(p * (2.0 * s0) + 11.0) : 0.5;
-    float n = 0.5 + 1.1 * (mix(n0, n1, f) - 0.5) / sqrt(f * f + (1.0 - f) * (1.0 - f));
-    return mix(0.5, clamp(n, 0.0, 1.0), clamp(2.2 - 1.6 * cells, 0.0, 1.0));
+    vec2 octave = strand_octave(cells);
+    float n0 = octave.y < 0.999 ? lattice_noise3(p * octave.x + 3.0) : 0.5;
+    float n1 = octave.y > 0.001 ? lattice_noise3(p * (2.0 * octave.x) + 11.0) : 0.5;
+    return strand_blend(n0, n1, octave.y, 1.1, cells);
 }
 
 #if defined(USE_SHADOW) && defined(KIND_HAIR)

@@ -40,7 +40,7 @@ float oil_pools(vec2 skin_uv) {
 // A face photographed as a stimulus shows a soft lift of its T-zone, not a glaze. The T-zone's
 // broad lobe weighs as the cheeks' but is narrower (TZONE_BROAD_ROUGHNESS; the cheeks' 0.66): its
 // peak still brighter.)
-const float TZONE_BROAD_WEIGHT = 0.42;  // the horny layer's broad lobe on the T-zone
+const float BROAD_LOBE_WEIGHT = 0.42;   // the horny layer's broad lobe, cheeks and T-zone alike
 const float TZONE_BROAD_ROUGHNESS = 0.54;
 const float OIL_FILM_WEIGHT = 0.14;     // the film's tight lobe where it lies, times oil_pools
 const float OIL_FILM_ROUGHNESS = 0.36;  // (0.42 until session 23: one broad, even highlight)
@@ -49,7 +49,7 @@ SkinLobes skin_lobes(float oil, float film, float lips, float wet, float blotch,
     float lip = max(lips, min(2.0 * wet, 1.0));   // the lips' lobes (LIP_LOBES in face.frag.glsl)
     float uneven = (0.7 + 0.6 * patches) * (0.8 + 0.4 * blotch);
     SkinLobes l;
-    l.weight = vec2(mix(mix(0.42, TZONE_BROAD_WEIGHT, tzone) * uneven, LIP_LOBES.x, lip),
+    l.weight = vec2(mix(BROAD_LOBE_WEIGHT * uneven, LIP_LOBES.x, lip),
                     (0.08 * tzone + OIL_FILM_WEIGHT * film) * uneven + LIP_LOBES.y * wet);
     l.roughness = vec2(mix(mix(0.66, TZONE_BROAD_ROUGHNESS, tzone), LIP_BROAD_ROUGHNESS, lip), mix(mix(0.48, OIL_FILM_ROUGHNESS, min(film, 1.0)), LIP_ROUGHNESS, lip));
     return l;
