@@ -638,10 +638,6 @@ void main() {
     alpha *= mix(1.0, smoothstep(0.06, 0.3, face_on), smoothstep(0.3, 0.8, outline));
 #ifdef COILY
     {
-        // A card seen near edge-on anywhere (not only at the volume's outline) is a sliver under
-        // a pixel wide: in the mass it hides nothing the cards around it do not, and off the
-        // mass it drew faint dotted lines (single multisamples) standing away from it.
-        alpha *= mix(1.0, smoothstep(0.08, 0.25, face_on), u_coil);
         float halo = value_noise3(v_rest * 70.0 + 2.0);   // single curls (~1.5 mm)
         // Coily hair is opaque curls with skin or background between them, never a film: the
         // texture's partial cover (its mipmapped tufts, the cards' thin margins at the
@@ -674,10 +670,6 @@ void main() {
         share *= 1.0 - smoothstep(0.35, 0.8, v_edge + 0.8 * (0.5 - 0.6 * coil_clump - 0.4 * halo) - 0.1);
         // Over a thinning hairline (v_cover < 1, see facsim/head/scalp.py) fewer of them.
         share *= smoothstep(0.0, 0.4, 1.3 * v_cover - 0.15);
-        // Seen at a slant the eye crosses more of the mass's coils (transmittance to the power
-        // 1 / cos, as the close crop's): toward the outline and low on the sides the cards'
-        // gaps close up, and the edge is the mass's, not a lace of tufts with specks beside it.
-        share = 1.0 - pow(1.0 - min(share, 0.999), 1.0 / max(dot(n, v), 0.2));
         float curl_w = 0.04 + fwidth(curl_rank);
         alpha = mix(alpha, smoothstep(curl_rank - curl_w, curl_rank + curl_w, share) * in_mass, u_coil);
     }
