@@ -5,9 +5,8 @@ a hard edge, and a hairstyle reads as a helmet. Real hair's outline is soft: sho
 hairs stand off the mass (fuzz), a few longer ones arc away from it (flyaways), and every
 strand thins to its tip. This module grows such strands on the outer layer of a
 hairstyle's cards, most where the hair's volume turns away from a frontal view (its
-outline), configured per style under ``wisps:`` in ``facsim/data/hair.yaml`` (strands can
-be tight coils, ``coil_radius_mm``; afro01 grows none: a dense coily mass ends in its own
-outline).
+outline), configured per style under ``wisps:`` in ``facsim/data/hair.yaml``; coily hair
+(afro01) gets tight coils standing out from the mass instead.
 
 Each strand is a polyline of ``points`` points; the renderer draws it as a thin ribbon
 turned toward the camera, tapered from root to tip, in the hair's colour

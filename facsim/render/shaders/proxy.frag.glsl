@@ -178,16 +178,14 @@ float strand_diffuse(vec3 t, vec3 l) {
 }
 
 
-// Coily hair's outline is a dense mass's: a photographed afro ends against the background in
-// opaque coils and clumps of coils, its edge bumpy at their scale but defined, a pixel or two
-// wide. (A translucent halo of thinning coils a few millimetres wide read as "fuzzy hair halo
-// with floating strands" in every image of amara, blind review session 23; the cards' own cut
-// read as "jagged", session 22.) The cards are cut where they stand within COILY_EDGE_MM of
-// the outline of the smooth volume the hair is shaded as (a dome over a vertical axis,
-// facsim.render.proxies.volume_normals, without the cards' own normals), measured as how far
-// p lies inside that outline seen from the eye (mm; a sphere's radius r seen at cos = n.v
-// lies r (1 - sin) inside), so the cut follows a rounded outline, not the cards'.
-const float COILY_EDGE_MM = 3.0;
+// Coily hair's outline is a halo: toward the mass's silhouette its fine coils thin out, so it
+// fades from solid into the background over a band of a few millimetres, semi-transparent,
+// rather than ending in the cards' polygonal cut (blind review, session 22: "the afro's jagged
+// outline"). The band is measured on the smooth volume the hair is shaded as (a dome over a
+// vertical axis, facsim.render.proxies.volume_normals, without the cards' own normals): how
+// far p lies inside its outline seen from the eye (mm; a sphere's radius r seen at
+// cos = n.v lies r (1 - sin) inside), so the fade follows a rounded outline, not the cards'.
+const float COILY_HALO_MM = 3.0;
 float coily_inside_outline_mm(vec3 p, vec3 v) {
     // (u_hair_apex lies a quarter radius above the crown, on the axis)
     vec3 q = vec3(u_hair_apex.x, min(p.y, u_hair_apex.y - 1.25 * HAIR_VOLUME_RADIUS), u_hair_apex.z);
@@ -398,10 +396,10 @@ void main() {
     float alpha = tex.a * v_cover * u_density * smoothstep(0.0, 0.15, v_depth) * (1.0 - smoothstep(0.55, 1.0, v_depth))
                 * smoothstep(0.3, 1.0, (v_rest.y - u_end_height) / u_end_fade);   // none where long hair ends
     vec3 v = normalize(u_cam_pos - v_pos);
-    // Coily hair's coils end at the mass's outline as its cards do (coily_inside_outline_mm):
-    // coils standing out past it floated as a grey lace beside the mass.
+    // Coily hair's coils thin out over the mass's halo as its cards do (coily_inside_outline_mm):
+    // coils on the cards that stand out edge-on past it floated as a grey lace beside the mass.
     if (u_coil > 0.0)
-        alpha *= mix(1.0, smoothstep(COILY_EDGE_MM - 1.0, COILY_EDGE_MM + 1.0,
+        alpha *= mix(1.0, smoothstep(-1.0, COILY_HALO_MM,
                                      coily_inside_outline_mm(v_pos, v)), u_coil);
     if (alpha < 0.01) discard;
     vec3 n = normalize(v_normal);
@@ -511,9 +509,9 @@ void main() {
     if (alpha < ALPHA_CUTOFF) discard;
 #else
 #ifdef COILY
-    // (coily hair is cut near its outline, coily_inside_outline_mm, not only where n.v is low)
+    // (coily hair fades over its halo band, coily_inside_outline_mm, not only where n.v is low)
     if (alpha < 0.02 || (alpha >= ALPHA_CUTOFF && v_edge < 0.1 && v_cover > 0.999 && dot(n, v) >= 0.28
-                         && coily_inside_outline_mm(v_pos, v) > COILY_EDGE_MM + 4.0)) discard;
+                         && coily_inside_outline_mm(v_pos, v) > COILY_HALO_MM + 3.0)) discard;
 #else
     if (alpha < 0.02 || (alpha >= ALPHA_CUTOFF && v_edge < 0.1 && v_cover > 0.999 && dot(n, v) >= 0.28)) discard;
 #endif
@@ -638,48 +636,58 @@ void main() {
     alpha *= mix(1.0, smoothstep(0.06, 0.3, face_on), smoothstep(0.3, 0.8, outline));
 #ifdef COILY
     {
-        float halo = value_noise3(v_rest * 70.0 + 2.0);   // single curls (~1.5 mm)
+        // Coily hair's outline breaks up in curls (placed on the neutral face, see below):
+        // the volume's edge is a halo of curls with the background between them, not a rim.
+        float halo = value_noise3(v_rest * 70.0 + 2.0);
         // Coily hair is opaque curls with skin or background between them, never a film: the
         // texture's partial cover (its mipmapped tufts, the cards' thin margins at the
         // hairline and the temples) is the share of the pixels its curls cover, each curl
         // there where its rank is under that share (curls ~1.5 mm and clumps of them ~5 mm
         // across, placed on the neutral head). The cap under the mass (v_depth near 0) toward
-        // its cards' outline, where it shows in the open at the temples, is thinner: the scalp
-        // shows between its coils as it does where real hair thins toward the face, instead of
-        // a dark smooth sheet ending in the cards' straight edge. Where even the curls are
-        // finer than a pixel (cards seen edge-on) the ranks fade to their mean and the share is
-        // cut at one half: solid or bare, never a translucent film.
+        // its cards' outline, where it shows in the open at the temples, is thinner: the scalp shows between its coils
+        // as it does where real hair thins toward the face, instead of a dark smooth sheet
+        // ending in the cards' straight edge. Where the curls are finer than a pixel, the
+        // share itself.
+        float curl_detail = clamp(2.0 - 1.4 * length(fwidth(v_rest * 70.0)), 0.0, 1.0);
         // (single curls keep their say only where they are a couple of pixels across: at 448²
         // a curl a pixel across dithered the mass's edges into dark and light specks)
         float curl_weight = 0.6 * clamp(1.6 - 1.4 * length(fwidth(v_rest * 70.0)), 0.0, 1.0);
-        // The mass ends COILY_EDGE_MM inside the volume's outline, further in or out clump by
-        // clump (about 1.5 mm), cut within a pixel (mm_per_px: the outline distance's change
-        // per pixel), so its edge is defined but bumpy at the clumps' scale. Low on the sides,
-        // where the mass ends over the ears, it is not cut (its cards lie near edge-on to the
-        // eye there: cut, the mass left a gap above the ears).
-        float outline_mm = coily_inside_outline_mm(v_pos, v);
-        float mm_per_px = max(fwidth(outline_mm), 0.02);
+        // Toward the outline the coils thin out (coily_inside_outline_mm): a few millimetres
+        // further in or out clump by clump and curl by curl, so the halo's edge is soft and a
+        // little uneven, never the cards' straight cut nor a dithered step. (Cutting whole
+        // clumps out of the outline band drew it notched and jagged, blind review session 22.)
+        // In the halo the coils are finer than a pixel and semi-transparent: their share, not
+        // solid curls with gaps (which speckled it).
+        float inside_mm = coily_inside_outline_mm(v_pos, v) + 2.0 * (coil_clump - 0.5) + 1.5 * (halo - 0.5);
+        float thinning = smoothstep(0.0, COILY_HALO_MM, inside_mm);
+        // Low on the sides, where the mass ends over the ears and meets the skin, it stays dense
+        // (thinned there, it showed its cards' corners as pale triangles beside the ears).
         float below_dome = u_hair_apex.y - 1.25 * HAIR_VOLUME_RADIUS - v_pos.y;   // dm
-        float edge_at = COILY_EDGE_MM * (1.0 - smoothstep(0.4, 0.55, below_dome)) + 3.0 * (coil_clump - 0.5);
-        float in_mass = smoothstep(-1.0, 1.0, (outline_mm - edge_at) / mm_per_px);
+        thinning = mix(thinning, 1.0, smoothstep(0.4, 0.55, below_dome));
+        curl_detail *= thinning;
         float curl_rank = clamp(0.5 + 2.2 * (curl_weight * halo + (1.0 - curl_weight) * coil_clump - 0.5), 0.02, 0.98);
         float share = alpha * mix(1.0, COILY_CAP_COVER, smoothstep(0.05, 0.4, v_edge) * (1.0 - smoothstep(0.1, 0.45, v_depth)));
+        float curl_w = 0.04 + fwidth(curl_rank);
+        alpha = mix(alpha, mix(share, smoothstep(curl_rank - curl_w, curl_rank + curl_w, share), curl_detail), u_coil);
+        // (the texture's tufts, mipmapped, leave holes that drew the halo as lace: there the
+        // coils cover evenly, thinning toward the outline)
+        float halo_cover = mix(max(alpha, 0.75) * (0.75 + 0.25 * halo), alpha, thinning) * thinning * thinning;
+        alpha = mix(alpha, halo_cover, u_coil);
         // A card's own cut edge (where the mass ends over the temples and the forehead) breaks
         // into curls and clumps of curls ending at different places, so the mass meets the
         // skin in a ragged fringe of coils, not along a brim.
-        share *= 1.0 - smoothstep(0.35, 0.8, v_edge + 0.8 * (0.5 - 0.6 * coil_clump - 0.4 * halo) - 0.1);
-        // Over a thinning hairline (v_cover < 1, see facsim/head/scalp.py) fewer of them.
-        share *= smoothstep(0.0, 0.4, 1.3 * v_cover - 0.15);
-        float curl_w = 0.04 + fwidth(curl_rank);
-        alpha = mix(alpha, smoothstep(curl_rank - curl_w, curl_rank + curl_w, share) * in_mass, u_coil);
+        alpha *= 1.0 - u_coil * smoothstep(0.35, 0.8, v_edge + 0.8 * (0.5 - 0.6 * coil_clump - 0.4 * halo) - 0.1);
     }
 #endif
     // Over a thinning hairline (v_cover < 1, see facsim/head/scalp.py) the cards break up into
-    // strands and clumps, fewer the thinner the cover, so they fade into the scalp's fine hairs
-    // (coily hair: fewer curls, above).
-#ifndef COILY
-    alpha *= smoothstep(rag - 0.2, rag + 0.2, 1.3 * v_cover - 0.15);
+    // strands and clumps, fewer the thinner the cover, so they fade into the scalp's fine hairs.
+    // Coily hair thins in round curls, not in strands along the card.
+#ifdef COILY
+    float thin_at = value_noise(v_uv * 90.0 + 3.0, 0);
+#else
+    float thin_at = rag;
 #endif
+    alpha *= smoothstep(thin_at - 0.2, thin_at + 0.2, 1.3 * v_cover - 0.15);
 #endif
 #ifdef PASS_OPAQUE
     if (alpha < ALPHA_CUTOFF) discard;
