@@ -309,12 +309,13 @@ def test_creases_of_an_au_at_c_show_most_of_what_they_show_at_e(face_of, head, a
     and 4's furrows between the brows are plain at C and deepen towards E, not switched on near E.
     (Until session 17 the furrows began only at a wrinkle strength of 0.15 and 9's nose, 0.13 at C,
     stayed smooth: 1.7 levels of darkening at its root on ava at C, 0.45 of E's; now 4.1 and 0.67.)
-    At E the folds keep deepening without setting into uniformly cut grooves. (Session 24 lowered
-    9's lift of the nostril wings and the upper lip, so the root's squeeze at C is a shade less of
-    E's: 3.5 of 6.4 levels, 0.549; bound 0.55 -> 0.54.)"""
+    At E the folds keep deepening without setting into uniformly cut grooves. (Session 24 softened
+    9's nose, "rubbery / too deep / too sharp" to a blind reviewer: a lower lift of the nostril
+    wings and the upper lip and gentler folds. At C the sides darken 3.5 of E's 6.4 levels, 0.549
+    (bound 0.55 -> 0.54), the root 2.7 of 4.9 (floor 3.0 -> 2.5 there).)"""
     face = face_of("ava")
     at_c, at_e = (crease_darkening(face, head, f"{au}{level}", place) for level in "CE")
-    assert at_c > 3.0, (at_c, at_e)
+    assert at_c > (2.5 if place == "nose_root" else 3.0), (at_c, at_e)
     assert at_c > 0.54 * at_e, (at_c, at_e)
 
 
