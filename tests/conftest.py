@@ -51,3 +51,27 @@ def face_of():
 def background_mask(image: np.ndarray, background=(255, 255, 255)) -> np.ndarray:
     """Pixels that show the background colour."""
     return np.all(np.abs(image[..., :3].astype(int) - background) <= 2, axis=-1)
+
+
+@functools.lru_cache(maxsize=None)
+def bench_hair_texture():
+    """benchmarks/bench_hair_texture.py as a module: its figures are what the hair tests measure."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_hair_texture.py"
+    spec = importlib.util.spec_from_file_location("bench_hair_texture", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def hair_renders(face, size: int):
+    """``face``'s neutral front view with its hair and without (RGBA, no background) and the
+    hair's mask (bench_hair_texture.hair_mask)."""
+    from facsim.face import Face
+
+    with Face(face.character.with_(hair="none")) as bald:
+        without = bald.render(None, size=size, background=None)
+    with_hair = face.render(None, size=size, background=None)
+    return with_hair, without, bench_hair_texture().hair_mask(with_hair, without)

@@ -4,6 +4,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from conftest import bench_hair_texture, hair_renders
+
 from facsim.head import proxies
 from facsim.head.assets import FaceDataError
 from facsim.head.character import CharacterError, Character, preset, preset_names
@@ -355,18 +357,8 @@ def test_coily_hair_is_solid_curls_not_a_cut_out_film(face_of, name):
 
 def _crown_banding(face, size: int = 256) -> float:
     """benchmarks/bench_hair_texture.py's ``crown`` figure of ``face``'s neutral front view."""
-    import sys
-    from pathlib import Path
-
-    from facsim.face import Face
-
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
-    from bench_hair_texture import crown_banding, hair_mask
-
-    with Face(face.character.with_(hair="none")) as bald:
-        without = bald.render(None, size=size, background=None)
-    with_hair = face.render(None, size=size, background=None)
-    return crown_banding(with_hair, hair_mask(with_hair, without), without)[0]
+    with_hair, without, mask = hair_renders(face, size)
+    return bench_hair_texture().crown_banding(with_hair, mask, without)[0]
 
 
 def test_the_strand_highlight_is_one_band_across_the_crown_not_patches_of_cards(face_of):
@@ -384,19 +376,8 @@ def test_straight_hair_shows_depth_between_locks_not_one_flat_sheet(face_of):
     black bob read as one flat sheet, blind review, session 21). On mei at 256² the hair's
     detail finer than 2 px over its mean (benchmarks/bench_hair_texture.py's ``fine``) was
     0.241, with locks 0.266; the crown's banding stays under the limit above (0.112 -> 0.124)."""
-    import sys
-    from pathlib import Path
-
-    from facsim.face import Face
-
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
-    from bench_hair_texture import hair_mask, luminance_variation
-
-    face = face_of("mei")
-    with Face(face.character.with_(hair="none")) as bald:
-        without = bald.render(None, size=256, background=None)
-    with_hair = face.render(None, size=256, background=None)
-    fine, _ = luminance_variation(with_hair, hair_mask(with_hair, without))
+    with_hair, _, mask = hair_renders(face_of("mei"), 256)
+    fine, _ = bench_hair_texture().luminance_variation(with_hair, mask)
     assert fine > 0.255, fine
 
 
@@ -447,39 +428,16 @@ def test_short_grey_hair_shows_strands_along_its_flow_not_mottled_stone(face_of)
     cells two or three long: george's grey short01 read as "stone-like / clumpy grey hair"
     (blind review, session 23, 12 of 26 images). On george at 384² the coherence of the hair's
     detail (benchmarks/bench_hair_texture.py's ``streaks``) was 0.657; now 0.723."""
-    import sys
-    from pathlib import Path
-
-    from facsim.face import Face
-
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
-    from bench_hair_texture import hair_mask, streak_coherence
-
-    face = face_of("george")
-    with Face(face.character.with_(hair="none")) as bald:
-        without = bald.render(None, size=384, background=None)
-    with_hair = face.render(None, size=384, background=None)
-    mask = hair_mask(with_hair, without)
+    with_hair, _, mask = hair_renders(face_of("george"), 384)
     assert mask.sum() > 5000
-    assert streak_coherence(with_hair, mask) > 0.69
+    assert bench_hair_texture().streak_coherence(with_hair, mask) > 0.69
 
 
 def _face_frame_band(face, size: int = 256) -> float:
     """``face``'s neutral front view: at the cheeks and temples (rows 40-62 % down), the mean
     luminance of the hair in the 2 % of the width next to the face over that of the hair
     4-8 % of the width further out (benchmarks/bench_hair_texture.py's hair mask)."""
-    import sys
-    from pathlib import Path
-
-    from facsim.face import Face
-
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
-    from bench_hair_texture import hair_mask
-
-    with Face(face.character.with_(hair="none")) as bald:
-        without = bald.render(None, size=size, background=None)
-    with_hair = face.render(None, size=size, background=None)
-    mask = hair_mask(with_hair, without)
+    with_hair, _, mask = hair_renders(face, size)
     lum = (with_hair[..., :3].astype(np.float32) / 255.0) @ np.array([0.2126, 0.7152, 0.0722], np.float32)
     near, far = [], []
     width = max(2, round(0.02 * size))

@@ -4,6 +4,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from conftest import bench_hair_texture, hair_renders
+
 from facsim.head import proxies, scalp
 
 
@@ -363,18 +365,7 @@ def test_the_hairline_is_hair_in_the_open_not_a_dark_brim(face_of):
     session 23, 13 of ava's 26 images). On ava at 384² the hair 2-9 px above the forehead's
     hairline over the hair's mean luminance (benchmarks/bench_hair_texture.py's ``hairline``)
     was 1.03; now 1.26."""
-    import sys
-    from pathlib import Path
-
-    from facsim.face import Face
-
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
-    from bench_hair_texture import hair_mask, hairline_band
-
-    face = face_of("ava")
-    with Face(face.character.with_(hair="none")) as bald:
-        without = bald.render(None, size=384, background=None)
-    with_hair = face.render(None, size=384, background=None)
-    band, columns = hairline_band(with_hair, hair_mask(with_hair, without))
+    with_hair, _, mask = hair_renders(face_of("ava"), 384)
+    band, columns = bench_hair_texture().hairline_band(with_hair, mask)
     assert columns > 50
     assert band > 1.15, band

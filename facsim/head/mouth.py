@@ -612,7 +612,7 @@ def mouth_light(rim: MouthRim, positions: np.ndarray, occlusion: np.ndarray) -> 
     closed = 1.0 - parted * parted * (3.0 - 2.0 * parted)
     upper_x, upper_y = plane(rim.upper_teeth)
     for teeth in (rim.upper_teeth, rim.lower_teeth):
-        x, y = plane(teeth)
+        x, y = (upper_x, upper_y) if teeth is rim.upper_teeth else plane(teeth)
         # The upper lip's lowest point within a tooth column's reach of x.
         over = np.abs(x[:, None] - lip_x[None]) < COLUMN_REACH
         edge = np.where(over.any(axis=1), np.where(over, lip_y[None], np.inf).min(axis=1), upper_edge(x))
