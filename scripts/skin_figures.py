@@ -163,7 +163,8 @@ def figures(name, expression=""):
         image, camera = _render(face, base, deformation)
         darker = {k: tuple(linear_to_srgb(0.5 * srgb_to_linear(base.colors[k]))) for k in SKIN_COLOURS}
         half, _ = _render(face, dataclasses.replace(base, colors={**base.colors, **darker}), deformation)
-        l1, l2 = radiance(image) @ LUMINANCE, radiance(half) @ LUMINANCE
+        full_light, half_light = radiance(image), radiance(half)
+        l1, l2 = full_light @ LUMINANCE, half_light @ LUMINANCE
         diffuse = np.clip(2 * (l1 - l2), 0, None)
         specular = np.clip(l1 - diffuse, 0, None)
         share = specular / np.maximum(l1, 1e-4)
@@ -181,7 +182,7 @@ def figures(name, expression=""):
         # The skin's unevenness: per-channel diffuse light, the slow shading divided out.
         from scipy.ndimage import gaussian_filter
 
-        diffuse_rgb = np.clip(2 * (radiance(image) - radiance(half)), 1e-4, None)
+        diffuse_rgb = np.clip(2 * (full_light - half_light), 1e-4, None)
         cheeks = _box(camera, [pt("cheek_left") + [-0.1, 0.02, 0.1], pt("cheek_right") + [0.1, 0.02, 0.1]], 14)
         d = diffuse_rgb @ LUMINANCE
         cheek_lab = np.median(rgb2lab(image[regions["cheek"]] / 255.0), axis=0)

@@ -378,15 +378,10 @@ class RegisterEngine:
         where the skin lies on the maxilla (:func:`mandible_share`, ``mandible.maxilla`` in the table). Beside
         the mouth (``spec["beside"]``) the band between the two grows taller - the cheek hangs between the
         zygoma and the mandible - and the skin in it follows smoothly from the moving to the still skin."""
-        from facsim.head.landmarks import landmarks
-
-        marks = landmarks(self.head)
-        corners = [positions[marks[f"{spec['lip_line']}_{side}"]] for side in ("left", "right")]
-        lip_line = float(np.mean([c[1] for c in corners]))
+        lip_line, half_width = self._mouth_line(positions, spec["lip_line"])
         below, above = float(spec["free_below_mm"]) / 100.0, float(spec["held_above_mm"]) / 100.0
         beside = spec.get("beside")
         if beside:
-            half_width = float(np.mean([abs(c[0]) for c in corners]))
             lateral = smoothstep(float(beside["from"]) * half_width, float(beside["full"]) * half_width, np.abs(positions[:, 0]))
             below = below + lateral * (float(beside["free_below_mm"]) / 100.0 - below)
             above = above + lateral * (float(beside["held_above_mm"]) / 100.0 - above)
@@ -414,13 +409,20 @@ class RegisterEngine:
         marks = landmarks(self.head)
         angles = turning_angles(offsets, positions, hinge)
         chin = float(angles[marks[mandible_spec()["reference"]]])
-        corners = [positions[marks[f"lip_corner_{side}"]] for side in ("left", "right")]
-        half_width = float(np.mean([abs(c[0]) for c in corners]))
-        lip_line = float(np.mean([c[1] for c in corners]))
+        lip_line, half_width = self._mouth_line(positions, "lip_corner")
         lower = (((self._lips > 0.5) | (anat.kind == MOUTH)) & (positions[:, 1] < lip_line)
                  & (angles > float(spec["min_share"]) * chin) & (angles < chin))
         taper = smoothstep(half_width, float(spec["full_within"]) * half_width, np.abs(positions[:, 0]))
         return np.where(lower, 1.0 + taper * (chin / np.maximum(angles, 1e-12) - 1.0), 1.0)
+
+    def _mouth_line(self, positions: np.ndarray, mark: str) -> tuple[float, float]:
+        """(height, half-width) of the line through the two ``mark`` landmarks (``lip_corner``:
+        the lip corners) on skin ``positions`` (N_skin, 3), both sides' mean."""
+        from facsim.head.landmarks import landmarks
+
+        marks = landmarks(self.head)
+        corners = [positions[marks[f"{mark}_{side}"]] for side in ("left", "right")]
+        return float(np.mean([c[1] for c in corners])), float(np.mean([abs(c[0]) for c in corners]))
 
     @cached_property
     def _lips(self) -> np.ndarray:

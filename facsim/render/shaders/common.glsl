@@ -3,6 +3,7 @@
 // where face.frag.glsl includes it (render.py does the include, not the GL driver).
 
 const float PI = 3.14159265;
+const vec3 LUMINANCE = vec3(0.2126, 0.7152, 0.0722);   // Rec. 709: linear RGB -> luminance
 
 // Light rig, world space. Directions point FROM the surface TOWARD the light; colours are
 // linear RGB with the intensity folded in (Renderer builds them from a Lighting and the camera).

@@ -155,7 +155,7 @@ const float STUBBLE_GRAIN = 1.5;
 const vec3 DARK_STUBBLE = vec3(0.70, 0.72, 0.78);
 const vec3 GREY_STUBBLE = vec3(0.79, 0.78, 0.77);
 vec3 stubble_shade() {
-    return mix(DARK_STUBBLE, GREY_STUBBLE, smoothstep(0.05, 0.15, dot(u_brows, vec3(0.2126, 0.7152, 0.0722))));
+    return mix(DARK_STUBBLE, GREY_STUBBLE, smoothstep(0.05, 0.15, dot(u_brows, LUMINANCE)));
 }
 
 // The skin's unevenness between the blotches and the regional maps (5-30 mm, what a photograph of
@@ -455,8 +455,7 @@ const vec3 MUCOSA = vec3(0.40, 0.075, 0.09);   // the lips' mucosa (linear; sRGB
 // than the mucosa (light skin) keep MUCOSA.
 const float MUCOSA_OVER_DARK_LIPS = 1.4;
 vec3 mucosa_colour(vec3 lips) {
-    const vec3 Y = vec3(0.2126, 0.7152, 0.0722);
-    return MUCOSA * min(1.0, MUCOSA_OVER_DARK_LIPS * dot(lips, Y) / dot(MUCOSA, Y));
+    return MUCOSA * min(1.0, MUCOSA_OVER_DARK_LIPS * dot(lips, LUMINANCE) / dot(MUCOSA, LUMINANCE));
 }
 #endif
 #if defined(REGION_TEETH) || defined(REGION_TONGUE)
@@ -728,7 +727,7 @@ void main() {
     // up by the blotches, and melanin lies unevenly in larger, softer patches (darker, a
     // little warmer). Melanin veils the blood in dark skin, whose unevenness is mostly its
     // pigment's.
-    float lum_skin = dot(u_skin, vec3(0.2126, 0.7152, 0.0722));
+    float lum_skin = dot(u_skin, LUMINANCE);
     float melanin_rich = 1.0 - smoothstep(0.05, 0.3, lum_skin);
     float haem = 0.55 * value_noise(skin_uv * vec2(55.0, 110.0) + 5.0, 0) + 0.45 * blotch;
     albedo *= mix(vec3(1.0), vec3(1.01, 0.86, 0.87), (0.9 - 0.5 * melanin_rich) * smoothstep(0.4, 0.85, haem));
@@ -740,7 +739,7 @@ void main() {
     // (thin skin over vessels and muscle), more so with age; a shaved beard's blue-grey shadow.
     // Mild: a nose or cheek a shade redder than the skin around it, never pink (a saturated
     // nose tip read as painted); melanin veils much of it in dark skin.
-    float veil = mix(0.45, 1.0, smoothstep(0.03, 0.3, dot(u_skin, vec3(0.2126, 0.7152, 0.0722))));
+    float veil = mix(0.45, 1.0, smoothstep(0.03, 0.3, dot(u_skin, LUMINANCE)));
     float red = u_redness * detail.r * veil * mix(0.6, 1.25, smoothstep(0.2, 0.8, 0.55 * blotch + 0.45 * patches));
     // (Older: broken veins, a little more. Until session 20 (1.03, 0.84, 0.83) at up to 1.05x the
     // map: george's nose and cheeks read as flushed, a sore red.) With age the flush breaks up
@@ -993,7 +992,7 @@ void main() {
     // direct key (fill, sky, rim) comes out redder and more saturated, as in photographs,
     // where skin in shadow is a deeper red-brown and never the grey of a painted surface.
     // (Melanin absorbs much of the scattered light in dark skin: less reddening there.)
-    float scatter = (1.0 - hair) * smoothstep(0.03, 0.3, dot(u_skin, vec3(0.2126, 0.7152, 0.0722)));
+    float scatter = (1.0 - hair) * smoothstep(0.03, 0.3, dot(u_skin, LUMINANCE));
     lit = key_part + (lit - key_part) * mix(vec3(1.0), vec3(1.14, 0.92, 0.84), scatter);
 #ifdef USE_PORES
     lit.gb = mix(lit.gb, diffuse_light(bumped, 0.5 * wrap, contact).gb, 0.6);

@@ -124,6 +124,14 @@ float pixel_strands(vec3 rest, vec3 along, float cells_per_dm) {
 }
 
 const float HAIR_VOLUME_RADIUS = 0.9;   // dm, facsim.render.proxies.VOLUME_RADIUS
+// The volume's dome sits on this height (its apex, a quarter radius above the crown, on the axis).
+float dome_base(vec3 apex) {
+    return apex.y - 1.25 * HAIR_VOLUME_RADIUS;
+}
+// The point of the volume's vertical axis nearest p: under the dome, level with p.
+vec3 volume_axis_point(vec3 p, vec3 apex) {
+    return vec3(apex.x, min(p.y, dome_base(apex)), apex.z);
+}
 
 // Strands a couple of pixels across and many long, running down the hair volume's meridians
 // from its axis (over the crown, then down the sides: facsim.render.proxies.volume_normals'
@@ -187,9 +195,7 @@ float strand_diffuse(vec3 t, vec3 l) {
 // cos = n.v lies r (1 - sin) inside), so the fade follows a rounded outline, not the cards'.
 const float COILY_HALO_MM = 3.0;
 float coily_inside_outline_mm(vec3 p, vec3 v) {
-    // (u_hair_apex lies a quarter radius above the crown, on the axis)
-    vec3 q = vec3(u_hair_apex.x, min(p.y, u_hair_apex.y - 1.25 * HAIR_VOLUME_RADIUS), u_hair_apex.z);
-    vec3 out_dir = p - q;
+    vec3 out_dir = p - volume_axis_point(p, u_hair_apex);
     float r = length(out_dir);
     float c = clamp(dot(out_dir, v) / max(r, 1e-6), 0.0, 1.0);
     return 100.0 * r * (1.0 - sqrt(1.0 - c * c));
@@ -355,7 +361,7 @@ void main() {
     float df = clamp(dot(n, u_fill_dir) * 0.5 + 0.5, 0.0, 1.0);
     vec3 lit = dk * u_key_col + df * u_fill_col + hemisphere(n) * 0.8;
     // The roots under full cover lie in the cards' shadow; the hairline's fine hairs in the open.
-    float light_hair = sqrt(clamp(dot(u_color, vec3(0.2126, 0.7152, 0.0722)), 0.0, 1.0));
+    float light_hair = sqrt(clamp(dot(u_color, LUMINANCE), 0.0, 1.0));
     // Brightness strand by strand (coily: curl by curl), not one flat tone.
 #ifdef COILY
     float strand_shade = 1.0;
@@ -561,9 +567,7 @@ void main() {
     // the forehead, hair brushed sideways), short smears along their own direction (pixel_strands).
     float flow_share = 0.0;
     if (u_along_v < 0.5) {
-        vec3 axis_point = vec3(u_hair_apex_rest.x, min(v_rest.y, u_hair_apex_rest.y - 1.25 * HAIR_VOLUME_RADIUS),
-                               u_hair_apex_rest.z);
-        vec3 nv = normalize(v_rest - axis_point);
+        vec3 nv = normalize(v_rest - volume_axis_point(v_rest, u_hair_apex_rest));
         vec3 meridian = cross(nv, normalize(cross(vec3(0.0, 1.0, 0.0), nv) + vec3(1e-5, 0.0, 0.0)));
         flow_share = smoothstep(0.75, 0.92, abs(dot(meridian, along_rest)));
     }
@@ -662,7 +666,7 @@ void main() {
         float thinning = smoothstep(0.0, COILY_HALO_MM, inside_mm);
         // Low on the sides, where the mass ends over the ears and meets the skin, it stays dense
         // (thinned there, it showed its cards' corners as pale triangles beside the ears).
-        float below_dome = u_hair_apex.y - 1.25 * HAIR_VOLUME_RADIUS - v_pos.y;   // dm
+        float below_dome = dome_base(u_hair_apex) - v_pos.y;   // dm
         thinning = mix(thinning, 1.0, smoothstep(0.4, 0.55, below_dome));
         curl_detail *= thinning;
         float curl_rank = clamp(0.5 + 2.2 * (curl_weight * halo + (1.0 - curl_weight) * coil_clump - 0.5), 0.02, 0.98);
@@ -770,7 +774,7 @@ void main() {
     // Light hair (blond, grey) scatters light on through the strands, so its inner layers
     // darken much less than dark hair's (the multiple scattering of Marschner's model).
     // Coily hair is denser: its inner curls stay dark whatever the colour.
-    float light_hair = sqrt(clamp(dot(u_color, vec3(0.2126, 0.7152, 0.0722)), 0.0, 1.0)) * (1.0 - 0.6 * u_coil);
+    float light_hair = sqrt(clamp(dot(u_color, LUMINANCE), 0.0, 1.0)) * (1.0 - 0.6 * u_coil);
 #ifdef USE_SHADOW
     // The key's cast shadow: the mass's own (light hair lets it further in) and the head's.
     float key_reach = hair_key_visibility(v_pos, n, mix(3.0, 7.0, light_hair));
