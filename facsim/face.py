@@ -127,7 +127,7 @@ class Face:
         key = hashlib.sha256(repr((VERSION, shape, hair[0].proxy.name,
                                    (hair[0].crop, hair_table()["crops"][hair[0].crop], CROP_ROUNDING, CROP_EDGE)
                                    if hair[0].crop else "", hair_table().get("scalp"),
-                                   hair_volume(hair[0].proxy.name)))
+                                   hair_volume(hair[0].proxy.name), hair_table().get("snug")))
                              .encode()).hexdigest()[:16]
         return bind_scalp(hair[0], self.head, self.neutral, cache=cache_dir() / "scalp" / f"{key}.npy")
 

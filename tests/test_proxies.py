@@ -375,10 +375,14 @@ def test_straight_hair_shows_depth_between_locks_not_one_flat_sheet(face_of):
     strands: their gaps lie in their neighbours' shade and their crowns catch the light (mei's
     black bob read as one flat sheet, blind review, session 21). On mei at 256² the hair's
     detail finer than 2 px over its mean (benchmarks/bench_hair_texture.py's ``fine``) was
-    0.241, with locks 0.266; the crown's banding stays under the limit above (0.112 -> 0.124)."""
+    0.241, with locks 0.266; the crown's banding stays under the limit above (0.112 -> 0.124).
+    Session 25 lit the hair along the forehead's hairline (a dark brim, whose edges counted as
+    detail here: over the whole mask 0.256 -> 0.215), so this is taken on the hair below the top
+    40 % of the image, the lengths beside the face: 0.248 on main 67a54cb, 0.249 now."""
     with_hair, _, mask = hair_renders(face_of("mei"), 256)
+    mask[: int(0.4 * len(mask))] = False
     fine, _ = bench_hair_texture().luminance_variation(with_hair, mask)
-    assert fine > 0.255, fine
+    assert fine > 0.235, fine
 
 
 def _afro_outline(face, size: int = 256, depths=(2, 8)) -> tuple[list[float], float]:
@@ -460,3 +464,93 @@ def test_long_hair_framing_the_face_is_not_a_dark_band(face_of):
     over the hair further out at 256² was 0.678 (mei 0.593, margaret 0.735); now 0.768 (0.695,
     0.789), the shade of a curtain of hair, not a rim."""
     assert _face_frame_band(face_of("ava")) > 0.72
+
+
+# ---- straight and wavy hair lying on the head, not a helmet (session 25)
+
+
+def _hair_at_the_hairline(face, above_mm: tuple[float, float]):
+    """``face``'s hair vertices over the forehead and temples (the nearest skin faces forward,
+    within 14 mm of it) from ``above_mm[0]`` to ``above_mm[1]`` mm above the hairline
+    (``scalp:`` in hair.yaml): their height over the skin (mm, along its normal) and their
+    openness (BoundProxy.depth)."""
+    from scipy.spatial import cKDTree
+
+    from facsim.head.scalp import hairline_height, outward_skin
+
+    hair = next(b for b in face.proxies if b.proxy.kind == "hair")
+    geo = np.asarray(face.neutral, np.float64)
+    skin, _, normals = outward_skin(face.head, geo)
+    points = hair.neutral.astype(np.float64)
+    distance, nearest = cKDTree(skin).query(points)
+    height = np.einsum("ij,ij->i", points - skin[nearest], normals[nearest])
+    eyes = np.concatenate([np.asarray(v) for v in face.head.eye_vertices.values()])
+    line = hairline_height(normals[nearest], skin[nearest, 2], float(geo[eyes, 1].mean()), float(geo[eyes, 2].mean()),
+                           proxies.hair_table()["scalp"]["hairline_above_eyes_mm"])
+    band = ((normals[nearest, 2] > 0.6) & (distance < 0.14)
+            & (points[:, 1] > line + 0.01 * above_mm[0]) & (points[:, 1] < line + 0.01 * above_mm[1]))
+    return 100.0 * height[band], hair.depth[band]
+
+
+@pytest.mark.parametrize("name", ["ava", "mei"])
+def test_hair_along_the_forehead_lies_in_the_open_not_in_a_dark_brim(face_of, name):
+    """The hair along the forehead's hairline is the outer layer there; marched outward from a
+    centre high in the head (hair_exposure) its rays grazed the neighbouring cards curving round
+    the forehead, and it was shaded as an under-layer: a dark brim along the hairline under a
+    lighter crown ("hair helmet / hair cap edge", blind review session 24, ava 12 of 13). The
+    cards in front of the head's centre now march forward too. Mean openness of long01's hair
+    from 20 mm below to 15 mm above the hairline: ava 0.41 -> 0.69, mei 0.46 -> 0.75."""
+    _, openness = _hair_at_the_hairline(face_of(name), (-20.0, 15.0))
+    assert len(openness) > 20
+    assert openness.mean() > 0.6, openness.mean()
+
+
+@pytest.mark.parametrize("name", ["ava", "mei", "liam"])
+def test_hair_lies_on_the_skin_at_the_hairline_not_on_a_shell(face_of, name):
+    """MakeHuman fits its cards a few millimetres off the forehead, so the hair sat on the head
+    like a shell with a cut brim. Along the hairline (``snug:`` in hair.yaml,
+    hair_snug_offset) the cards now lie down to the skin, keeping their layers' order. Of the
+    hair vertices from 20 mm below to 4 mm above the hairline, standing off the skin at all, the
+    upper quartile of their height (mm): ava 7.5 -> 3.6, mei 6.2 -> 3.4, liam 5.6 -> 3.3."""
+    height, _ = _hair_at_the_hairline(face_of(name), (-20.0, 4.0))
+    height = height[height > 0.0]
+    assert len(height) >= 2
+    assert np.percentile(height, 75) < 4.5, np.percentile(height, 75)
+
+
+def test_hair_lying_snug_is_lowered_toward_the_skin_never_into_it(face_of):
+    """hair_snug_offset lowers cards along the skin's normal and never below ``floor_mm`` over
+    it (a card pushed into the skin would show the skin through the hair's gaps)."""
+    from scipy.spatial import cKDTree
+
+    from facsim.head.scalp import outward_skin
+
+    face = face_of("ava")
+    proxy = next(b for b in face.proxies if b.proxy.kind == "hair").proxy
+    fitted = proxies.fit_proxy(proxy, face.base_positions,
+                               scale=proxies.offset_scale(face.base_positions, face.head.base_vertices))
+    offset = proxies.hair_snug_offset(proxy.name, fitted, face.head, face.neutral, proxy.corner_vertex[proxy.triangles])
+    moved = np.linalg.norm(offset, axis=1) > 1e-5
+    assert moved.sum() > 20
+    skin, _, normals = outward_skin(face.head, np.asarray(face.neutral, np.float64))
+    nearest = cKDTree(skin).query(fitted)[1]
+
+    def height(p):
+        return np.einsum("ij,ij->i", p - skin[nearest], normals[nearest])[moved]
+
+    before, after = height(np.asarray(fitted, np.float64)), height(np.asarray(fitted, np.float64) + offset)
+    floor = 0.01 * proxies.hair_table()["snug"]["floor_mm"]
+    assert np.all(after < before)
+    assert np.all(after >= floor - 1e-6)
+
+
+def test_hanging_hair_shows_locks_along_its_flow(face_of):
+    """Straight hair's locks run down the hair's flow as long pieces (proxy.frag.glsl's
+    flow_locks) with a narrow dark parting between neighbours (lock_gap), instead of blobs two or
+    three cells long smeared along each card (a dappled, "textured helmet", blind review session
+    24). On ava (long01) at 256², the hair's detail finer than 2 px over its mean
+    (bench_hair_texture's ``fine``) below the top 40 % of the image: 0.119 -> 0.138."""
+    with_hair, _, mask = hair_renders(face_of("ava"), 256)
+    mask[: int(0.4 * len(mask))] = False
+    fine, _ = bench_hair_texture().luminance_variation(with_hair, mask)
+    assert fine > 0.13, fine

@@ -423,6 +423,8 @@ def bind_to_frame(proxy: Proxy, head, base_positions: np.ndarray, neutral_geomet
         return FrameBinding(ref=ref, weights=weights, offsets=(fitted - anchor).astype(np.float32))
     if proxy.kind == "hair":
         fitted = fitted + hair_volume_offset(proxy.name, fitted, head, neutral_geometry)
+        fitted = fitted + hair_snug_offset(proxy.name, fitted, head, neutral_geometry,
+                                           proxy.corner_vertex[proxy.triangles])
     ref = geo_of_base[proxy.ref]
     missing = ref < 0
     if missing.any():
@@ -467,6 +469,72 @@ def hair_volume_offset(style: str, fitted: np.ndarray, head, neutral_geometry: n
                            hair_table()["scalp"]["hairline_above_eyes_mm"])
     fade = smoothstep(line, line + VOLUME_FADE, fitted[:, 1])
     return (0.01 * mm * fade[:, None] * normals[nearest]).astype(np.float32)
+
+
+def hair_snug(style: str) -> dict | None:
+    """How ``style``'s cards lie down onto the skin along the hairline (``snug:`` in
+    ``facsim/data/hair.yaml``), or None for a style that stands off the skull (``volume_mm``)."""
+    table = hair_table().get("snug")
+    return None if table is None or hair_volume(style) > 0.0 else table
+
+
+def hair_snug_offset(style: str, fitted: np.ndarray, head, neutral_geometry: np.ndarray,
+                     triangles: np.ndarray | None = None) -> np.ndarray:
+    """(V, 3) offsets (dm) moving a hairstyle's vertices ``fitted`` (V, 3) toward the skin
+    along the hairline (zeros for a style without :func:`hair_snug`).
+
+    MakeHuman fits its cards a few millimetres off the forehead and temples, so the hair sat on
+    the head like a shell with a cut brim ("hair helmet / hair cap", blind review session 24).
+    Near the skin (within ``reach_mm``) and up to ``over_mm`` above the hairline (``scalp:`` in
+    ``hair.yaml``, :func:`facsim.head.scalp.hairline_height`) each vertex's height over the skin
+    above ``floor_mm`` is scaled by ``squeeze`` along the skin's normal, fading out above and
+    away: the hair lies on the scalp where it grows from it, and the cards keep their order
+    (outer layers stay outside inner ones), so none cut through another. Cards are a few
+    centimetres across and the skull curves under them: where one of ``triangles`` (T, 3) would
+    dip under half the floor between its corners, its corners are lowered less.
+    """
+    from scipy.spatial import cKDTree
+
+    snug = hair_snug(style)
+    fitted = np.asarray(fitted, np.float64)
+    if snug is None:
+        return np.zeros_like(fitted, dtype=np.float32)
+    from facsim.head.scalp import hairline_height, outward_skin
+    from facsim.head.surface import smoothstep
+
+    geo = np.asarray(neutral_geometry, np.float64)
+    skin, _, normals = outward_skin(head, geo)
+    tree = cKDTree(skin)
+
+    def height_over_skin(points):
+        distance, nearest = tree.query(points)
+        return np.einsum("ij,ij->i", points - skin[nearest], normals[nearest]), distance, nearest
+
+    height, distance, nearest = height_over_skin(fitted)
+    n = normals[nearest]
+    eyes = np.concatenate([np.asarray(v) for v in head.eye_vertices.values()])
+    line = hairline_height(n, skin[nearest, 2], float(geo[eyes, 1].mean()), float(geo[eyes, 2].mean()),
+                           hair_table()["scalp"]["hairline_above_eyes_mm"])
+    over, reach, floor = (0.01 * float(snug[k]) for k in ("over_mm", "reach_mm", "floor_mm"))
+    weight = (1.0 - smoothstep(line + 0.4 * over, line + over, fitted[:, 1])) \
+        * (1.0 - smoothstep(0.6 * reach, reach, distance))
+    lowered = floor + (height - floor) * float(snug["squeeze"])
+    drop = np.where(height > floor, lowered - height, 0.0)
+    if triangles is not None and len(triangles):
+        tri = np.asarray(triangles, np.int64)
+        tri = tri[np.any(weight[tri] > 0.0, axis=1)]
+        # (the triangles' edge midpoints and centres, where a flat card lies lowest over a round skull)
+        mid = np.array([[0.5, 0.5, 0.0], [0.0, 0.5, 0.5], [0.5, 0.0, 0.5], [1 / 3, 1 / 3, 1 / 3]])
+        for _ in range(6):
+            moved = fitted + (drop * weight)[:, None] * n
+            samples = np.einsum("sk,tkd->tsd", mid, moved[tri]).reshape(-1, 3)
+            before = np.einsum("sk,tkd->tsd", mid, fitted[tri]).reshape(-1, 3)
+            sunk = (height_over_skin(samples)[0] < 0.5 * floor) & (height_over_skin(before)[0] >= 0.5 * floor)
+            bad = np.unique(tri[sunk.reshape(len(tri), -1).any(axis=1)])
+            if not len(bad):
+                break
+            weight[bad] *= 0.5
+    return ((drop * weight)[:, None] * n).astype(np.float32)
 
 
 @dataclass(frozen=True, eq=False)
@@ -660,6 +728,9 @@ def bind_wisps(hair: BoundProxy, head, neutral_geometry: np.ndarray) -> BoundPro
 #: How far (dm) in front of the hairstyle's centre the cards begin … end to face the open air
 #: over the face sideways (:func:`hair_exposure`).
 FACE_FRAME_DEPTH = (0.2, 0.6)
+#: How far (dm) under the hairstyle's top its cards begin … end to lie over the forehead and
+#: temples (:func:`hair_exposure`; the eyes lie about 1.15 under it).
+FOREHEAD_BELOW_TOP = (0.75, 1.0)
 #: How open the face-framing under-layer lies at most (the outer cards still keep the key
 #: from above off it).
 FACE_FRAME_OPEN = 0.5
@@ -714,7 +785,18 @@ def hair_exposure(points: np.ndarray, triangles: np.ndarray, *, reach: float = 0
     toward_midline[:, 0] = -np.sign(points[:, 0] - centre[0])
     in_front = smoothstep(*(centre[2] + np.asarray(FACE_FRAME_DEPTH)), points[:, 2])
     sideways = FACE_FRAME_OPEN * in_front * openness(toward_midline)
-    exposure = np.maximum(exposure, sideways)
+    # The hair along the forehead's and temples' hairline is the outer layer there: nothing lies
+    # between it and a viewer in front. Marched outward from a centre high in the head, its rays
+    # graze the neighbouring cards of the same layer curving round the forehead, and it drew as a
+    # dark brim along the hairline under a lighter crown ("hair cap edge", blind review s24).
+    # The cards in front of the centre at the forehead's and temples' height (``FOREHEAD_BELOW_TOP``
+    # under the hair's top) march forward too; an under-layer still meets the cards over it.
+    # (Lower down, the under-layer framing the cheeks keeps its half-open shade, above.)
+    forward = np.zeros_like(points)
+    forward[:, 2] = 1.0
+    top = points[:, 1].max()
+    at_forehead = in_front * smoothstep(top - FOREHEAD_BELOW_TOP[1], top - FOREHEAD_BELOW_TOP[0], points[:, 1])
+    exposure = np.maximum(np.maximum(exposure, sideways), at_forehead * openness(forward))
     return exposure.astype(np.float32)
 
 
