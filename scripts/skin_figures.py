@@ -34,6 +34,10 @@ specular S = L1 - D (luminance). Regions are small boxes at landmarks (both side
   its hue (R - G) / (R + G). ``--astronaut`` prints the same for the studio portrait's cheeks
   (``skimage.data.astronaut()``, ~1.4 mm per px: mid tone 5.5, mid hue 1.8; its smile's raised
   cheeks add to its tone).
+- ``sheen fine``: the share of the forehead's highlight energy in detail finer than ~2 px: over the
+  forehead box's brightest third of the specular light S blurred over 2 px, the mean absolute
+  difference between S and its blur over the mean S. One smooth glaze is near 0; a sheen broken by
+  the skin's relief into facets catching the light higher (main 67a54cb at 448 px: kwame 0.21).
 - ``tone cv`` and ``hue sd``: the skin's own unevenness on the cheeks (larger boxes): the
   diffuse light D over D blurred by 8 px (the shading's slow change removed), its standard
   deviation (per cent); and the standard deviation of the diffuse light's hue,
@@ -207,6 +211,9 @@ def figures(name, expression=""):
         forehead = regions["forehead"]
         ys, xs = np.nonzero(forehead)
         patch = specular[ys.min():ys.max() + 1, xs.min():xs.max() + 1]
+        smooth = gaussian_filter(specular, 2.0)[ys.min():ys.max() + 1, xs.min():xs.max() + 1]
+        brightest = smooth > np.percentile(smooth, 67)
+        out["sheen fine"] = float(np.abs(patch - smooth)[brightest].sum() / max(patch[brightest].sum(), 1e-9))
         out["speckle"] = float(np.abs(np.diff(patch, axis=1)).mean() / max(patch.mean(), 1e-6))
         # The sheen's and the colour's pixel-scale grain (pores and fine lines, in aggregate):
         # the specular S on the forehead's and nose's boxes, the diffuse D on the cheeks', each
