@@ -242,6 +242,28 @@ const vec2 PORE_CELLS = vec2(1000.0, 2000.0);
 const mat2 GRAIN_TURN = mat2(0.839, 0.545, -0.545, 0.839);
 const float PORE_TONE = 0.3;
 const float PORE_SHEEN = 2.5;
+// The sheen sees the skin's micro-relief (the grain's height below) SHEEN_RELIEF times as steep as
+// the diffuse light does: light reflected at the surface sees every facet of the relief sharp,
+// while light that scattered a millimetre or so under the skin before leaving sees it softened.
+// So the T-zone's highlight breaks into a stipple of facets catching the light (a photograph's
+// sheen at 448 px, pores and fine lines in aggregate) inside the lobe's envelope, instead of one
+// smooth glaze: kwame's forehead highlight, blurred over 2 px, leaves 35 % of its energy in finer
+// detail (21 % with the diffuse light's relief, until session 25: the blind reviewer's "plastic
+// shiny skin / forehead sheen"; scripts/skin_figures.py "sheen fine").
+const float SHEEN_RELIEF = 3.0;
+// Mottling between ~2 and ~10 mm (cells ~5 and ~2.5 mm on hm08's face UV, turned off the texture
+// axes as the grain is): the skin's lightness varies in soft blotches, a little warmer where
+// darker (melanin), by MOTTLE_TONE per unit of the noise on light skin, half that on melanin-rich
+// skin, whose pigment already varies more (mid_tone) and where more read as a camouflage. (Until
+// session 25 the finest albedo variation above the grain was the blotches' ~2-mm cells at 0.6 of
+// 10-13 %: mei's and liam's cheeks at 448 px an even, papery pale, "overly smooth", "waxy";
+// scripts/skin_figures.py "fine tone".)
+const float MOTTLE_TONE = 0.22;
+vec3 skin_mottle(vec2 skin_uv, float melanin_rich) {
+    float m = 0.55 * value_noise(GRAIN_TURN * (skin_uv * vec2(70.0, 140.0)) + 91.0, 0)
+            + 0.45 * value_noise(GRAIN_TURN * (skin_uv * vec2(140.0, 280.0)) + 13.0, 0) - 0.5;
+    return 1.0 + MOTTLE_TONE * (1.0 - 0.5 * melanin_rich) * m * vec3(0.9, 1.0, 1.1);
+}
 
 // Skin's specular (Fresnel F0 = SKIN_F0) from one light, in its two lobes (broad, tight):
 // GGX distributions of the given roughness (by region: skin_lobes in skin_light.glsl, the tight
@@ -732,6 +754,7 @@ void main() {
     float haem = 0.55 * value_noise(skin_uv * vec2(55.0, 110.0) + 5.0, 0) + 0.45 * blotch;
     albedo *= mix(vec3(1.0), vec3(1.01, 0.86, 0.87), (0.9 - 0.5 * melanin_rich) * smoothstep(0.4, 0.85, haem));
     albedo *= 1.0 - (0.05 + 0.07 * melanin_rich) * (patches - 0.5) * vec3(0.85, 1.0, 1.15);
+    albedo *= skin_mottle(skin_uv, melanin_rich);
     float capillaries = aged_flush(skin_uv, blotch);   // (older skin's flush in patches)
     albedo *= mid_tone(skin_uv, detail.r * u_redness * capillaries, melanin_rich);
     // Regional colour: redder nose, cheeks and ears (blood close to the surface), in broken
@@ -910,6 +933,7 @@ void main() {
     float pore_amount = pore_fade * (0.3 + 1.2 * tone.b) * (1.0 - paint.g) * (1.0 - hair);
     // (0.8 of the height the pores had with a slope per quad: the same mean step between pixels.)
     vec3 bumped = normalize(abs(det) * n - (0.00048 + 0.00024 * u_age) * pore_amount * grad);
+    vec3 sheen_n = bumped;   // (the pores' own relief: at this size the sheen already breaks on them)
     cavity *= 1.0 - 0.07 * pit * pore_amount;
     float spec_break = 1.0 - 0.6 * pit * pore_amount;   // pores hold no oil film facing the light
 #else
@@ -937,6 +961,7 @@ void main() {
     // the relief shades green and blue more than red.)
     float relief = (0.00096 + 0.00048 * u_age) * (0.5 + tone.b) * (1.0 - paint.g) * (1.0 - hair);
     vec3 bumped = normalize(abs(det) * n - relief * grad);
+    vec3 sheen_n = normalize(abs(det) * n - SHEEN_RELIEF * relief * grad);   // (the sheen's: see SHEEN_RELIEF)
     cavity *= 1.0 - 0.09 * pit;
     float spec_break = 1.0 - 0.7 * pit;   // pores hold no oil film facing the light
 #endif
@@ -944,7 +969,9 @@ void main() {
     // the key on one flank and break the lips' sheen into short strokes, so the red reads as
     // soft, lined tissue rather than smooth rubber.
     float lip_h = -0.0012 * (1.0 + 0.5 * u_age) * lip_line * lip_core;
-    bumped = normalize(abs(det) * bumped - sign(det) * (dFdx(lip_h) * r1 + dFdy(lip_h) * r2));
+    vec3 lip_grad = sign(det) * (dFdx(lip_h) * r1 + dFdy(lip_h) * r2);
+    bumped = normalize(abs(det) * bumped - lip_grad);
+    sheen_n = normalize(abs(det) * sheen_n - lip_grad);
     // Contact shadows: the baked visibility is close to 1 on the open face and falls only in
     // the nostrils, the lip line, the eye sockets and under the jaw; squaring it deepens
     // those small shadows (a soft studio key still reaches into them partly).
@@ -1048,8 +1075,8 @@ void main() {
     SkinLobes lobes = skin_lobes(oil, film, lips, wet, blotch, patches);
     vec2 weight = lobes.weight;
     vec2 roughness = lobes.roughness;
-    vec3 spec = dot(skin_specular(bumped, u_key_dir, v, ndv, roughness), weight) * u_key_col * key_shadow
-              + dot(skin_specular(bumped, u_rim_dir, v, ndv, roughness), weight) * u_rim_col;
+    vec3 spec = dot(skin_specular(sheen_n, u_key_dir, v, ndv, roughness), weight) * u_key_col * key_shadow
+              + dot(skin_specular(sheen_n, u_rim_dir, v, ndv, roughness), weight) * u_rim_col;
     // (Times pi: the diffuse term here is albedo times N.L, without the Lambert 1/pi.)
     spec *= PI * (1.0 - hair) * (0.85 + 0.3 * grain) * spec_break
           * max(1.0 + PORE_SHEEN * (0.6 + tone.b) * (1.0 - lips) * pores, 0.0);

@@ -43,7 +43,8 @@ float oil_pools(vec2 skin_uv) {
 const float BROAD_LOBE_WEIGHT = 0.42;   // the horny layer's broad lobe, cheeks and T-zone alike
 const float TZONE_BROAD_ROUGHNESS = 0.54;
 const float OIL_FILM_WEIGHT = 0.14;     // the film's tight lobe where it lies, times oil_pools
-const float OIL_FILM_ROUGHNESS = 0.36;  // (0.42 until session 23: one broad, even highlight)
+const float OIL_FILM_ROUGHNESS = 0.33;  // (0.42 until session 23: one broad, even highlight; 0.36 until
+                                        // session 25, before the sheen saw the relief sharp: SHEEN_RELIEF)
 SkinLobes skin_lobes(float oil, float film, float lips, float wet, float blotch, float patches) {
     float tzone = smoothstep(0.4, 0.85, oil);
     float lip = max(lips, min(2.0 * wet, 1.0));   // the lips' lobes (LIP_LOBES in face.frag.glsl)
