@@ -1045,3 +1045,34 @@ def test_the_dropped_jaw_stretches_the_lower_lip_evenly(face_of, character):
         stretch = np.linalg.norm(moved[a[lower]] - moved[b[lower]], axis=1) / length
         assert stretch.max() < 4.0, (character, expression, stretch.max())
 
+
+def _midline_red(face, positions) -> tuple[float, float]:
+    """The upper and the lower lip's red seen from the front at the midline (mm): the height of their
+    points within 2 mm of it that face the camera (normal's z over 0.3)."""
+    from facsim.head.surface import vertex_normals
+
+    red, half, anat = _lips_red(face)
+    n = anat.skin_count
+    skin = np.asarray(positions, np.float64)[:n]
+    facing = vertex_normals(skin, anat.triangles)[:, 2] > 0.3
+    middle = np.abs(np.asarray(face.neutral, np.float64)[:n, X]) < 0.02
+    heights = []
+    for lip in (1, -1):
+        ys = skin[red & facing & middle & (half == lip), Y]
+        heights.append(100.0 * (ys.max() - ys.min()))
+    return heights[0], heights[1]
+
+
+@pytest.mark.parametrize("code", ["23", "24"])
+@pytest.mark.parametrize("character", ["ava", "george"])
+def test_tightened_and_pressed_lips_narrow_both_reds(face_of, character, code):
+    """FACS 23 and 24 narrow the red of both lips. ARKit's mouthRollUpper rolled the upper lip's red
+    away (at 23E 1.3 of george's 5.1 mm at the midline) while the lower lip kept nearly all of its own
+    (6.5 of 7.3; ava 9.2 of 10.0), so anger (4+5+7+23) showed a full lower lip pushed out under a
+    vanished upper one ("pushed lip rubbery", session 24's blind reviewer). Now each keeps 0.45-0.75
+    of its red (session 25)."""
+    face = face_of(character)
+    upper_rest, lower_rest = _midline_red(face, face.neutral)
+    upper, lower = _midline_red(face, face.deform(code + "E").positions)
+    assert 0.4 * upper_rest < upper < 0.85 * upper_rest, (upper, upper_rest)
+    assert 0.4 * lower_rest < lower < 0.85 * lower_rest, (lower, lower_rest)
