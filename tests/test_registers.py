@@ -1011,3 +1011,68 @@ def test_the_dropped_jaw_parts_the_lips_in_an_oval(face_of, character):
         if near.any():   # ava's rim has no vertex there at 27E
             ratio = rise[near] / oval[near]
             assert ratio.max() < most and ratio.mean() < mean, (character, text, ratio)
+
+
+def _lips_red(face):
+    """The lips' red (mask over 0.5) on ``face``'s skin and each point's lip (+1 upper, -1 lower, 0 neither)."""
+    from facsim.engines.muscle.net import anatomy, mask_per_vertex
+
+    anat = anatomy(face.head)
+    n = anat.skin_count
+    lips = mask_per_vertex(face.head, "lips")[:n]
+    return np.maximum(lips, lips[anat.mirror[:n]]) > 0.5, anat.lip_half[:n], anat
+
+
+@pytest.mark.parametrize("character", ["ava", "george", "liam"])
+def test_the_dropped_jaw_stretches_the_lower_lip_evenly(face_of, character):
+    """Session 25: the lower lip's red stretches over the dropped jaw evenly, it does not tear. The
+    lower-lip rule of ``mandible`` turned the lip's points as far as the chin only where their own turn
+    passed half the chin's, a hard cut through the lip's outer part: neighbours 0.4 mm apart there moved
+    2.7 mm apart at 26E on ava, the red beside the opening smeared 5-9 times its length into the round,
+    rubbery ring a blind reviewer saw in every fear and surprise (the longest lower-lip edge at 26E
+    8.6 / 5.3 / 6.8 times its rest length on ava / george / liam, 7.2 / 4.5 / 5.9 in fear). The rule now
+    comes in smoothly between 0.3 and 0.5 of the chin's turn: 2.5 / 2.3 / 2.2 and 3.2 / 2.7 / 2.9."""
+    from facsim.facs.emotions import emotion
+
+    face = face_of(character)
+    red, half, anat = _lips_red(face)
+    a, b = anat.edges.T
+    lower = red[a] & red[b] & (half[a] == -1) & (half[b] == -1)
+    rest = np.asarray(face.neutral, np.float64)
+    length = np.linalg.norm(rest[a[lower]] - rest[b[lower]], axis=1)
+    for expression in ("26E", emotion("fear")):
+        moved = np.asarray(face.deform(expression).positions, np.float64)
+        stretch = np.linalg.norm(moved[a[lower]] - moved[b[lower]], axis=1) / length
+        assert stretch.max() < 4.0, (character, expression, stretch.max())
+
+
+def _midline_red(face, positions) -> tuple[float, float]:
+    """The upper and the lower lip's red seen from the front at the midline (mm): the height of their
+    points within 2 mm of it that face the camera (normal's z over 0.3)."""
+    from facsim.head.surface import vertex_normals
+
+    red, half, anat = _lips_red(face)
+    n = anat.skin_count
+    skin = np.asarray(positions, np.float64)[:n]
+    facing = vertex_normals(skin, anat.triangles)[:, 2] > 0.3
+    middle = np.abs(np.asarray(face.neutral, np.float64)[:n, X]) < 0.02
+    heights = []
+    for lip in (1, -1):
+        ys = skin[red & facing & middle & (half == lip), Y]
+        heights.append(100.0 * (ys.max() - ys.min()))
+    return heights[0], heights[1]
+
+
+@pytest.mark.parametrize("code", ["23", "24"])
+@pytest.mark.parametrize("character", ["ava", "george"])
+def test_tightened_and_pressed_lips_narrow_both_reds(face_of, character, code):
+    """FACS 23 and 24 narrow the red of both lips. ARKit's mouthRollUpper rolled the upper lip's red
+    away (at 23E 1.3 of george's 5.1 mm at the midline) while the lower lip kept nearly all of its own
+    (6.5 of 7.3; ava 9.2 of 10.0), so anger (4+5+7+23) showed a full lower lip pushed out under a
+    vanished upper one ("pushed lip rubbery", session 24's blind reviewer). Now each keeps 0.45-0.75
+    of its red (session 25)."""
+    face = face_of(character)
+    upper_rest, lower_rest = _midline_red(face, face.neutral)
+    upper, lower = _midline_red(face, face.deform(code + "E").positions)
+    assert 0.4 * upper_rest < upper < 0.85 * upper_rest, (upper, upper_rest)
+    assert 0.4 * lower_rest < lower < 0.85 * lower_rest, (lower, lower_rest)
