@@ -543,7 +543,7 @@ class ProxyLayer:
                 and np.array_equal(self._last[1], positions)):
             return
         self._last = (camera_position.copy(), positions.copy())
-        if self.mesh.kind in ("hair", "wisps"):   # (wisps: coily hair's halo, proxy.frag.glsl)
+        if self.mesh.kind in ("hair", "wisps"):   # (wisps: coily hair's outline, proxy.frag.glsl)
             apex = tuple(float(x) for x in hair_apex(positions))
             for prog in self.programs.values():
                 _set_uniform(prog, "u_hair_apex", apex)
