@@ -575,9 +575,10 @@ def test_surprise_raises_the_whole_brow_in_an_arch(face_of, name):
     """Session 15 (amara's surprise read as anger): in 1+2 the whole brow rises, curved and
     high, its inner end about as much as its outer, its middle highest - not a low, heavy
     head under a raised tail. Measured on the drawn brow (one preset per brow style and
-    ethnicity), in thirds along it. Session 23: arched - the middle third rises over 3.2 mm more
+    ethnicity), in thirds along it. Session 23: arched - the middle third rose 3.6-4.9 mm more
     than the mean of the inner and outer thirds (1.7-2.7 mm on main 98c87e1, where the brow rose
-    as a straight bar and FER2013 named surprise fear; 3.6-4.9 mm now)."""
+    as a straight bar and FER2013 named surprise fear). Session 25: bowed, not arched high - a
+    blind reviewer saw "eyebrows distorted into high arches"; 2.0-3.1 mm now, still over 1.5."""
     from facsim.head.proxies import along_brow
 
     face = face_of(name)
@@ -589,8 +590,26 @@ def test_surprise_raises_the_whole_brow_in_an_arch(face_of, name):
                             for lo, hi in ((0.0, 1 / 3), (1 / 3, 2 / 3), (2 / 3, 1.0)))
     assert inner > 0.04 and inner >= 0.7 * outer, (name, inner, middle, outer)
     assert middle >= 0.9 * max(inner, outer), (name, inner, middle, outer)
-    assert middle - (inner + outer) / 2 > 0.032, (name, inner, middle, outer)
+    assert middle - (inner + outer) / 2 > 0.015, (name, inner, middle, outer)
 
+
+
+@pytest.mark.parametrize("name", ["amara", "mei", "ava", "george", "kwame"])
+def test_surprise_lifts_the_brow_as_far_as_photographs_show(face_of, name):
+    """In photographs of surprise (1+2 at E) the brows rise about 6-9 mm, the whole brow lifted
+    and bowed a little, keeping its shape. Session 23's arch lifted the drawn brow's middle third
+    12.5 mm on every preset, its ends 7-10 mm: the reviewer's "eyebrows distorted into high
+    arches" (session 24). Now the middle third rises 9.6-9.7 mm and no third rises over 10 mm,
+    nor under 5 (1+2 still shows)."""
+    from facsim.head.proxies import along_brow
+
+    face = face_of(name)
+    brow = next(b for b in face.proxies if b.proxy.kind == "eyebrows")
+    rest = brow.binding.positions(face.neutral)
+    rise = brow.binding.positions(face.engine.deform(activations(parse("1+2"))).positions)[:, 1] - rest[:, 1]
+    along, left = along_brow(rest), rest[:, 0] > 0
+    thirds = [rise[left & (along >= lo) & (along <= hi)].mean() for lo, hi in ((0.0, 1 / 3), (1 / 3, 2 / 3), (2 / 3, 1.0))]
+    assert max(thirds) < 0.1 and min(thirds) > 0.05, (name, thirds)
 
 def _nose_and_glabella(head):
     """Skin vertex masks on the base mesh: the nose's bridge from its root between the eyes

@@ -403,7 +403,9 @@ const float IRIS_CAUSTIC = 0.3;    // how much brighter the iris's lower rim is 
 // (At 0.17 x 0.14, an even plate of ~1.1 mm² with a crisp edge, it still sat on the iris like a
 // sticker: now a ~30-cm box at 1.2 m, ~0.5 mm² on the cornea, brightest in its middle, its rim
 // fading out.)
-const vec2 SOFTBOX = vec2(0.1, 0.085);
+// (Session 25: its half-size, 0.1 x 0.085 as a box, is 1.5 times that as soft_catch_light's oval,
+// whose falloff starts at its middle.)
+const vec2 CATCH_LIGHT = vec2(0.15, 0.12);
 // The key softbox is tall: the cornea mirrors its lower part, near the eyes' level, rather
 // than the key's middle ~30 degrees up, whose reflection lies under the upper lid. (At ~16
 // degrees up it still lay under the relaxed lids of most presets: george, kwame, liam and noah
@@ -415,6 +417,23 @@ const float KEY_REFLECTION = 1.6;   // (0.65 for a box 2.8 times the area: the s
 // a lowered lid hides the key's, as in photographs).
 const vec2 FILL_BOX = vec2(0.2, 0.3);
 const float FILL_REFLECTION = 0.15;
+// The key's catch-light as a photograph shows it: a soft oval of light on the tear film,
+// brightest in its middle and fading out over its whole width (a Gaussian). Half-size `size`
+// (radians) about the light direction `l`, seen along the reflected ray `refl`: it follows the
+// cornea's curve. (softbox() below, a rounded rectangle with a flat top and a sharp rim, drew
+// the key at 1024² as a 2 x 2-px white square on every pupil: the reviewer's box-shaped sticker
+// of a doll's eye, issue 13. A wider faint glow round it, at the cornea's grazing Fresnel gain,
+// lit a second bright speck at amara's lower limbus.)
+float soft_catch_light(vec3 refl, vec3 l, vec2 size) {
+    vec3 bu = normalize(cross(l, vec3(0.0, 1.0, 0.0)));
+    vec3 bv = cross(bu, l);
+    vec2 q = vec2(dot(refl, bu), dot(refl, bv)) / size;
+    // (Widened by a pixel where the oval is smaller than that, so small images keep a
+    // catch-light instead of missing it between pixel centres.)
+    float px = max(fwidth(q.x), fwidth(q.y));
+    float d2 = dot(q, q) / (1.0 + px * px);
+    return exp(-2.2 * d2) * step(0.0, dot(refl, l));
+}
 // Coverage of a soft-edged rounded rectangle of half-size `size` (radians) centred on the
 // light direction `l`, seen along the reflected ray `refl` (for catch-lights).
 float softbox(vec3 refl, vec3 l, vec2 size) {
@@ -1045,6 +1064,12 @@ void main() {
     // (Only where the normals part: broad curves and terminators keep their red wrap.)
     float mesh_fold = smoothstep(MESH_FOLD_FROM, MESH_FOLD_FULL, 1.0 - dot(n, n_scatter_mesh));
     lit.r = mix(lit.r, min(lit.r, REDDEST_SCATTER * lit.g), mesh_fold);
+    // Nor is it bluer than a shade: where the averaged normal turns away from the key while the
+    // skin itself faces it (the rim of 5's raised upper lid, whose normals run down into the
+    // socket), red, which sees the averaged normal most, lost most of the key and the strip
+    // over the eyeball drew teal-grey (lit 0.50, 0.64, 0.63 on liam's fear): a glassy rim along
+    // the lid (issue 13, "glassy eyes"). Scattered light comes out at least as red as it went in.
+    lit.r = mix(lit.r, max(lit.r, lit.g), mesh_fold);
     vec3 diffuse = lit * albedo;
     // Translucency: thin ears and nose wings glow red where the rim light comes from behind
     // them.
@@ -1278,7 +1303,7 @@ void main() {
     float ndv = max(dot(nc, v), 0.0);
     float fres = schlick(0.025, ndv) / 0.025;
     vec3 room = mix(u_ground_col, u_sky_col, 0.5 + 0.5 * refl.y) * ROOM_REFLECTION;
-    vec3 boxes = softbox(refl, normalize(u_key_dir - vec3(0.0, SOFTBOX_DROP, 0.0)), SOFTBOX) * u_key_col
+    vec3 boxes = soft_catch_light(refl, normalize(u_key_dir - vec3(0.0, SOFTBOX_DROP, 0.0)), CATCH_LIGHT) * u_key_col
                + softbox(refl, u_fill_dir, FILL_BOX) * u_fill_col * FILL_REFLECTION;
     vec3 spec = (boxes * KEY_REFLECTION + room) * fres * mix(0.45, 1.0, cornea);
     // The sclera and the lid's wet rim are wet too but less smooth (a broad sheen), and the
