@@ -20,10 +20,11 @@ import numpy as np
 from facsim.render.gl import compile_program
 from facsim.render.proxies import ALPHA_CUTOFF, END_FADE
 
-#: World size (decimetres) of one shadow-map texel: 1.6 mm, so the 3-texel filter gives the
-#: soft key's penumbra of about 5 mm (a softbox a metre across at 1.5 m shades with an
-#: edge of several millimetres from features a centimetre or two off the skin).
-SHADOW_TEXEL = 0.016
+#: World size (decimetres) of one shadow-map texel: 2.6 mm, so the 3-texel filter gives the
+#: soft key's penumbra of about 8 mm (a softbox a metre across at 1.5 m shades with an edge of
+#: about a centimetre from features one or two centimetres off the skin: the nose, the chin).
+#: (1.6 mm until session 25: the nose's shadow had a drawn edge, a grey shape laid on the lip.)
+SHADOW_TEXEL = 0.026
 #: Largest shadow map side (texels); a caster set wider than this many texels gets coarser ones.
 SHADOW_MAP_MAX = 1024
 #: Map sides are rounded up to a multiple of this (a video's frames then share one map).

@@ -47,11 +47,13 @@ vec3 surface_normal() {
 // channel (a cheap subsurface look when red wraps furthest). `occ` (ambient visibility)
 // dims the ambient, fill and rim fully and the key partly; key_shadow (shadow.glsl) is the
 // key's cast shadow. Without cast shadows the occlusion stands in for them in creases and
-// sockets; with them it only says how much of the large softbox a crease still hides (the
-// shadow map sees the key from its middle), or sockets would darken twice. Not on the eyeballs:
+// sockets; with them it says how much of the large softbox a crease, a socket or the neck
+// under the jaw still hides (the shadow map sees the key from its middle). (0.25 until session
+// 25: a socket that sees two thirds of the room lost a tenth of the key, and the eyes sat in the
+// face as brightly lit as the cheeks, the blind reviewer's "flat lighting".) Not on the eyeballs:
 // their occlusion carries the lids' shade (USE_LIDS), finer than the map's texels resolve.
 #if defined(USE_SHADOW) && !defined(REGION_EYEBALL)
-const float KEY_OCCLUSION = 0.25;
+const float KEY_OCCLUSION = 0.5;
 #else
 const float KEY_OCCLUSION = 0.6;
 #endif

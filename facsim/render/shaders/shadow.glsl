@@ -26,7 +26,7 @@ float shadow_tap(vec2 base, float u, float v, float depth) {
 
 // Visibility of the key at p (world) with normal n: a 3x3-texel tent filter in four bilinear
 // comparisons (Castano's optimised PCF, as in The Witness), a smooth penumbra about three
-// texels (~5 mm) wide. Outside the map (nothing casts there) the key is unobstructed.
+// texels (~8 mm) wide. Outside the map (nothing casts there) the key is unobstructed.
 float key_visibility(vec3 p, vec3 n) {
     float ndl = clamp(dot(n, u_key_dir), -1.0, 1.0);
     float graze = sqrt(1.0 - ndl * ndl);
