@@ -424,8 +424,8 @@ def test_the_afro_is_a_dense_mass_with_coils_not_a_halo_or_fragments(face_of, na
     as a "fuzzy hair halo (with floating strands)" (blind review, 26/26 images); session 24's
     cut (cards solid 3 mm inside, their holes and pixel-scale curls left) as "noisy voxel-like
     fragments". At 256² on main 67a54cb: translucent 0.23 / 0.22 (amara / ngozi), band 11.2 /
-    9.5 px, floating 1334 / 1256 px, pieces 37 / 39 px; now 0.033 / 0.029, 2.0 / 1.4 px, 19 / 10,
-    13 / 9; coils 0.30 / 0.09 -> 0.17 / 0.08 (lower: main's counted the holes between its cards)."""
+    9.5 px, floating 1334 / 1256 px, pieces 37 / 39 px; now 0.030 / 0.027, 1.4 / 1.0 px, 5 / 2,
+    1 / 0; coils 0.30 / 0.09 -> 0.17 / 0.07 (lower: main's counted the holes between its cards)."""
     figures = _afro_figures(face_of(name))
     assert figures["translucent"] < 0.08, figures
     assert figures["band"] <= 3.0, figures

@@ -201,6 +201,21 @@ float hair_key_visibility(vec3 p, vec3 n, float free_path_mm) {
 }
 #endif
 
+#if defined(USE_SHADOW) && defined(KIND_HAIR) && defined(COILY)
+// The key's shadow on coily hair: only what lies more than 10 mm before p (the head, the mass's
+// far side). The cards a few millimetres before p shadowed the card behind them along their
+// edges, drawing the cards as dark patches in the mass; its self-shadow at that scale is the
+// clumps' (coily_self_shadow). (A 2x2 PCF comparison, as hair_key_visibility's.)
+float coily_key_visibility(vec3 p, vec3 n) {
+    vec3 c = (u_shadow_matrix * vec4(p + n * u_shadow_texel, 1.0)).xyz;
+    float mm = 0.01 / u_shadow_depth_range;
+    float near = texture(u_shadow, vec3(c.xy, c.z - 10.0 * mm));
+    float opacity = texture(u_shadow_opacity, c.xy).r;
+    float inside = step(0.0, c.x) * step(c.x, 1.0) * step(0.0, c.y) * step(c.y, 1.0) * step(c.z, 1.0);
+    return 1.0 - (1.0 - near) * opacity * inside;
+}
+#endif
+
 // Kajiya-Kay: light scattered by a thin cylinder along t.
 float strand_diffuse(vec3 t, vec3 l) {
     float tl = dot(t, l);
@@ -260,7 +275,8 @@ float coily_self_shadow(vec3 n, vec3 v, float crown) {
 // straight hair, which the cards' tangents drew as pale scratches across the mass.
 vec3 coily_sheen(vec3 n, vec3 v, float crown) {
     vec3 h = normalize(u_key_dir + v);
-    return u_key_col * 0.1 * pow(max(dot(n, h), 0.0), 4.0) * mix(0.5, 1.0, crown);
+    vec3 tint = mix(vec3(1.0), u_color / max(max(u_color.r, u_color.g), max(u_color.b, 1e-4)), 0.5);
+    return u_key_col * tint * 0.07 * pow(max(dot(n, h), 0.0), 4.0) * mix(0.5, 1.0, crown);
 }
 #endif
 
@@ -703,9 +719,9 @@ void main() {
         float below_dome = dome_base(u_hair_apex) - v_pos.y;   // dm
         float out_mm = inside_mm - COILY_BUMP_MM * (1.0 - bump) + 30.0 * smoothstep(0.75, 0.9, below_dome);
         float edge = clamp(0.5 + out_mm / max(fwidth(out_mm), 0.05), 0.0, 1.0);
-        // A card seen edge-on at the outline is a line standing off the mass: dropped whole.
-        float edge_on = step(0.12, face_on) + (1.0 - smoothstep(0.3, 0.8, outline));
-        alpha = mix(alpha, fill * edge * min(edge_on, 1.0), u_coil);
+        // A card seen edge-on is a line (standing off the mass at the outline, or beside the
+        // ears below it): dropped whole; the mass behind it is shaded alike.
+        alpha = mix(alpha, fill * edge * step(0.12, face_on), u_coil);
     }
 #endif
     // Over a thinning hairline (v_cover < 1, see facsim/head/scalp.py) the cards break up into
@@ -773,7 +789,10 @@ void main() {
         float bump = mix(0.5, coily_clumps(q), seen);
         float coils = mix(0.5, value_noise3(COIL_TURN_A * q * 90.0 + 5.0), seen);
         crown = smoothstep(0.3, 0.7, bump);
-        strand = mix(strand, mix(0.55, 1.15, crown) * (0.88 + 0.24 * coils), u_coil);
+        // (light hair scatters light into the hollows: grey afros' at full depth drew them as
+        // blotchy camouflage)
+        float light = sqrt(clamp(dot(u_color, LUMINANCE), 0.0, 1.0));
+        strand = mix(strand, mix(mix(0.55, 0.75, light), mix(1.15, 1.05, light), crown) * (0.88 + 0.24 * coils), u_coil);
         // Greying coily hair mixes white, grey and dark coils (placed on the head, not in the
         // cards' mirrored UVs), finer than its clumps: clumps of white and dark drew grey afros
         // as blotchy cloud or cauliflower (blind review session 20).
@@ -799,7 +818,9 @@ void main() {
     // darken much less than dark hair's (the multiple scattering of Marschner's model).
     // Coily hair is denser: its inner curls stay dark whatever the colour.
     float light_hair = sqrt(clamp(dot(u_color, LUMINANCE), 0.0, 1.0)) * (1.0 - 0.6 * u_coil);
-#ifdef USE_SHADOW
+#if defined(USE_SHADOW) && defined(COILY)
+    float key_reach = coily_key_visibility(v_pos, n);
+#elif defined(USE_SHADOW)
     // The key's cast shadow: the mass's own (light hair lets it further in) and the head's.
     float key_reach = hair_key_visibility(v_pos, n, mix(3.0, 7.0, light_hair));
 #else
