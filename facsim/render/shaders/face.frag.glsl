@@ -255,16 +255,16 @@ const float PORE_SHEEN = 2.5;
 const float SHEEN_RELIEF = 3.0;
 // Mottling between ~2 and ~10 mm (cells ~5 and ~2.5 mm on hm08's face UV, turned off the texture
 // axes as the grain is): the skin's lightness varies in soft blotches, a little warmer where
-// darker (melanin), by MOTTLE_TONE per unit of the noise on light skin, half that on melanin-rich
-// skin, whose pigment already varies more (mid_tone) and where more read as a camouflage. (Until
+// darker (melanin), by MOTTLE_TONE per unit of the noise, light and dark skin alike. (Until
 // session 25 the finest albedo variation above the grain was the blotches' ~2-mm cells at 0.6 of
-// 10-13 %: mei's and liam's cheeks at 448 px an even, papery pale, "overly smooth", "waxy";
-// scripts/skin_figures.py "fine tone".)
+// 10-13 %: mei's, liam's and amara's cheeks at 448 px an even, papery tone, "overly smooth",
+// "waxy", "skin uniform"; scripts/skin_figures.py "fine tone". Twice as strong, 0.44, read as a
+// camouflage of blotches on kwame.)
 const float MOTTLE_TONE = 0.22;
-vec3 skin_mottle(vec2 skin_uv, float melanin_rich) {
+vec3 skin_mottle(vec2 skin_uv) {
     float m = 0.55 * value_noise(GRAIN_TURN * (skin_uv * vec2(70.0, 140.0)) + 91.0, 0)
             + 0.45 * value_noise(GRAIN_TURN * (skin_uv * vec2(140.0, 280.0)) + 13.0, 0) - 0.5;
-    return 1.0 + MOTTLE_TONE * (1.0 - 0.5 * melanin_rich) * m * vec3(0.9, 1.0, 1.1);
+    return 1.0 + MOTTLE_TONE * m * vec3(0.9, 1.0, 1.1);
 }
 
 // Skin's specular (Fresnel F0 = SKIN_F0) from one light, in its two lobes (broad, tight):
@@ -775,7 +775,7 @@ void main() {
     float haem = 0.55 * value_noise(skin_uv * vec2(55.0, 110.0) + 5.0, 0) + 0.45 * blotch;
     albedo *= mix(vec3(1.0), vec3(1.01, 0.86, 0.87), (0.9 - 0.5 * melanin_rich) * smoothstep(0.4, 0.85, haem));
     albedo *= 1.0 - (0.05 + 0.07 * melanin_rich) * (patches - 0.5) * vec3(0.85, 1.0, 1.15);
-    albedo *= skin_mottle(skin_uv, melanin_rich);
+    albedo *= skin_mottle(skin_uv);
     float capillaries = aged_flush(skin_uv, blotch);   // (older skin's flush in patches)
     albedo *= mid_tone(skin_uv, detail.r * u_redness * capillaries, melanin_rich);
     // Regional colour: redder nose, cheeks and ears (blood close to the surface), in broken
