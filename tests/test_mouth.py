@@ -700,3 +700,25 @@ def test_dark_lips_mucosa_is_no_bright_pink_band(face_of):
     lab = rgb2lab(image[lips][None] / 255.0)[0]
     assert len(lab) > 2000
     assert ((lab[:, 0] > 45) & (lab[:, 1] > 20)).mean() < 0.004
+
+
+def test_the_lips_corners_fold_into_shade_as_they_part(face_of):
+    """Session 25: where the lips join, the parted (or smiling) mouth's corner is a small shaded pit
+    (facsim.head.mouth.COMMISSURE_FOLD). The light of the parted lips lit the corners as the lips'
+    middle (the skin within 2 mm of them at 1.38 times its rest's visibility in 1+2+5+26 on ava), and
+    the red ran round the opening's ends unbroken, a smooth rubber ring ("rubbery stretched mouth",
+    session 24's blind reviewer). Closed lips keep their corners' light."""
+    face = face_of("ava")
+    corners = face._mouth_rim.upper[[0, -1]]
+    rest = np.asarray(face.neutral, np.float64)
+    distance = np.min([np.linalg.norm(rest - rest[c], axis=1) for c in corners], axis=0)
+    near = (distance < 0.02) & (face.head.region == face.head.region[corners[0]])
+
+    def shade(text):
+        return float(face.frame_occlusion(face.deform(text).positions)[near].mean())
+
+    at_rest = shade("0")
+    for parted in ("1+2+5+26", "6+12+25"):
+        assert shade(parted) < 0.8 * at_rest, parted
+    assert abs(shade("12") - at_rest) < 0.05 * at_rest
+
