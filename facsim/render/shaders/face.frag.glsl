@@ -550,14 +550,14 @@ vec3 throat_shape(vec3 c) {
 // How far (band units, ~1.6 cm) the biting edge is cut back at ``side`` (0 mid-crown .. 1 at
 // its neighbours) of a tooth of ``kind`` (0 central incisor .. 6 molar) in the upper
 // (lower = 0) or lower row (1): incisors square with rounded corners, the upper laterals
-// ~0.9 mm shorter than the centrals, so the upper front teeth part at their tips in small
+// ~0.7 mm shorter than the centrals, so the upper front teeth part at their tips in small
 // V-shaped embrasures (~1 mm), each crown its own outline; the lower incisors almost
 // straight across (their embrasures, cut deep, showed the dark behind them as specks along
 // the row's edge); canines a cusp; premolars and molars cusps set higher (the curve of Spee).
 float incisal_notch(int kind, float side, float lower) {
     if (kind <= 1) {
         float corner = clamp((side - 0.35) / 0.65, 0.0, 1.0);
-        return mix(0.06, 0.01, lower) * corner * corner + (kind == 1 ? 0.055 * (1.0 - lower) : 0.0);
+        return mix(0.06, 0.01, lower) * corner * corner + (kind == 1 ? 0.045 * (1.0 - lower) : 0.0);
     }
     if (kind == 2) return 0.06 * pow(side, 1.6) - 0.01;
     // (Shallow: the back teeth's cusps show only in the buccal corridor's shade, where a
@@ -572,10 +572,10 @@ float incisal_notch(int kind, float side, float lower) {
 const vec3 TOOTH_KIND_VALUE = vec3(1.06, 0.9, 0.86);
 const vec3 TOOTH_KIND_TRANSLUCENCY = vec3(1.0, 1.25, 0.7);
 const vec3 TOOTH_KIND_YELLOW = vec3(0.0, 0.15, 0.8);
-// How much shorter than its kind each incisor's edge is (band units, ~16 mm: up to ~0.4 mm), and how
-// far its edge tilts across the crown (up to ~0.4 mm from one corner to the other): worn, uneven edges;
+// How much shorter than its kind each incisor's edge is (band units, ~16 mm: up to ~0.25 mm), and how
+// far its edge tilts across the crown (up to ~0.3 mm from one corner to the other): worn, uneven edges;
 // half as much on the lower row, whose edges, seen from above, show the dark behind them.
-const vec2 INCISAL_UNEVEN = vec2(0.025, 0.025);
+const vec2 INCISAL_UNEVEN = vec2(0.015, 0.02);
 float incisal_unevenness(float tooth_id, float w) {
     float shorter = hash2(ivec2(int(tooth_id), 61));
     float tilt = 2.0 * hash2(ivec2(int(tooth_id), 67)) - 1.0;
