@@ -5,6 +5,7 @@ lip) as a multiple of its rest length, and the 99th percentile - where the red s
 stretching evenly (session 25: the dropped jaw tore the lower lip's outer part, 5-9 times at 26E).
 ``--red``: the upper and the lower lip's red seen from the front (mm), at the midline and 0.6 of the
 way to the corners: the height of the lip's points there that face the camera (normal's z over 0.3).
+(In an open mouth the column 0.6 of the way out runs down along the lip's slope: read it for closed lips.)
 
 Usage::
 

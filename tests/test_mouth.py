@@ -700,3 +700,69 @@ def test_dark_lips_mucosa_is_no_bright_pink_band(face_of):
     lab = rgb2lab(image[lips][None] / 255.0)[0]
     assert len(lab) > 2000
     assert ((lab[:, 0] > 45) & (lab[:, 1] > 20)).mean() < 0.004
+
+
+def test_the_lips_corners_fold_into_shade_as_they_part(face_of):
+    """Session 25: where the lips join, the parted (or smiling) mouth's corner is a small shaded pit
+    (facsim.head.mouth.COMMISSURE_FOLD). The light of the parted lips lit the corners as the lips'
+    middle (the skin within 2 mm of them at 1.38 times its rest's visibility in 1+2+5+26 on ava), and
+    the red ran round the opening's ends unbroken, a smooth rubber ring ("rubbery stretched mouth",
+    session 24's blind reviewer). Closed lips keep their corners' light."""
+    face = face_of("ava")
+    corners = face._mouth_rim.upper[[0, -1]]
+    rest = np.asarray(face.neutral, np.float64)
+    distance = np.min([np.linalg.norm(rest - rest[c], axis=1) for c in corners], axis=0)
+    near = (distance < 0.02) & (face.head.region == face.head.region[corners[0]])
+
+    def shade(text):
+        return float(face.frame_occlusion(face.deform(text).positions)[near].mean())
+
+    at_rest = shade("0")
+    for parted in ("1+2+5+26", "6+12+25"):
+        assert shade(parted) < 0.8 * at_rest, parted
+    assert abs(shade("12") - at_rest) < 0.05 * at_rest
+
+
+def test_the_upper_front_teeth_differ_by_kind(face_of):
+    """Session 25: natural front teeth differ by kind - the upper centrals the largest and lightest, the
+    laterals shorter and a little darker (face.frag.glsl TOOTH_KIND_VALUE, incisal_notch). With only a
+    random spread per crown every tooth was one shape and nearly one shade ("teeth uniform", "too uniform
+    and small", session 24's blind reviewer): in ava's smile at 512 px the laterals' lighter half stood at
+    0.87 of the centrals' L* (the mouth's depth and the lip's shade alone; 0.81 now). Measured on the
+    upper row alone (the lower row moved out of view), in a 3-px column through each crown's middle."""
+    import dataclasses
+
+    from skimage.color import rgb2lab
+
+    from facsim import Face
+    from facsim.render.camera import project
+
+    face = face_of("ava")
+    size = 512
+    deformation = face.deform("6+12+25")
+    positions = np.array(deformation.positions, copy=True)
+    positions[_groups(face)["lower"], 1] -= 1.0      # the lower row out of view (1 dm down)
+    deformation = dataclasses.replace(deformation, positions=positions)
+    image = face.render(deformation=deformation, size=size, antialias=1)[..., :3]
+    marked = []
+    for colour in ("#ffffff", "#000000"):
+        with Face(face.character.with_(colors={"teeth": colour})) as recoloured:
+            marked.append(recoloured.render(deformation=deformation, size=size, antialias=1)[..., :3].astype(float))
+    teeth = np.abs(marked[0] - marked[1]).max(axis=-1) > 3
+    upper = _groups(face)["upper"]
+    arc = teeth_coordinates(face.head, face.data, face.base_positions)[upper, 0]
+    order = np.argsort(arc)
+    columns, _ = project(face.camera(size=(size, size)), positions[upper][order], size)
+    lightness = rgb2lab(image / 255.0)[..., 0]
+
+    def crown(middle):    # the lighter half of the crown's pixels in a column through its middle, both sides
+        values = []
+        for sign in (1, -1):
+            x = int(round(np.interp(sign * middle, arc[order], columns[:, 0])))
+            band = np.zeros_like(teeth)
+            band[:, x - 1: x + 2] = teeth[:, x - 1: x + 2]
+            values.append(np.sort(lightness[band])[band.sum() // 2:])
+        return float(np.concatenate(values).mean())
+
+    central, lateral = crown(0.0425), crown(0.1175)    # dm: the middle of each crown along the arch
+    assert lateral < 0.84 * central, (lateral, central)
