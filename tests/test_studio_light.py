@@ -126,3 +126,21 @@ def test_the_eye_sockets_keep_part_of_the_large_key_out(face_of, head, name):
     socket, cheek = loss((0.12, 7.33, 1.50)), loss((0.36, 6.84, 1.38))
     assert socket > 0.11, socket
     assert cheek < 0.05, cheek
+
+
+def test_light_figures_script_measures_the_modelling_of_a_face_and_of_the_reference_photograph():
+    """scripts/light_figures.py (the figures behind the rig's choices) runs: on ava's neutral face
+    the socket and the face's side are darker than the mid-cheek and the two cheeks differ but
+    modestly; the studio portrait it compares with shows the same order."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts"))
+    try:
+        import light_figures
+    finally:
+        sys.path.pop(0)
+    for out in (light_figures.figures("ava"), light_figures.astronaut_figures()):
+        assert out["socket"] < 0.8 and out["side"] < 0.8, out
+        assert 1.0 < out["lit/other"] < 1.6, out
+        assert out["neck"] < 0.5, out
