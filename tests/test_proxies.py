@@ -546,7 +546,7 @@ def test_hair_lying_snug_is_lowered_toward_the_skin_never_into_it(face_of):
 
 def test_hanging_hair_shows_locks_along_its_flow(face_of):
     """Straight hair's locks run down the hair's flow as long pieces (proxy.frag.glsl's
-    flow_locks) with a narrow dark parting between neighbours (lock_gap), instead of blobs two or
+    flow_lock_coordinate) with a narrow dark parting between neighbours (lock_gap), instead of blobs two or
     three cells long smeared along each card (a dappled, "textured helmet", blind review session
     24). On ava (long01) at 256², the hair's detail finer than 2 px over its mean
     (bench_hair_texture's ``fine``) below the top 40 % of the image: 0.119 -> 0.138."""

@@ -156,20 +156,20 @@ float flow_strands(vec3 rest, float cells_per_dm, float stretch) {
     return strand_blend(n0, n1, octave.y, 1.1, cells);
 }
 
-// Straight hair's locks laid out like flow_strands, at the locks' scale: value noise over the
+// Straight hair's locks laid out like flow_strands, at the locks' scale (flow_lock_coordinate): value noise over the
 // horizontal direction from the volume's axis (LOCK_CELLS_PER_DM across at its radius) that changes
 // LOCK_STRETCH times slower with the distance from the apex, so each lock runs several centimetres
 // down the hair's flow as one piece. (Smeared over a few cells along each strand, the locks were
 // blobs two or three cells long that drew a dappled, camouflage-like pattern across the lengths:
 // a "textured helmet", blind review session 24.) Faded to its mean where finer than a pixel.
+// (The coordinate, not the noise, so its screen-space change is taken outside any branch.)
 const float LOCK_STRETCH = 7.0;
-float flow_locks(vec3 rest) {
+vec3 flow_lock_coordinate(vec3 rest) {
     vec2 out_dir = rest.xz - u_hair_apex_rest.xz;
     out_dir /= max(length(out_dir), 1e-4);
     float along = length(rest - u_hair_apex_rest);
-    vec3 p = vec3(out_dir.x, 0.0, out_dir.y) * (HAIR_VOLUME_RADIUS * LOCK_CELLS_PER_DM)
-           + vec3(0.0, along * LOCK_CELLS_PER_DM / LOCK_STRETCH, 0.0);
-    return mix(0.5, lattice_noise3(p + 19.0), clamp(2.5 - 1.6 * length(fwidth(p)), 0.0, 1.0));
+    return vec3(out_dir.x, 0.0, out_dir.y) * (HAIR_VOLUME_RADIUS * LOCK_CELLS_PER_DM)
+         + vec3(0.0, along * LOCK_CELLS_PER_DM / LOCK_STRETCH, 0.0);
 }
 
 // The narrow gap between two locks: where the lock noise crosses its mean, a connected network of
@@ -637,15 +637,19 @@ void main() {
     // bob read as a flat sheet, blind review, session 21). Faded to its mean where finer than a pixel.
     vec3 lock_p = v_rest * LOCK_CELLS_PER_DM;
     // Where the strands run down and out from the crown (the hanging lengths, a short style's
-    // mass) the locks follow that flow (flow_locks); where they turn from it (a fringe, hair
+    // mass) the locks follow that flow (flow_lock_coordinate); where they turn from it (a fringe, hair
     // brushed sideways from a parting), a smear along their own direction.
     vec3 lock_nv = normalize(v_rest - volume_axis_point(v_rest, u_hair_apex_rest));
     vec3 lock_meridian = cross(lock_nv, normalize(cross(vec3(0.0, 1.0, 0.0), lock_nv) + vec3(1e-5, 0.0, 0.0)));
     float lock_flow = smoothstep(0.6, 0.85, abs(dot(lock_meridian, along_rest)));
-    float lock = lock_flow > 0.999 ? flow_locks(v_rest)
-               : mix(mix(0.5, smeared_noise(lock_p + 19.0, 1.6 * along_rest),
-                         clamp(2.5 - 1.6 * length(fwidth(lock_p)), 0.0, 1.0)),
-                     flow_locks(v_rest), lock_flow);
+    vec3 flow_lock_p = flow_lock_coordinate(v_rest);
+    float smear_fade = clamp(2.5 - 1.6 * length(fwidth(lock_p)), 0.0, 1.0);
+    float flow_fade = clamp(2.5 - 1.6 * length(fwidth(flow_lock_p)), 0.0, 1.0);
+    float lock = 0.5;
+    if (lock_flow < 0.999)
+        lock = mix(0.5, smeared_noise(lock_p + 19.0, 1.6 * along_rest), smear_fade);
+    if (lock_flow > 0.001)
+        lock = mix(lock, mix(0.5, lattice_noise3(flow_lock_p + 19.0), flow_fade), lock_flow);
     // (long hair's crown, combed flat sideways from the parting, shows shallower gaps than its
     // hanging lengths: at full depth there its locks drew bands across the crown)
     lock = clamp(0.5 + mix(1.6, 0.8, on_head * u_along_v) * (lock - 0.5), 0.0, 1.0);
