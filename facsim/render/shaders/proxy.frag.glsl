@@ -161,9 +161,11 @@ float flow_strands(vec3 rest, float cells_per_dm, float stretch) {
 // LOCK_STRETCH times slower with the distance from the apex, so each lock runs several centimetres
 // down the hair's flow as one piece. (Smeared over a few cells along each strand, the locks were
 // blobs two or three cells long that drew a dappled, camouflage-like pattern across the lengths:
-// a "textured helmet", blind review session 24.) Faded to its mean where finer than a pixel.
+// a "textured helmet", blind review session 24; stretched 7 times, the partings between them
+// still closed round each lock as contour lines, wood grain in a profile view.) Faded to its mean
+// where finer than a pixel.
 // (The coordinate, not the noise, so its screen-space change is taken outside any branch.)
-const float LOCK_STRETCH = 7.0;
+const float LOCK_STRETCH = 25.0;
 vec3 flow_lock_coordinate(vec3 rest) {
     vec2 out_dir = rest.xz - u_hair_apex_rest.xz;
     out_dir /= max(length(out_dir), 1e-4);
