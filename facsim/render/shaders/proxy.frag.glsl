@@ -829,7 +829,7 @@ void main() {
                       * mix(mix(0.74, 0.8, light_hair), 1.0, smoothstep(0.02, 0.32, px))
                       * mix(mix(LOCK_GAP_DARK, LOCK_GAP_LIGHT, light_hair), 1.0, smoothstep(0.15, 0.6, lock))
     // and the parting between two locks running down the flow is a narrow dark crevice
-                      * (1.0 - lock_flow * lock_gap(lock) * mix(0.6, 0.4, light_hair));
+                      * (1.0 - smoothstep(0.7, 1.0, lock_flow) * lock_gap(lock) * mix(0.6, 0.4, light_hair));
     float jitter = 0.22 * (tex.r - 0.5) + 0.12 * (fine - 0.5) + 0.18 * (mid - 0.5) + 0.1 * (clump - 0.5)
                  + 0.25 * (px - 0.5);
     // Key light: strand diffuse blended with a squared half-Lambert, which keeps the volume
@@ -873,7 +873,7 @@ void main() {
     // each card's edge, and at full strength they cut the band into the cards' shapes.)
     float strands = mix(0.55, 1.0, smoothstep(0.25, 0.7, fine) * smoothstep(0.2, 0.7, mid))
                   * mix(0.45, 1.0, smoothstep(0.3, 0.65, tex.r)) * mix(0.7, 1.0, clump) * smoothstep(0.3, 0.75, px) * 1.4
-                  * mix(0.4, 1.6, lock) * (1.0 - 0.7 * lock_flow * lock_gap(lock));   // the locks' crowns catch the light, their gaps little
+                  * mix(0.4, 1.6, lock) * (1.0 - 0.7 * smoothstep(0.7, 1.0, lock_flow) * lock_gap(lock));   // the locks' crowns catch the light, their gaps little
     float sparkle = smoothstep(0.45, 0.75, fine) * smoothstep(0.4, 0.7, mid) * smoothstep(0.4, 0.75, px);
     vec3 tint = mix(vec3(1.0), u_color / max(max(u_color.r, u_color.g), max(u_color.b, 1e-4)), 0.5);
     // Light hair's own diffuse is bright already: a full-strength white lobe on it reads as
