@@ -156,20 +156,22 @@ float flow_strands(vec3 rest, float cells_per_dm, float stretch) {
     return strand_blend(n0, n1, octave.y, 1.1, cells);
 }
 
-// Straight hair's locks laid out like flow_strands, at the locks' scale: value noise over the
+// Straight hair's locks laid out like flow_strands, at the locks' scale (flow_lock_coordinate): value noise over the
 // horizontal direction from the volume's axis (LOCK_CELLS_PER_DM across at its radius) that changes
 // LOCK_STRETCH times slower with the distance from the apex, so each lock runs several centimetres
 // down the hair's flow as one piece. (Smeared over a few cells along each strand, the locks were
 // blobs two or three cells long that drew a dappled, camouflage-like pattern across the lengths:
-// a "textured helmet", blind review session 24.) Faded to its mean where finer than a pixel.
-const float LOCK_STRETCH = 7.0;
-float flow_locks(vec3 rest) {
+// a "textured helmet", blind review session 24; stretched 7 times, the partings between them
+// still closed round each lock as contour lines, wood grain in a profile view.) Faded to its mean
+// where finer than a pixel.
+// (The coordinate, not the noise, so its screen-space change is taken outside any branch.)
+const float LOCK_STRETCH = 25.0;
+vec3 flow_lock_coordinate(vec3 rest) {
     vec2 out_dir = rest.xz - u_hair_apex_rest.xz;
     out_dir /= max(length(out_dir), 1e-4);
     float along = length(rest - u_hair_apex_rest);
-    vec3 p = vec3(out_dir.x, 0.0, out_dir.y) * (HAIR_VOLUME_RADIUS * LOCK_CELLS_PER_DM)
-           + vec3(0.0, along * LOCK_CELLS_PER_DM / LOCK_STRETCH, 0.0);
-    return mix(0.5, lattice_noise3(p + 19.0), clamp(2.5 - 1.6 * length(fwidth(p)), 0.0, 1.0));
+    return vec3(out_dir.x, 0.0, out_dir.y) * (HAIR_VOLUME_RADIUS * LOCK_CELLS_PER_DM)
+         + vec3(0.0, along * LOCK_CELLS_PER_DM / LOCK_STRETCH, 0.0);
 }
 
 // The narrow gap between two locks: where the lock noise crosses its mean, a connected network of
@@ -671,15 +673,19 @@ void main() {
     // bob read as a flat sheet, blind review, session 21). Faded to its mean where finer than a pixel.
     vec3 lock_p = v_rest * LOCK_CELLS_PER_DM;
     // Where the strands run down and out from the crown (the hanging lengths, a short style's
-    // mass) the locks follow that flow (flow_locks); where they turn from it (a fringe, hair
+    // mass) the locks follow that flow (flow_lock_coordinate); where they turn from it (a fringe, hair
     // brushed sideways from a parting), a smear along their own direction.
     vec3 lock_nv = normalize(v_rest - volume_axis_point(v_rest, u_hair_apex_rest));
     vec3 lock_meridian = cross(lock_nv, normalize(cross(vec3(0.0, 1.0, 0.0), lock_nv) + vec3(1e-5, 0.0, 0.0)));
     float lock_flow = smoothstep(0.6, 0.85, abs(dot(lock_meridian, along_rest)));
-    float lock = lock_flow > 0.999 ? flow_locks(v_rest)
-               : mix(mix(0.5, smeared_noise(lock_p + 19.0, 1.6 * along_rest),
-                         clamp(2.5 - 1.6 * length(fwidth(lock_p)), 0.0, 1.0)),
-                     flow_locks(v_rest), lock_flow);
+    vec3 flow_lock_p = flow_lock_coordinate(v_rest);
+    float smear_fade = clamp(2.5 - 1.6 * length(fwidth(lock_p)), 0.0, 1.0);
+    float flow_fade = clamp(2.5 - 1.6 * length(fwidth(flow_lock_p)), 0.0, 1.0);
+    float lock = 0.5;
+    if (lock_flow < 0.999)
+        lock = mix(0.5, smeared_noise(lock_p + 19.0, 1.6 * along_rest), smear_fade);
+    if (lock_flow > 0.001)
+        lock = mix(lock, mix(0.5, lattice_noise3(flow_lock_p + 19.0), flow_fade), lock_flow);
     // (long hair's crown, combed flat sideways from the parting, shows shallower gaps than its
     // hanging lengths: at full depth there its locks drew bands across the crown)
     lock = clamp(0.5 + mix(1.6, 0.8, on_head * u_along_v) * (lock - 0.5), 0.0, 1.0);
@@ -837,7 +843,7 @@ void main() {
                       * mix(mix(0.74, 0.8, light_hair), 1.0, smoothstep(0.02, 0.32, px))
                       * mix(mix(LOCK_GAP_DARK, LOCK_GAP_LIGHT, light_hair), 1.0, smoothstep(0.15, 0.6, lock))
     // and the parting between two locks running down the flow is a narrow dark crevice
-                      * (1.0 - lock_flow * lock_gap(lock) * mix(0.6, 0.4, light_hair));
+                      * (1.0 - smoothstep(0.7, 1.0, lock_flow) * lock_gap(lock) * mix(0.6, 0.4, light_hair));
     float jitter = 0.22 * (tex.r - 0.5) + 0.12 * (fine - 0.5) + 0.18 * (mid - 0.5) + 0.1 * (clump - 0.5)
                  + 0.25 * (px - 0.5);
     // Key light: strand diffuse blended with a squared half-Lambert, which keeps the volume
@@ -881,7 +887,7 @@ void main() {
     // each card's edge, and at full strength they cut the band into the cards' shapes.)
     float strands = mix(0.55, 1.0, smoothstep(0.25, 0.7, fine) * smoothstep(0.2, 0.7, mid))
                   * mix(0.45, 1.0, smoothstep(0.3, 0.65, tex.r)) * mix(0.7, 1.0, clump) * smoothstep(0.3, 0.75, px) * 1.4
-                  * mix(0.4, 1.6, lock) * (1.0 - 0.7 * lock_flow * lock_gap(lock));   // the locks' crowns catch the light, their gaps little
+                  * mix(0.4, 1.6, lock) * (1.0 - 0.7 * smoothstep(0.7, 1.0, lock_flow) * lock_gap(lock));   // the locks' crowns catch the light, their gaps little
     float sparkle = smoothstep(0.45, 0.75, fine) * smoothstep(0.4, 0.7, mid) * smoothstep(0.4, 0.75, px);
     vec3 tint = mix(vec3(1.0), u_color / max(max(u_color.r, u_color.g), max(u_color.b, 1e-4)), 0.5);
     // Light hair's own diffuse is bright already: a full-strength white lobe on it reads as
