@@ -298,7 +298,9 @@ def test_wrinkle_darkens_the_skin(renderer, scene):
     wrinkle[head] = np.clip((pos[head, 1] - 15.3) * 4, 0, 1)  # the upper face, a gradient
     creased = renderer.render(pos, appearance=app, camera=cam, wrinkle=wrinkle).astype(int)
     upper = slice(10, 40)
-    assert creased[upper, 30:66, :3].sum() < 0.95 * plain[upper, 30:66, :3].sum()
+    # (Session 25: the folds are relief, lit on one flank and shaded in their valleys, and no
+    # longer a stain over the whole compressed skin: 4.4 % darker here, not 5 % and more.)
+    assert creased[upper, 30:66, :3].sum() < 0.98 * plain[upper, 30:66, :3].sum()
     lower = slice(70, 85)
     assert np.abs(creased[lower, 35:60] - plain[lower, 35:60]).max() <= 2
 

@@ -312,10 +312,14 @@ def test_creases_of_an_au_at_c_show_most_of_what_they_show_at_e(face_of, head, a
     At E the folds keep deepening without setting into uniformly cut grooves. (Session 24 softened
     9's nose, "rubbery / too deep / too sharp" to a blind reviewer: a lower lift of the nostril
     wings and the upper lip and gentler folds. At C the sides darken 3.5 of E's 6.4 levels, 0.549
-    (bound 0.55 -> 0.54), the root 2.7 of 4.9 (floor 3.0 -> 2.5 there).)"""
+    (bound 0.55 -> 0.54), the root 2.7 of 4.9 (floor 3.0 -> 2.5 there).) (Session 25: the creases
+    are relief, light and shade, and the compressed skin is no longer stained dark as a whole; the
+    root's 2.9 levels at C were all stain (its mean darkening equalled its mean change), the
+    furrows' phase there runs half a furrow across the patch: the root now darkens 1.1 levels at C,
+    1.0 at E (floor 2.5 -> 0.8 there); the sides 4.0 of 6.6, the glabella 3.6 of 6.0.)"""
     face = face_of("ava")
     at_c, at_e = (crease_darkening(face, head, f"{au}{level}", place) for level in "CE")
-    assert at_c > (2.5 if place == "nose_root" else 3.0), (at_c, at_e)
+    assert at_c > (0.8 if place == "nose_root" else 3.0), (at_c, at_e)
     assert at_c > 0.54 * at_e, (at_c, at_e)
 
 
@@ -582,11 +586,15 @@ def test_a_mesh_crease_is_a_shade_not_a_red_line(face_of, head, name):
     streak in 4+9). Over a ~2.5-cm patch at 1024 px: the pixels in shade (6 L* under the patch's
     median) carry at most 2 C* more than it (until session 22 +4.5 on ava, +4.3 on george; now
     -0.2 and +0.2), and no pixel stands out in chroma far beyond the skin's own mottle (the 99th
-    percentile: +19.8 and +20.3 over the median; now +7.0 and +9.9)."""
+    percentile: +19.8 and +20.3 over the median; now +7.0 and +9.9). (Session 25: the engine's
+    furrows no longer stain the compressed skin dark as a whole, which put many neutral grey pixels
+    among the shaded ones, and left the upper lids' pink skin at the patch's lower corners darker and
+    greyer: now +2.2 on ava (bound 2.0 -> 2.5), and the 99th percentile, those lids' pixels and no
+    furrow's, +14.3 (bound 12 -> 15.5; a red stroke drew +20).)"""
     shade, excess, top = _crease_colour(face_of(name), head, "4E+9E", CREASE_PLACES["glabella"], (40, 40))
     assert shade > 0.05                   # the fold is there ...
-    assert excess < 2.0, excess           # ... as shade,
-    assert top < 12.0, top                # not as a red line
+    assert excess < 2.5, excess           # ... as shade,
+    assert top < 15.5, top                # not as a red line
 
 
 @pytest.mark.parametrize("name", ["mei", "george"])

@@ -78,6 +78,8 @@ const float FOLD_TEXELS = 3.0;   // a groove's half-width in fold-map texels (~0
 const float FOLD_RELIEF = 1.6;   // height of the grooves and their rolls, of the map's groove depth
 const vec2 CREVICE_SHADE = vec2(0.12, 0.05);   // shade at the floor: lines (R), under-eye lines (G)
 const float GROOVE_SCATTER = 0.5;   // share of the grooves' slope the scattered light sees
+const float FOLD_ASPECT = 0.5;   // the engine's furrows: roll height over spacing at FOLD_SPACING_REF (see main)
+const float FOLD_SPACING_REF = 0.07;   // dm: the glabella's furrows
 const float FURROW_SCATTER = 0.8;   // and of the engine's furrows' (rolls ~9 mm across: CREASES_PER_DM)
 uniform sampler2D u_folds;   // R forehead lines + crow's feet, G under-eye lines, B fold shade,
                              // A where R and G replace the engine's furrows (facsim.head.skin)
@@ -288,27 +290,36 @@ vec2 skin_specular(vec3 n, vec3 l, vec3 v, float ndv, vec2 roughness) {
 }
 
 #ifdef USE_WRINKLE
-// Creases as folds of skin, not painted lines (issue 13: "stamped/carved"): compressed skin
-// buckles into rounded rolls with a narrow crevice between them. One crevice at each whole
-// number of the crease phase (v_crease, in furrow spacings; slightly wavy). The fold is a
-// height profile across the furrows: a broad roll (the bulge between two furrows) minus a
-// narrow crevice. Its slope (Fold.slope) tilts the shading normal in main(), so the key
-// light catches one flank of each roll and leaves the other in soft shade, as on real skin; only the bottom of the crevice darkens (light cannot reach it).
-// Each line has its own depth, and the depth varies along it (lines fade out, break and
-// restart); all of it grows with the wrinkle amount, so lines fade at their ends.
+// Creases as folds of skin, not painted lines (issue 13: "stamped/carved", "painted cheek
+// wrinkles"): compressed skin buckles into rounded rolls with a soft valley between them. One
+// valley at each whole number of the crease phase (v_crease, in furrow spacings), the phase bent
+// by noise so the lines are not evenly spaced. The fold is a height profile across the furrows,
+// its slope (Fold.slope) tilting the shading normal in main(): the light catches one flank and
+// leaves the other in shade, so a fold's light and dark depend on where the light comes from;
+// only the valley's floor darkens by itself (Fold.valley: less of the room reaches it).
+// The lines are irregular: each has its own depth and length (a per-line share of a slow noise
+// along it: some run long, some are short dashes, some hardly show), fine branch lines split
+// off between them here and there, and every person's lines fall elsewhere (skin_uv). (Until
+// session 25 every line was at least half as deep as the deepest and ran nearly the whole
+// field: a smiling cheek drew four even parallel strokes, "painted cheek wrinkles".)
 struct Fold {
-    float slope;     // dH/ds: height change per furrow spacing (dm)
-    float crevice;   // 0..1 how deep in a crevice the point lies (occlusion)
+    float slope;     // dH/ds: height change per furrow spacing, in furrow spacings (main() scales it)
+    float valley;    // 0..1 how deep in a valley the point lies (occlusion)
     float s;         // the wavy phase (for its screen derivatives)
+    float fold_amount;   // 0..1 how far the skin has folded
 };
 Fold crease_fold(float wrinkle, float phase, vec2 uv) {
-    float s = phase + 0.3 * value_noise(uv * vec2(40.0, 25.0), 0);
+    float s = phase + 0.3 * value_noise(uv * vec2(40.0, 25.0), 0) + 0.35 * value_noise(uv * vec2(11.0, 8.0) + 17.0, 0);
     float line = floor(s + 0.5);
-    float t = s - line;                                       // -0.5 .. 0.5, crevice at 0
+    float t = s - line;                                       // -0.5 .. 0.5, valley at 0
     float aa = fwidth(s);
-    // Depth along the line: per-line (hash) times a slow variation along it.
-    float along = value_noise(uv * vec2(22.0, 44.0) + 9.0 * hash2(ivec2(int(line), 3)), 0);
-    float depth = (0.5 + 0.5 * hash2(ivec2(int(line), 11))) * smoothstep(0.1, 0.55, along);
+    int id = int(line) + int(7.0 * u_skin_seed);
+    // Depth along the line: per line (hash) times a slow variation along it, which the line shows
+    // in full only above its own threshold (its length) and at a quarter below it (a faint trace).
+    float along = 0.7 * value_noise(uv * vec2(22.0, 44.0) + 9.0 * hash2(ivec2(id, 3)), 0)
+                + 0.3 * value_noise(uv * vec2(55.0, 110.0) + 5.0 * hash2(ivec2(id, 5)), 0);
+    float cut = mix(0.15, 0.5, hash2(ivec2(id, 13)));
+    float depth = (0.45 + 0.55 * hash2(ivec2(id, 11))) * mix(0.25, 1.0, smoothstep(cut, cut + 0.3, along));
     // How far the skin has folded: from the engine's buckling threshold on (the wrinkle field is 0
     // below it), growing fastest at first (a buckled sheet's fold amplitude grows as the square
     // root of its extra compression) and levelling off (the folds close on themselves) - so an AU
@@ -317,23 +328,21 @@ Fold crease_fold(float wrinkle, float phase, vec2 uv) {
     // were full at 0.8: 9's nose lines, 0.13 at C, did not show at all.) Older skin creases
     // sooner (less elastic): the same compression shows more lines.
     float amount = (1.0 - exp(-wrinkle / (0.3 - 0.1 * u_age))) * smoothstep(0.0, 0.08, wrinkle);
-    // The crevice is widened where it would be finer than a pixel, keeping its area (a
-    // pre-filter: no aliasing, no shimmer as the face moves); the roll fades to flat when
-    // the furrows themselves are finer than a few pixels.
-    const float W = 0.12;
-    float w = max(W, 0.8 * aa);
-    float g = exp(-(t * t) / (w * w));
+    // The roll fades to flat where the furrows are finer than a few pixels (a pre-filter).
     float roll = clamp(2.0 - 4.0 * aa, 0.0, 1.0);
+    // H(t) = -0.5 cos(2 pi t): the valley at t = 0, the rolls' crests half a spacing away.
+    float dh_dt = PI * sin(2.0 * PI * t);
+    // A fine branch line here and there on a roll's crest (t = +-0.5), where a second noise peaks.
+    float tb = s - floor(s) - 0.5;
+    float branch = smoothstep(0.62, 0.82, value_noise(uv * vec2(30.0, 60.0) + 13.0 * hash2(ivec2(id, 17)), 0));
+    const float B = 0.07;
+    float wb = max(B, 0.8 * aa);
+    float dbranch = branch * 0.6 * (B / wb) * 2.0 * tb / (wb * wb) * exp(-(tb * tb) / (wb * wb));
     Fold f;
-    // H(t) = A (-0.5 cos 2 pi t) - C exp(-t^2 / w^2): rolls 2 mm high, crevices up to 0.6 mm
-    // deep and 0.12 of a furrow spacing wide. The crevice is where the rolls' flanks meet: it
-    // opens only once the skin has folded (amount squared), so a slight fold is a soft roll and a
-    // deep one a roll with a seam. (Until session 17: 2.6 mm rolls, 0.9 mm crevices 0.085 wide, at
-    // full depth as soon as the skin buckled - 4's folds at E looked like creased paper, "carved".)
-    float seam = amount * amount;
-    f.slope = depth * (amount * roll * 0.02 * PI * sin(2.0 * PI * t) + seam * 0.006 * (W / w) * 2.0 * t / (w * w) * g);
-    f.crevice = seam * depth * (W / w) * exp(-(t * t) / (2.2 * w * w));
+    f.slope = amount * roll * (depth * dh_dt + 0.12 * dbranch);
+    f.valley = amount * depth * exp(-(t * t) / (2.0 * 0.12 * 0.12));
     f.s = s;
+    f.fold_amount = amount;
     return f;
 }
 #endif
@@ -945,11 +954,26 @@ void main() {
     n = normalize(abs(det) * n - groove_grad);
 #ifdef USE_WRINKLE
     // The engine's furrows, except where the fold map draws the lines itself (folds.a).
-    Fold fold = crease_fold(v_wrinkle * (1.0 - folds.a) * (1.0 - mucosa), v_crease, v_uv);
-    // Compressed skin is a little darker overall (blood pushed together, less light between
-    // the rolls), and the crevices' bottoms darker still.
-    cavity *= (1.0 - u_wrinkle_darken * clamp(v_wrinkle, 0.0, 1.0)) * (1.0 - 0.5 * fold.crevice);
-    vec3 fold_grad = sign(det) * fold.slope * (dFdx(fold.s) * r1 + dFdy(fold.s) * r2);
+    Fold fold = crease_fold(v_wrinkle * (1.0 - folds.a) * (1.0 - mucosa), v_crease, skin_uv);
+    // Less of the room reaches a valley's floor (and blood is pushed together there): the shade
+    // lies in the valleys, not over the whole compressed patch like a stain.
+    // (Where the fold map draws the lines (folds.a), its grooves (R) are the valleys.)
+    float valley = mix(fold.valley, folds.r, folds.a);
+    cavity *= 1.0 - u_wrinkle_darken * clamp(v_wrinkle, 0.0, 1.0) * (0.25 + 1.6 * valley);
+    // A deep fold's valley closes into a narrow shadowed floor (the old crevice, softer and only
+    // where the skin has folded far).
+    cavity *= 1.0 - 0.25 * fold.fold_amount * fold.valley;
+    // The fold's height over its spacing grows with the spacing: fine lines (the crow's feet's
+    // 5 mm, the nose's 4.5 mm) are shallow, the glabella's and the forehead's broad furrows deep.
+    // At a fixed height (until session 25) the finer the lines the steeper and darker they drew:
+    // the nose's sides "sculpted", the cheeks' lines "painted". (fold_dir: the phase's surface
+    // gradient, of length |det| / spacing.)
+    // (Where the phase turns back, its gradient vanishes and the spacing it implies is unbounded:
+    // capped, the slope fades out there instead of flipping in a hard seam.)
+    vec3 fold_dir = dFdx(fold.s) * r1 + dFdy(fold.s) * r2;
+    float relative = min(abs(det) / max(length(fold_dir), 1e-12) / FOLD_SPACING_REF, 1.0);
+    float aspect = FOLD_ASPECT * max(relative, 0.5);
+    vec3 fold_grad = sign(det) * aspect * fold.slope * FOLD_SPACING_REF * relative * fold_dir;
     n = normalize(abs(det) * n - fold_grad);
 #endif
 #ifdef USE_PORES
@@ -1142,8 +1166,8 @@ void main() {
                     + hemisphere(n_smooth);
     spec += PEACH_FUZZ * graze * graze * fuzz_light * mix(vec3(1.0), albedo, 0.5) * (1.0 - lips) * (1.0 - hair);
 #ifdef USE_WRINKLE
-    // Light reaching a crevice's floor has passed through the skin around it: redder.
-    vec3 crevice_tint = mix(vec3(1.0), vec3(1.0, 0.94, 0.92), fold.crevice * scatter);
+    // Light reaching a valley's floor has passed through the skin around it: a little redder.
+    vec3 crevice_tint = mix(vec3(1.0), vec3(1.0, 0.94, 0.92), 0.4 * fold.fold_amount * fold.fold_amount * fold.valley * scatter);
 #else
     vec3 crevice_tint = vec3(1.0);
 #endif
