@@ -50,6 +50,9 @@ SETTLED_ITERATIONS = 200
 STATIC_RESIDUAL = 0.02
 #: A static solve takes one more increment per this many degrees of jaw opening.
 JAW_DEGREES_PER_STEP = 10.0
+#: A static solve's preconditioner is the tangent stiffness, factorised afresh every this many
+#: iterations (solver.tangent_solvers); the animation path keeps the rest stiffness's factors.
+TANGENT_REFRESH = 30
 #: At most this many extra rounds of iterations for a static solve that ends with folded skin.
 POLISH_ROUNDS = 5
 #: Expressions solved together by :meth:`MuscleEngine.solve_many`.
@@ -330,12 +333,13 @@ def solve_static(model, target, *, steps: int, iterations: int) -> solver.State:
     """An expression from rest in ``steps`` increments; where the skin is still folded through
     itself at the end (a big change not yet relaxed), keep relaxing, a few rounds at most."""
     state = solver.solve(model, solver.rest_state(model, target.muscle.shape[0]), target, steps=steps,
-                         iterations=iterations, residual=STATIC_RESIDUAL)
+                         iterations=iterations, residual=STATIC_RESIDUAL, refresh=TANGENT_REFRESH)
     for _ in range(POLISH_ROUNDS):
         folded = solver.folded(model, state.x) > 0
         if not folded.any():
             break
-        more = solver.solve(model, state, target, steps=1, iterations=iterations, residual=STATIC_RESIDUAL)
+        more = solver.solve(model, state, target, steps=1, iterations=iterations, residual=STATIC_RESIDUAL,
+                            refresh=TANGENT_REFRESH)
         # Only the folded ones take the extra round (so a batch solves each alike to alone).
         state = solver.State(np.where(folded[None, :, None], more.x, state.x), target,
                              np.where(folded[:, None], more.jaw, state.jaw))
