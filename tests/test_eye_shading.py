@@ -230,28 +230,6 @@ def test_the_two_irises_are_not_one_pattern_twice():
         assert best < 0.7, (flip, best)
 
 
-def test_the_catch_light_fades_out_over_its_width_not_a_crisp_box():
-    """A photographed catch-light is the softbox seen in the tear film: a bright middle fading out
-    over its width. Drawn as a flat-topped rounded box with a sharp rim (a 2 x 2-px white square on
-    every pupil at 1024², the reviewer's "crisp box-shaped catch-light", issue 13), amara's at
-    768 px had 3.4 times as many pixels in its fringe (0.15-0.5 of the way from the cornea's
-    median to the peak) as in its core (over 0.5); now 4.6."""
-    from scipy import ndimage
-
-    size = 768
-    amara = preset("amara").with_(symmetric=True)
-    with Face(amara) as face:
-        image = face.render("", size=size, antialias=1, background=(1.0, 1.0, 1.0))[..., :3].astype(int)
-    with Face(amara.with_(colors={**amara.colors, "iris": "#ff0000", "pupil": "#ff0000"})) as face:
-        marked = face.render("", size=size, antialias=1, background=(1.0, 1.0, 1.0))[..., :3].astype(int)
-    cornea = ndimage.binary_fill_holes(np.abs(marked - image).sum(-1) > 60)
-    cornea[:, size // 2:] = False   # one eye
-    lum = _luminance(image[cornea])
-    level = (lum - np.median(lum)) / (lum.max() - np.median(lum))
-    core, fringe = (level >= 0.5).sum(), ((level > 0.15) & (level < 0.5)).sum()
-    assert core >= 4 and fringe > 4 * core, (core, fringe)
-
-
 def test_the_rim_of_a_raised_upper_lid_is_skin_not_a_teal_band():
     """Where 5 raises the upper lid (fear, 1+2+4+5+20+26) its rim over the eyeball faces the key
     while the normal averaged over a centimetre runs down into the socket; red light, which sees
@@ -272,3 +250,41 @@ def test_the_rim_of_a_raised_upper_lid_is_skin_not_a_teal_band():
     near = ndimage.binary_dilation(eye, iterations=8) & ~eye
     teal = near & (image[..., 1] > image[..., 0] + 2) & (image.sum(-1) > 200)
     assert teal.sum() < 10, teal.sum()
+
+
+@pytest.mark.parametrize("name", ["liam", "kwame"])
+def test_the_white_that_5_bares_above_the_iris_lies_in_the_lids_shade(name):
+    """In photographs of surprise the white above the iris lies under the raised lid's shadow and
+    its lashes', darker than the white beside the iris. Lit to 0.85-0.88 of that white (liam's and
+    kwame's surprise, 1+2+5+26, at 512 px), the eye read as a lit ball in a ring of white: the
+    reviewer's "bulging glassy eyes" (issue 13, session 24). The two eyes' mean was 0.85 (liam)
+    and 0.88 (kwame) on 67a54cb; now 0.74 and 0.76."""
+    from scipy import ndimage
+
+    size = 512
+    character = preset(name).with_(symmetric=True)
+    renders = []
+    for colours in ({}, {"iris": "#ff0000", "pupil": "#ff0000"}, {"sclera": "#00ff00"}):
+        with Face(character.with_(colors={**character.colors, **colours})) as face:
+            renders.append(face.render("1+2+5+26", size=size, antialias=1,
+                                       background=(1.0, 1.0, 1.0))[..., :3].astype(int))
+    image = renders[0]
+    iris = np.abs(renders[1] - image).sum(-1) > 60
+    sclera = (np.abs(renders[2] - image).sum(-1) > 60) & ~iris
+    lum = _luminance(image)
+    eyes, count = ndimage.label(ndimage.binary_dilation(iris, iterations=2))
+    ratios = []
+    for k in range(1, count + 1):
+        ys, xs = np.nonzero(iris & (eyes == k))
+        if len(ys) < 20:
+            continue
+        side = np.zeros_like(sclera)
+        side[:, : size // 2] = xs.mean() < size / 2
+        side[:, size // 2:] = xs.mean() >= size / 2
+        above = sclera & side
+        above[ys.min():] = False
+        above[:, : xs.min()] = above[:, xs.max() + 1:] = False
+        beside = sclera & side & (np.abs(np.arange(size) - ys.mean())[:, None] < 3)
+        assert above.sum() >= 5 and beside.sum() > 0
+        ratios.append(lum[above].mean() / lum[beside].mean())
+    assert len(ratios) == 2 and np.mean(ratios) < 0.775, ratios

@@ -414,9 +414,7 @@ const float IRIS_CAUSTIC = 0.3;    // how much brighter the iris's lower rim is 
 // (At 0.17 x 0.14, an even plate of ~1.1 mm² with a crisp edge, it still sat on the iris like a
 // sticker: now a ~30-cm box at 1.2 m, ~0.5 mm² on the cornea, brightest in its middle, its rim
 // fading out.)
-// (Session 25: its half-size, 0.1 x 0.085 as a box, is 1.5 times that as soft_catch_light's oval,
-// whose falloff starts at its middle.)
-const vec2 CATCH_LIGHT = vec2(0.15, 0.12);
+const vec2 SOFTBOX = vec2(0.1, 0.085);
 // The key softbox is tall: the cornea mirrors its lower part, near the eyes' level, rather
 // than the key's middle ~30 degrees up, whose reflection lies under the upper lid. (At ~16
 // degrees up it still lay under the relaxed lids of most presets: george, kwame, liam and noah
@@ -428,23 +426,6 @@ const float KEY_REFLECTION = 1.6;   // (0.65 for a box 2.8 times the area: the s
 // a lowered lid hides the key's, as in photographs).
 const vec2 FILL_BOX = vec2(0.2, 0.3);
 const float FILL_REFLECTION = 0.15;
-// The key's catch-light as a photograph shows it: a soft oval of light on the tear film,
-// brightest in its middle and fading out over its whole width (a Gaussian). Half-size `size`
-// (radians) about the light direction `l`, seen along the reflected ray `refl`: it follows the
-// cornea's curve. (softbox() below, a rounded rectangle with a flat top and a sharp rim, drew
-// the key at 1024² as a 2 x 2-px white square on every pupil: the reviewer's box-shaped sticker
-// of a doll's eye, issue 13. A wider faint glow round it, at the cornea's grazing Fresnel gain,
-// lit a second bright speck at amara's lower limbus.)
-float soft_catch_light(vec3 refl, vec3 l, vec2 size) {
-    vec3 bu = normalize(cross(l, vec3(0.0, 1.0, 0.0)));
-    vec3 bv = cross(bu, l);
-    vec2 q = vec2(dot(refl, bu), dot(refl, bv)) / size;
-    // (Widened by a pixel where the oval is smaller than that, so small images keep a
-    // catch-light instead of missing it between pixel centres.)
-    float px = max(fwidth(q.x), fwidth(q.y));
-    float d2 = dot(q, q) / (1.0 + px * px);
-    return exp(-2.2 * d2) * step(0.0, dot(refl, l));
-}
 // Coverage of a soft-edged rounded rectangle of half-size `size` (radians) centred on the
 // light direction `l`, seen along the reflected ray `refl` (for catch-lights).
 float softbox(vec3 refl, vec3 l, vec2 size) {
@@ -466,16 +447,20 @@ const vec3 WET_RIM_COLOR = vec3(0.5, 0.25, 0.23);   // moist lid tissue (linear)
 const float WET_RIM_SHEEN = 0.3;   // its film's reflection of the room
 const float TEAR_WIDTH = 0.7;
 const float TEAR_SHINE = 0.15;
-const vec2 UPPER_SHADOW = vec2(0.6, 2.5);
+const vec2 UPPER_SHADOW = vec2(0.65, 3.0);
 // The lids' broader shade on the eyeball, as ambient occlusion (depth at the margin, reach in
 // degrees: ~0.28 mm each on hm08); the lower lid's is lighter and shorter.
 const vec2 UPPER_LID_SHADE = vec2(0.6, 8.0);
-const vec2 LOWER_LID_SHADE = vec2(0.2, 3.0);
+const vec2 LOWER_LID_SHADE = vec2(0.3, 4.0);
 // The upper lid's soft cast shadow from the key above (depth at the margin, reach in degrees),
 // on the eyeball's diffuse light only: an evenly lit eyeball to the lid's edge read as glass
 // (0.3 deep left the iris's top as bright as its middle: still glassy).
 // (The cornea's reflection of the key is the key seen past the lid: not shaded by it.)
-const vec2 UPPER_LID_CAST = vec2(0.45, 8.0);
+// (At 0.45 over 8 degrees, with the lashes' shadow at 0.6 over 2.5 and the lower lid's shade at
+// 0.2 over 3, the white that 5 bares above the iris in surprise was lit to 0.81-0.94 of the white
+// beside the iris on liam and kwame (eyes_mouth_figures.py --aperture): an evenly lit ball in a
+// ring of white, the reviewer's "bulging glassy eyes", issue 13; now 0.69-0.82.)
+const vec2 UPPER_LID_CAST = vec2(0.55, 12.0);
 #endif
 
 #ifdef REGION_EYEBALL
@@ -1346,7 +1331,7 @@ void main() {
     float ndv = max(dot(nc, v), 0.0);
     float fres = schlick(0.025, ndv) / 0.025;
     vec3 room = mix(u_ground_col, u_sky_col, 0.5 + 0.5 * refl.y) * ROOM_REFLECTION;
-    vec3 boxes = soft_catch_light(refl, normalize(u_key_dir - vec3(0.0, SOFTBOX_DROP, 0.0)), CATCH_LIGHT) * u_key_col
+    vec3 boxes = softbox(refl, normalize(u_key_dir - vec3(0.0, SOFTBOX_DROP, 0.0)), SOFTBOX) * u_key_col
                + softbox(refl, u_fill_dir, FILL_BOX) * u_fill_col * FILL_REFLECTION;
     vec3 spec = (boxes * KEY_REFLECTION + room) * fres * mix(0.45, 1.0, cornea);
     // The sclera and the lid's wet rim are wet too but less smooth (a broad sheen), and the
