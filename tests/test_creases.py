@@ -64,7 +64,7 @@ def test_a_frowns_furrows_are_light_and_shade_not_a_dark_stain(face_of, head):
     creases change the skin's light and shade more than they darken it overall. (Until session 25
     the compressed skin was darkened as a whole, 15 % at full compression, and the valleys cut in
     dark: on ava at 4E the patch darkened by 12 levels of luma, more than 0.6 of the creases'
-    spread of 20; now about 4 of 11.)"""
+    spread of 20; now 5 of 14.)"""
     face = face_of("ava")
     difference, positions, camera = _crease_difference(face, "4E", face.appearance)
     patch = difference[_box_around(head, positions, camera, GLABELLA)]

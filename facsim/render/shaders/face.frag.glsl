@@ -942,9 +942,9 @@ void main() {
     Fold fold = crease_fold(v_wrinkle * (1.0 - folds.a) * (1.0 - mucosa), v_crease, skin_uv);
     // Less of the room reaches a valley's floor (and blood is pushed together there): the shade
     // lies in the valleys, not over the whole compressed patch like a stain.
-    // (Where the fold map draws the lines (folds.a), its grooves (R) are the valleys.)
-    float valley = mix(fold.valley, folds.r, folds.a);
-    cavity *= 1.0 - u_wrinkle_darken * clamp(v_wrinkle, 0.0, 1.0) * (0.25 + 1.6 * valley);
+    // (Where the fold map draws the lines (folds.a) they deepen with the compression as relief,
+    // line_depth above, and its crevices' floors shade themselves.)
+    cavity *= 1.0 - u_wrinkle_darken * clamp(v_wrinkle, 0.0, 1.0) * (0.35 + 1.6 * fold.valley);
     // A deep fold's valley closes into a narrow shadowed floor (the old crevice, softer and only
     // where the skin has folded far).
     cavity *= 1.0 - 0.25 * fold.fold_amount * fold.valley;
