@@ -69,10 +69,12 @@ class Lighting:
     # stood 51 degrees to the side and lit the right side's outline as brightly as the cheek); a
     # faint rim from behind; a bright room lit from above, its floor returning little (until
     # session 25 half the ceiling's light: the undersides of the brows, nose and jaw were lit
-    # nearly as the tops, one more way the face read "flat" to the blind reviewer). (The key's
-    # height is bounded by the skin's sheen: at 40 degrees its reflection lay across the
-    # forehead as a glaze, tests/test_skin.py.)
-    key_direction: tuple[float, float, float] = (-0.42, 0.55, 0.78)
+    # nearly as the tops, one more way the face read "flat" to the blind reviewer). The key
+    # stands 38 degrees above the lens axis (32 until session 25: the brows, nose, lips and chin
+    # barely shaded their undersides, "flat lighting"); a point source that high laid its
+    # reflection across the forehead as a glaze, a softbox's spreads it broad and dim
+    # (KEY_SOFTBOX_HALF_ANGLE in face.frag.glsl; tests/test_skin.py).
+    key_direction: tuple[float, float, float] = (-0.42, 0.70, 0.78)
     key_color: tuple[float, float, float] = (1.27, 1.21, 1.13)
     fill_direction: tuple[float, float, float] = (0.6, 0.0, 0.8)
     fill_color: tuple[float, float, float] = (0.23, 0.225, 0.23)

@@ -289,6 +289,19 @@ vec2 skin_specular(vec3 n, vec3 l, vec3 v, float ndv, vec2 roughness) {
     return distribution * visibility * (schlick(SKIN_F0, max(dot(v, h), 0.0)) * ndl);
 }
 
+// The key is a softbox about a metre across some 1.5 m away (half-angle ~0.3 rad), not a
+// point: each point of skin reflects the whole box, so the key's highlight is the lobe spread
+// by the box's size, broader and dimmer at its peak with the same light in all. (Lit by a point,
+// an oily T-zone showed a small source's hot spot: a key at 40 degrees laid a white glaze on
+// kwame's forehead, tests/test_skin.py.) The half-vector moves half as far as the light, so the
+// box widens the GGX slope spread (alpha) by about half its half-angle, in quadrature (the
+// spreads of two blurs add so); the wide, dry lobes hardly change, the oil film's tight one most.
+const float KEY_SOFTBOX_HALF_ANGLE = 0.3;
+vec2 softbox_roughness(vec2 roughness, float half_angle) {
+    vec2 alpha = roughness * roughness;
+    return sqrt(sqrt(alpha * alpha + 0.25 * half_angle * half_angle));
+}
+
 #ifdef USE_WRINKLE
 // Creases as folds of skin, not painted lines (issue 13: "stamped/carved", "painted cheek
 // wrinkles"): compressed skin buckles into rounded rolls with a soft valley between them. One
@@ -420,7 +433,9 @@ const vec2 SOFTBOX = vec2(0.1, 0.085);
 // degrees up it still lay under the relaxed lids of most presets: george, kwame, liam and noah
 // showed no catch-light at 448², dead eyes; now about level with the eyes, as with the flash of
 // stimulus photographs.)
-const float SOFTBOX_DROP = 0.55;
+// (0.55 until session 25, when the key rose from ~32 to 38 degrees: the box's lower part, which
+// the cornea mirrors, stays at the eyes' level; the catch-light's direction is unchanged.)
+const float SOFTBOX_DROP = 0.64;
 const float KEY_REFLECTION = 1.6;   // (0.65 for a box 2.8 times the area: the same light from a smaller box is brighter)
 // The fill is a broad bounce card to the side: a larger, dimmer reflection (it shows where
 // a lowered lid hides the key's, as in photographs).
@@ -1128,7 +1143,10 @@ void main() {
     SkinLobes lobes = skin_lobes(oil, film, lips, wet, blotch, patches);
     vec2 weight = lobes.weight;
     vec2 roughness = lobes.roughness;
-    vec3 spec = dot(skin_specular(sheen_n, u_key_dir, v, ndv, roughness), weight) * u_key_col * key_shadow
+    // The key's lobes spread by its softbox's size (softbox_roughness), except on the wet lips: their
+    // film's beads and furrows curve within a millimetre or two and mirror the box as small glints.
+    vec2 key_roughness = mix(softbox_roughness(roughness, KEY_SOFTBOX_HALF_ANGLE), roughness, max(lips, min(2.0 * wet, 1.0)));
+    vec3 spec = dot(skin_specular(sheen_n, u_key_dir, v, ndv, key_roughness), weight) * u_key_col * key_shadow
               + dot(skin_specular(sheen_n, u_rim_dir, v, ndv, roughness), weight) * u_rim_col;
     // (Times pi: the diffuse term here is albedo times N.L, without the Lambert 1/pi.)
     spec *= PI * (1.0 - hair) * (0.85 + 0.3 * grain) * spec_break
