@@ -192,27 +192,15 @@ class Face:
             density[self.scalp.binding.ref[:, 0]] = self.scalp.shade
         return density
 
-    def proxy_draws(self, positions: np.ndarray, proxy_positions: list | None = None) -> list:
-        """This frame's :class:`facsim.render.proxies.ProxyDraw` s for geometry ``positions``
-        (``proxy_positions``: each drawn proxy's vertices on them, when already found)."""
+    def proxy_draws(self, positions: np.ndarray) -> list:
+        """This frame's :class:`facsim.render.proxies.ProxyDraw` s for geometry ``positions``."""
         from facsim.render.proxies import ProxyDraw
 
         pigment, white, grey = self._hair_greying
-        if proxy_positions is None:
-            proxy_positions = [self._proxy_positions(bound, positions) for bound in self._drawn_proxies]
-        return [ProxyDraw(mesh, vertices, tuple(self.colors[bound.color_key]), bound.sheen,
+        return [ProxyDraw(mesh, self._proxy_positions(bound, positions), tuple(self.colors[bound.color_key]), bound.sheen,
                           bound.density, bound.coil,
                           *((pigment, white, grey) if bound.color_key == "hair" else (None, None, 0.0)))
-                for bound, mesh, vertices in zip(self._drawn_proxies, self.proxy_meshes, proxy_positions)]
-
-    def frame_inputs(self, positions: np.ndarray) -> tuple:
-        """(occlusion, lids, proxy positions) for geometry ``positions``: the renderer's per-frame
-        inputs that depend on the positions alone (:meth:`frame_occlusion`, :meth:`frame_lids`,
-        each drawn proxy's vertices). A video's forked engine child computes them ahead of the
-        drawing (:func:`facsim.pipeline.deformations`), so the drawing process does not."""
-        positions = np.asarray(positions, np.float32)
-        return (self.frame_occlusion(positions), self.frame_lids(positions),
-                [self._proxy_positions(bound, positions) for bound in self._drawn_proxies])
+                for bound, mesh in zip(self._drawn_proxies, self.proxy_meshes)]
 
     @cached_property
     def _hair_greying(self) -> tuple:
@@ -510,8 +498,8 @@ class Face:
                              size=options.size)
         positions = np.asarray(deformation.positions, np.float32)
         wrinkle, crease_phase = deformation.wrinkle, deformation.crease_phase
-        occlusion, lids, proxy_positions = deformation.frame_inputs or self.frame_inputs(positions)
-        proxies = self.proxy_draws(positions, proxy_positions)
+        occlusion, lids = self.frame_occlusion(positions), self.frame_lids(positions)
+        proxies = self.proxy_draws(positions)
         rig = self.body_rig(options.body)
         if rig is not None:  # the body's rows after the head's: still skin and cloth, open, no lids
             positions = rig.with_body(positions)

@@ -229,11 +229,7 @@ def deformations(face, frames) -> Iterator[Iterator]:
 
 
 def _deform_frames(face, frames, queue, parent: int) -> None:
-    """The forked child: put each frame's (positions, wrinkle, crease_phase, frame inputs), then
-    None or an error. The frame inputs (:meth:`Face.frame_inputs <facsim.face.Face.frame_inputs>`:
-    occlusion, lids, proxy vertices) depend on the positions alone: found here, ahead, they and
-    the tables they are built from on first use (the occlusion with the hair's shadow, the lids'
-    creases) are off the drawing process's path, and built while it starts its renderer.
+    """The forked child: put each frame's (positions, wrinkle, crease_phase), then None or an error.
 
     Signals get their default actions back: the parent's handlers (the CLI's, which report and
     clean up) are the parent's business, and Ctrl-C in a terminal reaches both processes.
@@ -259,7 +255,7 @@ def _deform_frames(face, frames, queue, parent: int) -> None:
         engine = face.start_animation()
         for act in frames:
             d = engine.step(act)
-            put((d.positions, d.wrinkle, d.crease_phase, face.frame_inputs(d.positions)))
+            put((d.positions, d.wrinkle, d.crease_phase))
         put(None)
     except BaseException as exc:  # noqa: BLE001 — handed to the parent, which raises it
         import pickle
@@ -291,9 +287,8 @@ def _received(queue, count: int, child) -> Iterator:
         if (item is None) != (i == count):
             raise RuntimeError(f"the deformation process sent {i} of {count} frames")
         if item is not None:
-            positions, wrinkle, phase, inputs = item
-            yield Deformation(positions, creases=None if wrinkle is None else (lambda w=wrinkle, p=phase: (w, p)),
-                              frame_inputs=inputs)
+            positions, wrinkle, phase = item
+            yield Deformation(positions, creases=None if wrinkle is None else (lambda w=wrinkle, p=phase: (w, p)))
 
 
 def _speech_audio(timeline, fps):

@@ -157,39 +157,3 @@ def test_a_video_with_repeats_gives_the_frames_drawing_every_frame_gives(tmp_pat
     assert np.array_equal(a[3], a[2]) and np.array_equal(a[4], a[2]) and np.array_equal(a[5], a[1])
     # Drawn again, a repeated frame differs at most by the kept hair's level or two (see the test above).
     assert max(np.abs(x - y).max() for x, y in zip(a, b)) <= 3
-
-
-FORKED_INPUTS = textwrap.dedent("""
-    import numpy as np
-    from facsim.engines.base import Deformation
-    from facsim.face import Face
-    from facsim.pipeline import deformations
-    from facsim.timeline.builders import stimulus_timeline
-    from facsim.timeline.sampling import sample_frames
-
-    face = Face("ava")
-    frames = sample_frames(stimulus_timeline("happiness", 0.2, 0.1, 0.2, 30), 30)
-    with deformations(face, frames) as stream:
-        forked = list(stream)
-    assert all(d.frame_inputs is not None for d in forked), "the child should send each frame's inputs"
-    for d in forked[::4]:
-        occlusion, lids, proxies = d.frame_inputs
-        here = face.frame_inputs(d.positions)
-        assert np.array_equal(occlusion, here[0]) and np.array_equal(lids, here[1])
-        assert len(proxies) == len(here[2]) > 0 and all(np.array_equal(a, b) for a, b in zip(proxies, here[2]))
-    for d in (forked[3], forked[6]):
-        ahead = face.render(deformation=d, size=128, antialias="fxaa")
-        drawn_here = face.render(deformation=Deformation(d.positions, creases=lambda d=d: (d.wrinkle, d.crease_phase)),
-                                 size=128, antialias="fxaa")
-        assert np.array_equal(ahead, drawn_here), "frame inputs from the child must give the same pixels"
-    print("ok")
-""")
-
-
-@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="frames are deformed in a forked child on Linux")
-def test_forked_engine_sends_frame_inputs_that_give_the_same_pixels():
-    # Occlusion, lids and proxy vertices found in the child, ahead of the drawing, are the
-    # parent's own, and the frames drawn with them are the frames drawn without.
-    done = subprocess.run([sys.executable, "-c", FORKED_INPUTS], capture_output=True, text=True, timeout=300)
-    assert done.returncode == 0, done.stderr[-2000:]
-    assert done.stdout.strip().endswith("ok")

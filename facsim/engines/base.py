@@ -40,15 +40,10 @@ class Deformation:
         furrow spacings; the renderer draws furrows at whole numbers). Called
         once, when a renderer or exporter first asks (a solve alone does not
         need them). None: the engine computes no creases.
-    frame_inputs : tuple, optional
-        What :meth:`facsim.face.Face.frame_inputs` gives for these positions, when it was
-        computed ahead of the drawing (the forked child of :func:`facsim.pipeline.deformations`);
-        None: the face computes it when it draws the frame.
     """
 
     positions: np.ndarray
     creases: Callable[[], tuple[np.ndarray, np.ndarray]] | None = field(default=None, repr=False, compare=False)
-    frame_inputs: tuple | None = field(default=None, repr=False, compare=False)
 
     @cached_property
     def _creases(self) -> tuple[np.ndarray | None, np.ndarray | None]:
