@@ -27,8 +27,8 @@ The minimiser is a projected L-BFGS whose initial inverse Hessian is the
 factorised rest stiffness (the projective-dynamics system matrix: arcs,
 attachments and muscles as isotropic springs; Liu, Bouaziz & Kavan 2017). The
 sparse factorisation is computed once per model and reused by every iteration
-of every frame; a static solve re-factorises it every few iterations with the
-stretched arcs at their tangent stiffness (a Newton-like preconditioner). Arrays are laid out ``(xyz, B, points)`` — component-major, so
+of every frame; a solve may instead re-factorise it every few iterations with the
+stretched arcs at their tangent stiffness (``refresh``: a Newton-like preconditioner). Arrays are laid out ``(xyz, B, points)`` — component-major, so
 numpy's inner loops run over the points — and ``B`` configurations are solved
 at once, so many expressions cost little more than one.
 
@@ -55,8 +55,6 @@ FOLD_GUARD = 0.35
 FLOOR_AGE = 4
 #: L-BFGS memory.
 HISTORY = 10
-#: An L-BFGS pair is kept only from a step that moved some point at least this share of ``max_step``.
-MIN_PAIR_STEP = 1e-5
 
 
 # ------------------------------------------------------------------ model ---
@@ -1012,10 +1010,8 @@ def minimise(model: Model, x: np.ndarray, ld: Loads, iterations: int, *, toleran
         # Keep the pair only if the energy curved up along the step at least a little, compared
         # with the rest stiffness (projections onto contacts and kinks can break the secant pair).
         # (Per configuration: a rejected pair gets rho = 0, which makes it a no-op in the recursion.)
-        # Nor from a step of round-off size (a collapsed line search): its curvature is noise, and
-        # its 1/sy (up to 1e18) carried the batch's last-bit differences into whole millimetres.
         shs = _per_config(s, model.stiffness_diagonal * s)
-        keep = (sy > 1e-3 * shs) & (shs > 0) & (np.abs(s).max(axis=(0, 2)) > MIN_PAIR_STEP * model.max_step)
+        keep = (sy > 1e-3 * shs) & (shs > 0)
         if keep.any():
             s_hist.append(s)
             y_hist.append(y)
