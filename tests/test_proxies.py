@@ -378,11 +378,15 @@ def test_straight_hair_shows_depth_between_locks_not_one_flat_sheet(face_of):
     0.241, with locks 0.266; the crown's banding stays under the limit above (0.112 -> 0.124).
     Session 25 lit the hair along the forehead's hairline (a dark brim, whose edges counted as
     detail here: over the whole mask 0.256 -> 0.215), so this is taken on the hair below the top
-    40 % of the image, the lengths beside the face: 0.248 on main 67a54cb, 0.262 now."""
+    40 % of the image, the lengths beside the face: 0.248 on main 67a54cb, 0.262 with the locks
+    along the flow. The same session's studio rig (softer 8-mm penumbra, the fill beside the
+    camera, a darker floor, the key at 38 degrees) takes the figure to 0.160 (67a54cb's hair under
+    that rig: 0.157), so this bound now guards only against the hair going flat under today's light;
+    the locks along the flow are test_hanging_hair_shows_locks_along_its_flow's."""
     with_hair, _, mask = hair_renders(face_of("mei"), 256)
     mask[: int(0.4 * len(mask))] = False
     fine, _ = bench_hair_texture().luminance_variation(with_hair, mask)
-    assert fine > 0.235, fine
+    assert fine > 0.15, fine
 
 
 def _afro_figures(face, size: int = 256) -> dict:
@@ -558,7 +562,8 @@ def test_hanging_hair_shows_locks_along_its_flow(face_of):
     flow_lock_coordinate) with a narrow dark parting between neighbours (lock_gap), instead of blobs two or
     three cells long smeared along each card (a dappled, "textured helmet", blind review session
     24). On ava (long01) at 256², the hair's detail finer than 2 px over its mean
-    (bench_hair_texture's ``fine``) below the top 40 % of the image: 0.119 -> 0.142."""
+    (bench_hair_texture's ``fine``) below the top 40 % of the image: 0.119 -> 0.142 (under session
+    25's studio rig 0.127 -> 0.133)."""
     with_hair, _, mask = hair_renders(face_of("ava"), 256)
     mask[: int(0.4 * len(mask))] = False
     fine, _ = bench_hair_texture().luminance_variation(with_hair, mask)
