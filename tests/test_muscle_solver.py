@@ -327,22 +327,3 @@ def test_an_increment_stops_once_its_residual_is_small(model, monkeypatch):
     held = solver._hold_on_contacts(model, g.copy(), solver._gaps(model, loose.x, floors), floors, sign=1.0)
     _, g0 = real(model, solver.rest_state(model).x, ld)
     assert np.linalg.norm(held) <= 0.5 * np.linalg.norm(g0)
-
-
-@pytest.mark.parametrize("text", ["6+12+25", "1+2+4+5+20+26"])
-def test_the_tangent_stiffness_takes_a_static_solve_further(model, text):
-    """In the same iterations a static solve gets further down its energy with the stretched arcs'
-    tangent stiffness as preconditioner than with the rest stiffness (ava's smile: -0.539 -> -0.558,
-    settled about -0.59; fear 0.704 -> 0.693, settled about 0.676)."""
-    from facsim.engines.muscle import STATIC_RESIDUAL, STATIC_STEPS, TANGENT_REFRESH_ON, solver
-
-    target = _drive(model, text)
-    ld = solver.loads(model, target)
-    steps = STATIC_STEPS + (1 if "26" in text else 0)   # as MuscleEngine._extra_steps for 26
-
-    def energy_after(refresh):
-        state = solver.solve(model, solver.rest_state(model), target, steps=steps, iterations=60,
-                             residual=STATIC_RESIDUAL, refresh=refresh)
-        return solver.energy(model, state.x, ld)[0][0]
-
-    assert energy_after(TANGENT_REFRESH_ON) < energy_after(0)

@@ -50,15 +50,6 @@ SETTLED_ITERATIONS = 200
 STATIC_RESIDUAL = 0.02
 #: A static solve takes one more increment per this many degrees of jaw opening.
 JAW_DEGREES_PER_STEP = 10.0
-#: Every this many iterations a static solve may factorise the net's tangent stiffness afresh as its
-#: preconditioner (solver.tangent_solvers; 0: the rest stiffness's factors throughout, as frames do).
-#: At 30 the 60 iterations get ava's smile to energy -0.558 (-0.539 with the rest stiffness; settled
-#: about -0.59) and fear to 0.693 (0.704; settled 0.676) at the same cost, but the further-converged
-#: faces fail validity in 3 of 6 parts of tests/test_muscle_pairs.py (session 25) and lie further from
-#: the animation path's: off until those are settled.
-TANGENT_REFRESH = 0
-#: ... the refresh interval to use when it is on.
-TANGENT_REFRESH_ON = 30
 #: At most this many extra rounds of iterations for a static solve that ends with folded skin.
 POLISH_ROUNDS = 5
 #: Expressions solved together by :meth:`MuscleEngine.solve_many`.
@@ -339,13 +330,12 @@ def solve_static(model, target, *, steps: int, iterations: int) -> solver.State:
     """An expression from rest in ``steps`` increments; where the skin is still folded through
     itself at the end (a big change not yet relaxed), keep relaxing, a few rounds at most."""
     state = solver.solve(model, solver.rest_state(model, target.muscle.shape[0]), target, steps=steps,
-                         iterations=iterations, residual=STATIC_RESIDUAL, refresh=TANGENT_REFRESH)
+                         iterations=iterations, residual=STATIC_RESIDUAL)
     for _ in range(POLISH_ROUNDS):
         folded = solver.folded(model, state.x) > 0
         if not folded.any():
             break
-        more = solver.solve(model, state, target, steps=1, iterations=iterations, residual=STATIC_RESIDUAL,
-                            refresh=TANGENT_REFRESH)
+        more = solver.solve(model, state, target, steps=1, iterations=iterations, residual=STATIC_RESIDUAL)
         # Only the folded ones take the extra round (so a batch solves each alike to alone).
         state = solver.State(np.where(folded[None, :, None], more.x, state.x), target,
                              np.where(folded[:, None], more.jaw, state.jaw))

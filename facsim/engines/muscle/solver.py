@@ -27,8 +27,7 @@ The minimiser is a projected L-BFGS whose initial inverse Hessian is the
 factorised rest stiffness (the projective-dynamics system matrix: arcs,
 attachments and muscles as isotropic springs; Liu, Bouaziz & Kavan 2017). The
 sparse factorisation is computed once per model and reused by every iteration
-of every frame; a solve may instead re-factorise it every few iterations with the
-stretched arcs at their tangent stiffness (``refresh``: a Newton-like preconditioner). Arrays are laid out ``(xyz, B, points)`` — component-major, so
+of every frame. Arrays are laid out ``(xyz, B, points)`` — component-major, so
 numpy's inner loops run over the points — and ``B`` configurations are solved
 at once, so many expressions cost little more than one.
 
@@ -847,8 +846,8 @@ def clearances(model: Model, x: np.ndarray, ld: Loads) -> tuple[np.ndarray, np.n
 
 # -------------------------------------------------------------- minimiser ---
 
-def _precondition(model: Model, r: np.ndarray, solvers=None) -> np.ndarray:
-    """Apply the inverse rest stiffness (or each configuration's own, ``solvers[b]``) to (3, B, N).
+def _precondition(model: Model, r: np.ndarray) -> np.ndarray:
+    """Apply the inverse rest stiffness to (3, B, N).
 
     One back-substitution per configuration: with all of them at once the batch's width
     changed the last bits of each (SuperLU's blocked solves), and the solves of a batch then
@@ -856,34 +855,7 @@ def _precondition(model: Model, r: np.ndarray, solvers=None) -> np.ndarray:
     """
     out = np.empty_like(r)
     for b in range(r.shape[1]):
-        solve = model.solve_rest if solvers is None else solvers[b]
-        out[:, b] = solve(np.ascontiguousarray(r[:, b].T)).T
-    return out
-
-
-def tangent_solvers(model: Model, x: np.ndarray) -> list:
-    """Per configuration of ``x`` (3, B, N), the factorised stiffness of the net as it stands:
-    the rest stiffness with each stretched arc's spring constant raised to its tangent,
-    k + 3 k q δ² (isotropic springs, as the rest stiffness is).
-
-    The rest stiffness is a poor model of a face far from rest: in a smile the most stretched
-    arcs are up to 40 times stiffer (strain stiffening), and L-BFGS spent its iterations
-    relearning that. (Compressed arcs keep k: their softer tangent, down to a twentieth,
-    made the steps sideways too long and the solves converged worse than with k.) Each
-    configuration gets its own factorisation from its own points, so a batch solves each
-    as it would alone.
-    """
-    d = _apply(model.arc_diff, x)
-    delta = np.sqrt(_dot(d, d)) - model.arc_rest                          # (B, A)
-    tangent = model.arc_k + 3.0 * model.arc_kq * np.maximum(delta, 0.0) ** 2
-    out = []
-    for b in range(x.shape[1]):
-        if not np.abs(x[:, b] - model.rest.T).max() > 0:   # at rest: the rest stiffness is the tangent
-            out.append(model.solve_rest)
-            continue
-        change = model.arc_scatter @ sp.diags(tangent[b] - model.arc_k) @ model.arc_diff
-        system = (model.stiffness + change).tocsc()
-        out.append(spla.splu(system, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True}).solve)
+        out[:, b] = model.solve_rest(np.ascontiguousarray(r[:, b].T)).T
     return out
 
 
@@ -899,8 +871,7 @@ def _per_config(a, b) -> np.ndarray:
 
 
 def minimise(model: Model, x: np.ndarray, ld: Loads, iterations: int, *, tolerance: float = 1e-7,
-             residual: float = 0.0, memory: tuple = (), floors: "Floors | None" = None, start=None,
-             refresh: int = 0):
+             residual: float = 0.0, memory: tuple = (), floors: "Floors | None" = None, start=None):
     """Projected L-BFGS from ``x`` (3, B, N), H₀⁻¹ = the factorised rest stiffness.
 
     A point on its contact floor may not step further in (that part of the
@@ -922,11 +893,6 @@ def minimise(model: Model, x: np.ndarray, ld: Loads, iterations: int, *, toleran
     ``residual`` times its norm at the start of the call (or every entry below the
     absolute ``tolerance``); the others go on. A configuration stops where it would
     have stopped solved alone.
-
-    ``refresh`` > 0: every ``refresh`` iterations, from the first, the
-    initial inverse Hessian becomes the factorised tangent stiffness at the current points
-    (:func:`tangent_solvers`) instead of the rest stiffness: a static solve's Newton-like
-    preconditioner. 0 (the animation path): the rest stiffness throughout, back-substitution only.
     """
     if floors is None:
         floors = select_sites(model, x, ld)
@@ -953,21 +919,18 @@ def minimise(model: Model, x: np.ndarray, ld: Loads, iterations: int, *, toleran
     # must not leave the next frame (a new drive) crawling.
     trust = np.maximum(memory[3], 0.25) if len(memory) > 3 else np.ones(x.shape[1])
     start_norm = np.sqrt(_per_config(g, g))
-    solvers = None
-    for it in range(iterations):
+    for _ in range(iterations):
         norm = np.sqrt(_per_config(g, g))
         active = (norm > residual * start_norm) & (np.abs(g).max(axis=(0, 2)) >= tolerance)
         if not active.any():
             break
-        if refresh > 0 and it % refresh == 0:
-            solvers = tangent_solvers(model, x)
         q = g.copy()
         alphas = []
         for s, y, rho in zip(reversed(s_hist), reversed(y_hist), reversed(rho_hist)):
             alpha = rho * _per_config(s, q)
             q -= alpha[:, None] * y
             alphas.append(alpha)
-        z = _precondition(model, q, solvers)
+        z = _precondition(model, q)
         for (s, y, rho), alpha in zip(zip(s_hist, y_hist, rho_hist), reversed(alphas)):
             z += (alpha - rho * _per_config(y, z))[:, None] * s
         direction = hold(-z, gaps, floors)
@@ -975,7 +938,7 @@ def minimise(model: Model, x: np.ndarray, ld: Loads, iterations: int, *, toleran
         slope = _per_config(g, direction)
         bad = (slope >= 0) & active  # not a descent direction: fall back to the preconditioned gradient
         if bad.any():
-            fallback = hold(-_precondition(model, g, solvers), gaps, floors)
+            fallback = hold(-_precondition(model, g), gaps, floors)
             direction[:, bad] = fallback[:, bad]
             slope = _per_config(g, direction)
         # Trust region: no point moves further than max_step in one iteration.
@@ -1058,7 +1021,7 @@ def _lerp_drive(a: Drive, b: Drive, t: float) -> Drive:
 
 
 def solve(model: Model, state: State, target: Drive, *, steps: int = 3, iterations: int = 12,
-          residual: float = 0.0, settle: bool = True, refresh: int = 0) -> State:
+          residual: float = 0.0, settle: bool = True) -> State:
     """Apply the change from ``state.drive`` to ``target`` in ``steps`` increments.
 
     Each increment adds 1/steps of the change and relaxes the net toward
@@ -1066,8 +1029,7 @@ def solve(model: Model, state: State, target: Drive, *, steps: int = 3, iteratio
     every intermediate state is a valid expression (an animation steps with
     ``steps=1`` per frame). Each increment iterates until the net force left on
     the points falls below ``residual`` of what the increment added (see
-    :func:`minimise`), ``iterations`` at most; ``refresh`` > 0 re-factorises the tangent
-    stiffness every that many iterations (:func:`minimise`).
+    :func:`minimise`), ``iterations`` at most.
 
     ``settle`` re-chooses, at the end, the bone each point lies over after
     sliding and projects onto it (a static solve's last word). Without it (the
@@ -1090,7 +1052,7 @@ def solve(model: Model, state: State, target: Drive, *, steps: int = 3, iteratio
             new_e, new_g = load_energy(model, x, ld)
             start = (known[1] - old_e + new_e, known[2] - old_g + new_g)
         x, memory, (e, g) = minimise(model, x, ld, iterations, residual=residual, memory=memory,
-                                   floors=floors, start=start, refresh=refresh)
+                                   floors=floors, start=start)
         known = (ld, e, g)
         mirrored = symmetric_drive(model, d) if settle else np.zeros(0, bool)
         if mirrored.any():  # a symmetric drive moves the face symmetrically: drop the round-off that breaks it
