@@ -400,9 +400,9 @@ class RegisterEngine:
         """Per skin point (N_skin,), the factor on the jaw target's ``offsets`` (N_skin, 3) that turns the lower
         lip and the lining behind it (below the corners' line) as far about ``hinge`` as the chin, in full
         within ``spec["full_within"]`` of the mouth's half-width and fading to the target's own turn at the
-        corners (``mandible.lower_lip`` in the table). Points turning less than ``spec["min_share"][0]`` of the
+        corners (``mandible.lower_lip`` in the table). Points turning less than ``spec["share_ramp"][0]`` of the
         chin's angle keep their own turn: mostly the upper lip's inner side, hanging below that line; from there
-        to ``spec["min_share"][1]`` the factor comes in smoothly, as the lower lip's turn itself grows toward
+        to ``spec["share_ramp"][1]`` the factor comes in smoothly, as the lower lip's turn itself grows toward
         the corners (a hard cut there tore neighbouring points of the lateral lower lip 2-3 mm apart)."""
         from facsim.engines.muscle.net import MOUTH, anatomy
         from facsim.head.landmarks import landmarks
@@ -413,7 +413,7 @@ class RegisterEngine:
         chin = float(angles[marks[mandible_spec()["reference"]]])
         lip_line, half_width = self._mouth_line(positions, "lip_corner")
         lower = ((self._lips > 0.5) | (anat.kind == MOUTH)) & (positions[:, 1] < lip_line) & (angles < chin)
-        low, high = (float(share) * chin for share in spec["min_share"])
+        low, high = (float(share) * chin for share in spec["share_ramp"])
         taper = smoothstep(half_width, float(spec["full_within"]) * half_width, np.abs(positions[:, 0]))
         taper = taper * smoothstep(low, high, angles)
         return np.where(lower, 1.0 + taper * (chin / np.maximum(angles, 1e-12) - 1.0), 1.0)

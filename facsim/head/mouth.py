@@ -363,7 +363,7 @@ UPPER_LIP_RINGS = 5
 #: The commissure: where the lips join at each corner, the skin folds in toward the modiolus, and as
 #: the lips part (or a smile draws them apart) the corner becomes a small shaded pit between them, as
 #: in photographs. The skin and lips within ``reach`` (dm) of a corner take up to ``depth`` of shade,
-#: falling off with the square of the distance. Without it the open mouth's red ran round its corners
+#: falling to 0 at the reach as (1 - distance / reach)². Without it the open mouth's red ran round its corners
 #: unbroken, lit as evenly as the lips' middle: a smooth ring of rubber (session 24's blind reviewer,
 #: "rubbery stretched mouth" in fear and surprise).
 COMMISSURE_FOLD = {"reach": 0.045, "depth": 0.75}
@@ -477,7 +477,7 @@ def mouth_rim(head, data, neutral: np.ndarray) -> MouthRim:
 def _commissure(p: np.ndarray, skin: np.ndarray, corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The ``skin`` points (indices into ``p``, (N, 3) at rest) within :data:`COMMISSURE_FOLD`'s reach of
     either of the two ``corners`` (indices), and their share of the fold's shade (1 at a corner, 0 at the
-    reach, falling off with the square of the distance)."""
+    reach: (1 - distance / reach)²)."""
     reach = float(COMMISSURE_FOLD["reach"])
     distance = np.min([np.linalg.norm(p[skin] - p[c], axis=1) for c in corners], axis=0)
     near = distance < reach

@@ -572,8 +572,7 @@ class BoundProxy:
         if self.proxy.kind == "eyebrows" and self.neutral is not None:
             return along_brow(self.neutral)
         if self.proxy.kind == "hair" and self.neutral is not None:
-            return hair_exposure(self.neutral, self.proxy.corner_vertex[self.proxy.triangles],
-                                 face_on=self.coil < 0.5)
+            return hair_exposure(self.neutral, self.proxy.corner_vertex[self.proxy.triangles])
         reach = np.linalg.norm(self.binding.offsets, axis=1)
         depth = reach / (np.percentile(reach, 95) + 1e-6)
         if self.proxy.kind == "eyelashes" and self.neutral is not None:
@@ -738,7 +737,7 @@ FACE_FRAME_OPEN = 0.5
 
 
 def hair_exposure(points: np.ndarray, triangles: np.ndarray, *, reach: float = 0.3,
-                  steps: int = 8, radius: float = 0.035, face_on: bool = True) -> np.ndarray:
+                  steps: int = 8, radius: float = 0.035) -> np.ndarray:
     """(V,) how open each hair vertex lies: 1 on the outermost layer … 0 under other cards.
 
     Hair cards are layered: a card near the scalp lies under the outer ones and gets little
@@ -747,7 +746,8 @@ def hair_exposure(points: np.ndarray, triangles: np.ndarray, *, reach: float = 0
     from the hairstyle's centre (``steps`` points up to ``reach`` dm) and counts the points
     that pass within ``radius`` of a card (cards sampled densely over their triangles).
     Cards in front of the centre (``FACE_FRAME_DEPTH``) also march toward the face's midline:
-    the under-layer framing the face is that open sideways (at most ``FACE_FRAME_OPEN``).
+    the under-layer framing the face is that open sideways (at most ``FACE_FRAME_OPEN``); those
+    over the forehead and temples also march forward (the hair lying along the hairline).
 
     Parameters
     ----------
@@ -755,9 +755,6 @@ def hair_exposure(points: np.ndarray, triangles: np.ndarray, *, reach: float = 0
         Hair vertices on the neutral face (dm).
     triangles : (T, 3) int
         Triangles over those vertices.
-    face_on : bool
-        The cards over the forehead and temples also march forward (straight hair lying along
-        the hairline; coily hair's dense mass shades its own front, facsim's afro01).
     """
     from scipy.spatial import cKDTree
 
@@ -800,9 +797,7 @@ def hair_exposure(points: np.ndarray, triangles: np.ndarray, *, reach: float = 0
     forward[:, 2] = 1.0
     top = points[:, 1].max()
     at_forehead = in_front * smoothstep(top - FOREHEAD_BELOW_TOP[1], top - FOREHEAD_BELOW_TOP[0], points[:, 1])
-    exposure = np.maximum(exposure, sideways)
-    if face_on:
-        exposure = np.maximum(exposure, at_forehead * openness(forward))
+    exposure = np.maximum(np.maximum(exposure, sideways), at_forehead * openness(forward))
     return exposure.astype(np.float32)
 
 

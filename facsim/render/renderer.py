@@ -163,7 +163,8 @@ class Renderer:
         Crease depth (decimetres) per unit of ``wrinkle``: the normals are computed on the
         surface pushed inward by ``wrinkle_depth * wrinkle``, giving furrow shading.
     wrinkle_darken : float
-        Cavity darkening at ``wrinkle >= 1`` (0 = none, 1 = black).
+        Cavity darkening at ``wrinkle >= 1``: 0.35 of it over the compressed skin, up to 1.95 of
+        it on a furrow's valley floor (0 = none; keep it under 0.5).
     brow_uv_frame : (2, 2) array_like
         Maps skin UV to eyebrow-stroke space: row 0 gives the coordinate along the hairs
         (1 unit ~ one stroke length), row 1 across them (1 unit ~ one strand width). The

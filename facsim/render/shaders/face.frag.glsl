@@ -429,7 +429,7 @@ const float IRIS_CAUSTIC = 0.3;    // how much brighter the iris's lower rim is 
 // fading out.)
 const vec2 SOFTBOX = vec2(0.1, 0.085);
 // The key softbox is tall: the cornea mirrors its lower part, near the eyes' level, rather
-// than the key's middle ~30 degrees up, whose reflection lies under the upper lid. (At ~16
+// than the key's middle 38 degrees up, whose reflection lies under the upper lid. (At ~16
 // degrees up it still lay under the relaxed lids of most presets: george, kwame, liam and noah
 // showed no catch-light at 448², dead eyes; now about level with the eyes, as with the flash of
 // stimulus photographs.)

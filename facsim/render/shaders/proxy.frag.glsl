@@ -156,14 +156,14 @@ float flow_strands(vec3 rest, float cells_per_dm, float stretch) {
     return strand_blend(n0, n1, octave.y, 1.1, cells);
 }
 
-// Straight hair's locks laid out like flow_strands, at the locks' scale (flow_lock_coordinate): value noise over the
-// horizontal direction from the volume's axis (LOCK_CELLS_PER_DM across at its radius) that changes
+// Where straight hair's locks lie, laid out like flow_strands at the locks' scale: the coordinate (main()
+// takes value noise of it) of the horizontal direction from the volume's axis (LOCK_CELLS_PER_DM across at its radius) that changes
 // LOCK_STRETCH times slower with the distance from the apex, so each lock runs several centimetres
 // down the hair's flow as one piece. (Smeared over a few cells along each strand, the locks were
 // blobs two or three cells long that drew a dappled, camouflage-like pattern across the lengths:
 // a "textured helmet", blind review session 24; stretched 7 times, the partings between them
-// still closed round each lock as contour lines, wood grain in a profile view.) Faded to its mean
-// where finer than a pixel.
+// still closed round each lock as contour lines, wood grain in a profile view.) main() fades the
+// noise to its mean where finer than a pixel.
 // (The coordinate, not the noise, so its screen-space change is taken outside any branch.)
 const float LOCK_STRETCH = 25.0;
 vec3 flow_lock_coordinate(vec3 rest) {
@@ -273,7 +273,7 @@ float coily_self_shadow(vec3 n, vec3 v, float crown) {
 }
 
 // Coils face every way: their highlight is a broad soft sheen where the mass faces the key
-// light, carried by the coils' crowns (clump: 0 crevice ... 1 crown), not the strand lobes of
+// light, carried by the coils' crowns (crown: 0 crevice ... 1 crown), not the strand lobes of
 // straight hair, which the cards' tangents drew as pale scratches across the mass.
 vec3 coily_sheen(vec3 n, vec3 v, float crown) {
     vec3 h = normalize(u_key_dir + v);
@@ -575,7 +575,7 @@ void main() {
     // before the noise is computed (most of the blended pass's fragments are cards under the
     // outer layer, seen through its frayed gaps, that belong to the alpha-tested pass).
 #if defined(PASS_OPAQUE) && defined(COILY)
-    if (alpha < 0.02) discard;   // coily hair's thin cover turns into solid curls (below)
+    if (alpha < 0.02) discard;   // coily hair's texture holes are filled below (fill)
 #elif defined(PASS_OPAQUE)
     if (alpha < ALPHA_CUTOFF) discard;
 #else
@@ -715,7 +715,7 @@ void main() {
         float bump = coily_clumps(coil_place(v_rest));
         // Coily hair is a dense mass: the texture's tufts and the holes between them are filled
         // (each hole showed the darker cards under it as a hard-edged fragment: "voxel-like",
-        // blind review session 24), and cards seen edge-on at the outline stay solid too.
+        // blind review session 24).
         float fill = clamp(0.5 + (tex.a - 0.3) / max(fwidth(tex.a), 0.002), 0.0, 1.0);
         // Its outline: rounded clumps of coils standing up to COILY_BUMP_MM out of the mass
         // (the cards are cut where they reach further out than the clump there), each solid
