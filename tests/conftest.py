@@ -48,6 +48,22 @@ def face_of():
     return _face
 
 
+def welded_sphere(n_lat: int, n_lon: int):
+    """A welded unit sphere (poles and the seam shared): (points, faces)."""
+    theta = np.linspace(0, np.pi, n_lat + 1)[1:-1]
+    phi = np.linspace(0, 2 * np.pi, n_lon, endpoint=False)
+    t, p = np.meshgrid(theta, phi, indexing="ij")
+    ring = np.stack([np.sin(t) * np.sin(p), np.cos(t), np.sin(t) * np.cos(p)], -1).reshape(-1, 3)
+    points = np.concatenate([[[0.0, 1.0, 0.0]], ring, [[0.0, -1.0, 0.0]]])
+    idx = 1 + np.arange(len(ring)).reshape(n_lat - 1, n_lon)
+    nxt = np.roll(idx, -1, axis=1)
+    faces = [np.stack([np.zeros(n_lon, int), nxt[0], idx[0]], 1),
+             np.stack([idx[:-1], nxt[:-1], nxt[1:]], -1).reshape(-1, 3),
+             np.stack([idx[:-1], nxt[1:], idx[1:]], -1).reshape(-1, 3),
+             np.stack([np.full(n_lon, len(points) - 1), idx[-1], nxt[-1]], 1)]
+    return points, np.concatenate(faces)
+
+
 def background_mask(image: np.ndarray, background=(255, 255, 255)) -> np.ndarray:
     """Pixels that show the background colour."""
     return np.all(np.abs(image[..., :3].astype(int) - background) <= 2, axis=-1)

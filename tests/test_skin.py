@@ -636,13 +636,9 @@ def _mid_scale_unevenness(image, mask, px_per_mm, fine=1.5, coarse=6.0):
     return 100 * spread(band), 100 * spread(hue)
 
 
-@pytest.mark.parametrize("name", ["ava", "mei"])
-def test_the_cheeks_colour_varies_in_patches_a_few_millimetres_across(face_of, marks, name):
-    """Blood and pigment lie unevenly at 5-30 mm, what a face at 448 px shows most: the cheeks' hue
-    varies between ~3 and ~20 mm by more than 1.3 % (a studio portrait's, skimage.data.astronaut():
-    1.8 %; main 98c87e1: ava 1.09, mei 1.01, an even tint that read as wax to the blind reviewer)."""
-    size = 448
-    face = face_of(name)
+def _neutral_cheeks(face, marks, size: int = 448):
+    """``face``'s neutral front view at ``size`` (no body), a mask of two squares ~16 mm across on
+    its cheeks and the pixels per millimetre there."""
     camera = face.camera(size=(size, size))
     image = face.renderer(size=size, body="none").render(face.neutral, appearance=face.appearance, camera=camera,
                                                          occlusion=face.shading_occlusion)
@@ -653,6 +649,15 @@ def test_the_cheeks_colour_varies_in_patches_a_few_millimetres_across(face_of, m
     for point in (left + [-0.08, 0.02, 0.1], right + [0.08, 0.02, 0.1]):
         (x, y), = project(camera, [point], size)[0].astype(int)
         mask[y - r:y + r + 1, x - r:x + r + 1] = True
+    return image, mask, px_per_mm
+
+
+@pytest.mark.parametrize("name", ["ava", "mei"])
+def test_the_cheeks_colour_varies_in_patches_a_few_millimetres_across(face_of, marks, name):
+    """Blood and pigment lie unevenly at 5-30 mm, what a face at 448 px shows most: the cheeks' hue
+    varies between ~3 and ~20 mm by more than 1.3 % (a studio portrait's, skimage.data.astronaut():
+    1.8 %; main 98c87e1: ava 1.09, mei 1.01, an even tint that read as wax to the blind reviewer)."""
+    image, mask, px_per_mm = _neutral_cheeks(face_of(name), marks)
     _, hue = _mid_scale_unevenness(image, mask, px_per_mm)
     assert hue > 1.3, hue
 
@@ -818,18 +823,7 @@ def test_young_skin_is_mottled_at_a_few_millimetres_not_an_even_paper(face_of, m
     deviation of its log) varies by over ``least`` per cent (main 67a54cb: mei 2.49, liam 1.59, amara
     2.11, an even papery tone the blind reviewer called "overly smooth", "waxy" and "skin uniform";
     now 3.45, 2.50 and 2.81; george, 72, 3.7 on main)."""
-    size = 448
-    face = face_of(name)
-    camera = face.camera(size=(size, size))
-    image = face.renderer(size=size, body="none").render(face.neutral, appearance=face.appearance, camera=camera,
-                                                         occlusion=face.shading_occlusion)
-    left, right = face.neutral[marks["cheek_left"]], face.neutral[marks["cheek_right"]]
-    (x0, _), (x1, _) = project(camera, [left, left + [0.1, 0.0, 0.0]], size)[0]
-    px_per_mm = abs(x1 - x0) / 10
-    mask, r = np.zeros((size, size), bool), int(8 * px_per_mm)
-    for point in (left + [-0.08, 0.02, 0.1], right + [0.08, 0.02, 0.1]):
-        (x, y), = project(camera, [point], size)[0].astype(int)
-        mask[y - r:y + r + 1, x - r:x + r + 1] = True
+    image, mask, px_per_mm = _neutral_cheeks(face_of(name), marks)
     tone, _ = _mid_scale_unevenness(image, mask, px_per_mm, fine=0.7, coarse=3.0)
     assert tone > least, tone
 

@@ -10,26 +10,12 @@ from facsim.render.camera import frame_camera
 from facsim.render.geometry import smoothing_operator, surface_curvature, vertex_normals
 from facsim.render.renderer import DEFAULT_COLORS, REGIONS, Appearance, Lighting, Renderer, RenderTopology
 
-
-def sphere(n_lat: int = 40, n_lon: int = 60):
-    """A welded unit sphere: (points, faces) (poles and the seam shared)."""
-    theta = np.linspace(0, np.pi, n_lat + 1)[1:-1]
-    phi = np.linspace(0, 2 * np.pi, n_lon, endpoint=False)
-    t, p = np.meshgrid(theta, phi, indexing="ij")
-    ring = np.stack([np.sin(t) * np.sin(p), np.cos(t), np.sin(t) * np.cos(p)], -1).reshape(-1, 3)
-    points = np.concatenate([[[0.0, 1.0, 0.0]], ring, [[0.0, -1.0, 0.0]]])
-    idx = 1 + np.arange(len(ring)).reshape(n_lat - 1, n_lon)
-    nxt = np.roll(idx, -1, axis=1)
-    faces = [np.stack([np.zeros(n_lon, int), nxt[0], idx[0]], 1)]
-    faces.append(np.concatenate([np.stack([idx[:-1], nxt[:-1], nxt[1:]], -1).reshape(-1, 3),
-                                 np.stack([idx[:-1], nxt[1:], idx[1:]], -1).reshape(-1, 3)]))
-    faces.append(np.stack([np.full(n_lon, len(points) - 1), idx[-1], nxt[-1]], 1))
-    return points, np.concatenate(faces)
+from conftest import welded_sphere
 
 
 @pytest.mark.parametrize("radius", [0.05, 0.5, 2.0])
 def test_surface_curvature_is_one_over_the_radius_positive_on_a_bulge_negative_in_a_hollow(radius):
-    points, faces = sphere()
+    points, faces = welded_sphere(40, 60)
     p = points * radius
     op = smoothing_operator(faces, len(p))
     normals = vertex_normals(p, faces)
@@ -68,7 +54,7 @@ def _render_skin_sphere(points, faces, radius: float, appearance, *, key, size: 
 def render_sphere(radius: float, *, oil: int = 90, key=(-0.9, 0.0, 0.45), seed: float = 0.0):
     """A skin sphere of ``radius`` (dm) filling a 96² image, lit by the key only from the side
     (camera left), with a uniform oil map (detail.b; 90 = the cheeks' 0.35, 255 = the T-zone's)."""
-    points, faces = sphere()
+    points, faces = welded_sphere(40, 60)
     detail = np.zeros((4, 4, 4), np.uint8)
     detail[..., 2] = oil
     appearance = Appearance(DEFAULT_COLORS, detail=detail, seed=seed)
@@ -214,7 +200,7 @@ def render_lip_sphere(size: int = 192, key=(-0.3, 0.3, 0.9)):
     """A 5-mm sphere of lip (the paint's lip mask full, cheek-dry oil), its texture coordinates at
     hm08's face scale, filling a ``size``² image, lit by a key near the camera: its luminance
     (linear) and the disc's pixels."""
-    points, faces = sphere(60, 90)
+    points, faces = welded_sphere(60, 90)
     paint = np.zeros((4, 4, 4), np.uint8)
     paint[..., 1] = 255
     detail = np.zeros((4, 4, 4), np.uint8)

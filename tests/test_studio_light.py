@@ -15,6 +15,8 @@ import pytest
 from facsim.render.camera import frame_camera, project
 from facsim.render.renderer import DEFAULT_COLORS, REGIONS, Appearance, Lighting, Renderer, RenderTopology
 
+from conftest import welded_sphere
+
 DARK = (0.0, 0.0, 0.0)
 
 
@@ -23,27 +25,11 @@ def linear_luminance(image: np.ndarray) -> np.ndarray:
     return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4) @ np.array([0.2126, 0.7152, 0.0722])
 
 
-def unit_sphere(n_lat: int = 48, n_lon: int = 72):
-    """A welded unit sphere: (points, faces)."""
-    theta = np.linspace(0, np.pi, n_lat + 1)[1:-1]
-    phi = np.linspace(0, 2 * np.pi, n_lon, endpoint=False)
-    t, p = np.meshgrid(theta, phi, indexing="ij")
-    ring = np.stack([np.sin(t) * np.sin(p), np.cos(t), np.sin(t) * np.cos(p)], -1).reshape(-1, 3)
-    points = np.concatenate([[[0.0, 1.0, 0.0]], ring, [[0.0, -1.0, 0.0]]])
-    idx = 1 + np.arange(len(ring)).reshape(n_lat - 1, n_lon)
-    nxt = np.roll(idx, -1, axis=1)
-    faces = [np.stack([np.zeros(n_lon, int), nxt[0], idx[0]], 1),
-             np.stack([idx[:-1], nxt[:-1], nxt[1:]], -1).reshape(-1, 3),
-             np.stack([idx[:-1], nxt[1:], idx[1:]], -1).reshape(-1, 3),
-             np.stack([np.full(n_lon, len(points) - 1), idx[-1], nxt[-1]], 1)]
-    return points, np.concatenate(faces)
-
-
 def lit_sphere(**only):
     """A head-sized skin sphere (1 dm) seen from the front at 128², lit by the default rig's lights
     named in ``only`` (each ``True``: the default's; the others off): a function of the sphere's
     front point (x, y) to its linear luminance there."""
-    points, faces = unit_sphere()
+    points, faces = welded_sphere(48, 72)
     p = points.astype(np.float32)
     topology = RenderTopology(faces=faces, render_to_geo=np.arange(len(p)), uv=np.full((len(p), 2), 0.5, np.float32),
                               region=np.full(len(p), REGIONS.index("skin"), np.uint8),
