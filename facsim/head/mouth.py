@@ -616,6 +616,8 @@ def mouth_light(rim: MouthRim, positions: np.ndarray, occlusion: np.ndarray) -> 
     Measured in the mouth's own frame (x from corner to corner, y up across it), so a
     turned or tilted head keeps it.
     """
+    from facsim.head.surface import smoothstep
+
     lips = _lips(rim, positions)
     plane, upper_edge, lower_edge, middle = lips
     lo, hi = LIP_PARTING
@@ -633,9 +635,7 @@ def mouth_light(rim: MouthRim, positions: np.ndarray, occlusion: np.ndarray) -> 
     lo, hi = TONGUE_LIT_GAP
     lit = np.clip((gap - lo) / (hi - lo), 0.0, 1.0)
     occlusion[rim.tongue] = lit * lit * (3.0 - 2.0 * lit)
-    lo, hi = COMMISSURE_OPENING
-    opening = np.clip((gap - lo) / (hi - lo), 0.0, 1.0)
-    opening = opening * opening * (3.0 - 2.0 * opening)
+    opening = smoothstep(*COMMISSURE_OPENING, gap)
     occlusion[rim.commissure] *= 1.0 - float(COMMISSURE_FOLD["depth"]) * opening * rim.commissure_share
     lip_x, lip_y = plane(rim.upper_lip)
     corners = plane(rim.upper)[0][[0, -1]]

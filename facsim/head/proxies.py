@@ -444,6 +444,17 @@ def hair_volume(style: str) -> float:
     return float(hair_table().get("volume_mm", {}).get(style, 0.0))
 
 
+def _hairline_over(head, geo: np.ndarray, skin: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """The hairline's height (dm) over the skin points ``skin`` (N, 3) with outward ``normals``
+    (N, 3) on the neutral ``geo``: ``scalp: hairline_above_eyes_mm`` in ``hair.yaml`` over the eyes'
+    mean height (:func:`facsim.head.scalp.hairline_height`)."""
+    from facsim.head.scalp import hairline_height
+
+    eyes = np.concatenate([np.asarray(v) for v in head.eye_vertices.values()])
+    return hairline_height(normals, skin[:, 2], float(geo[eyes, 1].mean()), float(geo[eyes, 2].mean()),
+                           hair_table()["scalp"]["hairline_above_eyes_mm"])
+
+
 def hair_volume_offset(style: str, fitted: np.ndarray, head, neutral_geometry: np.ndarray) -> np.ndarray:
     """(V, 3) offsets (dm) lifting a hairstyle's vertices ``fitted`` (V, 3) by its
     :func:`hair_volume` along the outward normal of the skin nearest each (zeros without one).
@@ -457,16 +468,14 @@ def hair_volume_offset(style: str, fitted: np.ndarray, head, neutral_geometry: n
     fitted = np.asarray(fitted, np.float64)
     if mm == 0.0:
         return np.zeros_like(fitted, dtype=np.float32)
-    from facsim.head.scalp import hairline_height, outward_skin
+    from facsim.head.scalp import outward_skin
     from facsim.head.surface import smoothstep
 
     geo = np.asarray(neutral_geometry, np.float64)
     skin, _, normals = outward_skin(head, geo)
 
     nearest = cKDTree(skin).query(fitted)[1]
-    eyes = np.concatenate([np.asarray(v) for v in head.eye_vertices.values()])
-    line = hairline_height(normals[nearest], skin[nearest, 2], float(geo[eyes, 1].mean()), float(geo[eyes, 2].mean()),
-                           hair_table()["scalp"]["hairline_above_eyes_mm"])
+    line = _hairline_over(head, geo, skin[nearest], normals[nearest])
     fade = smoothstep(line, line + VOLUME_FADE, fitted[:, 1])
     return (0.01 * mm * fade[:, None] * normals[nearest]).astype(np.float32)
 
@@ -499,7 +508,7 @@ def hair_snug_offset(style: str, fitted: np.ndarray, head, neutral_geometry: np.
     fitted = np.asarray(fitted, np.float64)
     if snug is None:
         return np.zeros_like(fitted, dtype=np.float32)
-    from facsim.head.scalp import hairline_height, outward_skin
+    from facsim.head.scalp import outward_skin
     from facsim.head.surface import smoothstep
 
     geo = np.asarray(neutral_geometry, np.float64)
@@ -512,9 +521,7 @@ def hair_snug_offset(style: str, fitted: np.ndarray, head, neutral_geometry: np.
 
     height, distance, nearest = height_over_skin(fitted)
     n = normals[nearest]
-    eyes = np.concatenate([np.asarray(v) for v in head.eye_vertices.values()])
-    line = hairline_height(n, skin[nearest, 2], float(geo[eyes, 1].mean()), float(geo[eyes, 2].mean()),
-                           hair_table()["scalp"]["hairline_above_eyes_mm"])
+    line = _hairline_over(head, geo, skin[nearest], n)
     over, reach, floor = (0.01 * float(snug[k]) for k in ("over_mm", "reach_mm", "floor_mm"))
     weight = (1.0 - smoothstep(line + 0.4 * over, line + over, fitted[:, 1])) \
         * (1.0 - smoothstep(0.6 * reach, reach, distance))
@@ -525,11 +532,11 @@ def hair_snug_offset(style: str, fitted: np.ndarray, head, neutral_geometry: np.
         tri = tri[np.any(weight[tri] > 0.0, axis=1)]
         # (the triangles' edge midpoints and centres, where a flat card lies lowest over a round skull)
         mid = np.array([[0.5, 0.5, 0.0], [0.0, 0.5, 0.5], [0.5, 0.0, 0.5], [1 / 3, 1 / 3, 1 / 3]])
+        above_before = height_over_skin(np.einsum("sk,tkd->tsd", mid, fitted[tri]).reshape(-1, 3))[0] >= 0.5 * floor
         for _ in range(6):
             moved = fitted + (drop * weight)[:, None] * n
             samples = np.einsum("sk,tkd->tsd", mid, moved[tri]).reshape(-1, 3)
-            before = np.einsum("sk,tkd->tsd", mid, fitted[tri]).reshape(-1, 3)
-            sunk = (height_over_skin(samples)[0] < 0.5 * floor) & (height_over_skin(before)[0] >= 0.5 * floor)
+            sunk = (height_over_skin(samples)[0] < 0.5 * floor) & above_before
             bad = np.unique(tri[sunk.reshape(len(tri), -1).any(axis=1)])
             if not len(bad):
                 break

@@ -1145,7 +1145,7 @@ void main() {
     vec2 roughness = lobes.roughness;
     // The key's lobes spread by its softbox's size (softbox_roughness), except on the wet lips: their
     // film's beads and furrows curve within a millimetre or two and mirror the box as small glints.
-    vec2 key_roughness = mix(softbox_roughness(roughness, KEY_SOFTBOX_HALF_ANGLE), roughness, max(lips, min(2.0 * wet, 1.0)));
+    vec2 key_roughness = mix(softbox_roughness(roughness, KEY_SOFTBOX_HALF_ANGLE), roughness, lobes.lip);
     vec3 spec = dot(skin_specular(sheen_n, u_key_dir, v, ndv, key_roughness), weight) * u_key_col * key_shadow
               + dot(skin_specular(sheen_n, u_rim_dir, v, ndv, roughness), weight) * u_rim_col;
     // (Times pi: the diffuse term here is albedo times N.L, without the Lambert 1/pi.)
@@ -1419,7 +1419,8 @@ void main() {
     float vary = hash2(ivec2(int(tooth_id), 29));
     float yellowing = hash2(ivec2(int(tooth_id), 41));
     vec3 front = vec3(float(kind == 0), float(kind == 1), float(kind == 2));   // which front tooth, if any
-    float kind_value = dot(front, TOOTH_KIND_VALUE) + 1.0 - dot(front, vec3(1.0));
+    float back = 1.0 - dot(front, vec3(1.0));   // 1 on the other teeth, which keep factor 1
+    float kind_value = dot(front, TOOTH_KIND_VALUE) + back;
     vec3 enamel = u_albedo * (1.0 + TOOTH_SHADE_SPREAD.x * (vary - 0.75)) * kind_value
                 * mix(vec3(1.0), TOOTH_YELLOW, TOOTH_SHADE_SPREAD.y * yellowing + dot(front, TOOTH_KIND_YELLOW));
     float streak = value_noise(vec2(v_uv.x * 140.0, max(h, lingual) * 5.0), 0);
@@ -1427,7 +1428,7 @@ void main() {
     float edge_h = max(h, lingual) - notch;                 // band units above the edge
     float incisal = (1.0 - smoothstep(0.025, 0.1, edge_h)) * (kind <= 2 ? 1.0 : 0.5) * mix(1.0, 0.6, lower);
     float translucent = INCISAL_TRANSLUCENCY * (0.6 + 0.8 * hash2(ivec2(int(tooth_id), 53)))
-                      * (dot(front, TOOTH_KIND_TRANSLUCENCY) + 1.0 - dot(front, vec3(1.0)));
+                      * (dot(front, TOOTH_KIND_TRANSLUCENCY) + back);
     enamel = mix(enamel, dot(u_albedo, vec3(0.33)) * vec3(0.86, 0.92, 1.0), translucent * incisal);
     float halo_w = max(0.012, fwidth(edge_h));
     enamel *= 1.0 + 0.22 * exp(-edge_h * edge_h / (halo_w * halo_w)) * (0.012 / halo_w) * float(shaped);

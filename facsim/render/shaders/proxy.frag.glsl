@@ -239,6 +239,13 @@ float coily_inside_outline_mm(vec3 p, vec3 v) {
     return 100.0 * r * (1.0 - sqrt(1.0 - c * c));
 }
 
+#ifdef KIND_HAIR
+// The hair colour's hue at full brightness, halfway from white: what tints its highlights.
+vec3 hair_tint() {
+    return mix(vec3(1.0), u_color / max(max(u_color.r, u_color.g), max(u_color.b, 1e-4)), 0.5);
+}
+#endif
+
 #if defined(KIND_HAIR) && defined(COILY)
 // Coily hair's clumps of coils, placed on the neutral head (rest, dm) by their direction from
 // the volume's axis (at the volume's radius): the cards lie in layers a few millimetres apart,
@@ -259,8 +266,7 @@ float coily_clumps(vec3 q) {
     return 0.25 * value_noise3(COIL_TURN_B * q * 12.0 + 7.0) + 0.4 * value_noise3(COIL_TURN_A * q * 25.0 + 1.0)
          + 0.35 * value_noise3(COIL_TURN_B * q * 50.0 + 3.0);
 }
-#endif
-#if defined(KIND_HAIR) && defined(COILY)
+
 // Coily hair is a dense mass: it shadows itself toward its underside (n: the volume's normal
 // turned down), where it overhangs the forehead and the temples, and its clumps' hollows lie in
 // their crowns' shade (crown). Only the mass's broad shape counts, not which card is drawn
@@ -277,7 +283,7 @@ float coily_self_shadow(vec3 n, vec3 v, float crown) {
 // straight hair, which the cards' tangents drew as pale scratches across the mass.
 vec3 coily_sheen(vec3 n, vec3 v, float crown) {
     vec3 h = normalize(u_key_dir + v);
-    vec3 tint = mix(vec3(1.0), u_color / max(max(u_color.r, u_color.g), max(u_color.b, 1e-4)), 0.5);
+    vec3 tint = hair_tint();
     return u_key_col * tint * 0.07 * pow(max(dot(n, h), 0.0), 4.0) * mix(0.5, 1.0, crown);
 }
 #endif
@@ -832,6 +838,8 @@ void main() {
 #else
     float key_reach = 1.0;
 #endif
+    // the parting between two locks running down the flow (a narrow crevice: shade, little highlight)
+    float parting = smoothstep(0.7, 1.0, lock_flow) * lock_gap(lock);
     float layer = smoothstep(0.0, 0.95, v_depth);
     // (light hair's under-layers and gaps kept 0.7 and 0.85 of the light: george's and
     // margaret's grey read as a flat pale helmet without the depth a photograph shows between
@@ -843,7 +851,7 @@ void main() {
                       * mix(mix(0.74, 0.8, light_hair), 1.0, smoothstep(0.02, 0.32, px))
                       * mix(mix(LOCK_GAP_DARK, LOCK_GAP_LIGHT, light_hair), 1.0, smoothstep(0.15, 0.6, lock))
     // and the parting between two locks running down the flow is a narrow dark crevice
-                      * (1.0 - smoothstep(0.7, 1.0, lock_flow) * lock_gap(lock) * mix(0.6, 0.4, light_hair));
+                      * (1.0 - parting * mix(0.6, 0.4, light_hair));
     float jitter = 0.22 * (tex.r - 0.5) + 0.12 * (fine - 0.5) + 0.18 * (mid - 0.5) + 0.1 * (clump - 0.5)
                  + 0.25 * (px - 0.5);
     // Key light: strand diffuse blended with a squared half-Lambert, which keeps the volume
@@ -887,9 +895,9 @@ void main() {
     // each card's edge, and at full strength they cut the band into the cards' shapes.)
     float strands = mix(0.55, 1.0, smoothstep(0.25, 0.7, fine) * smoothstep(0.2, 0.7, mid))
                   * mix(0.45, 1.0, smoothstep(0.3, 0.65, tex.r)) * mix(0.7, 1.0, clump) * smoothstep(0.3, 0.75, px) * 1.4
-                  * mix(0.4, 1.6, lock) * (1.0 - 0.7 * smoothstep(0.7, 1.0, lock_flow) * lock_gap(lock));   // the locks' crowns catch the light, their gaps little
+                  * mix(0.4, 1.6, lock) * (1.0 - 0.7 * parting);   // the locks' crowns catch the light, their gaps little
     float sparkle = smoothstep(0.45, 0.75, fine) * smoothstep(0.4, 0.7, mid) * smoothstep(0.4, 0.75, px);
-    vec3 tint = mix(vec3(1.0), u_color / max(max(u_color.r, u_color.g), max(u_color.b, 1e-4)), 0.5);
+    vec3 tint = hair_tint();
     // Light hair's own diffuse is bright already: a full-strength white lobe on it reads as
     // white streaks, so it takes less.
     gate *= mix(1.0, 0.55, light_hair);

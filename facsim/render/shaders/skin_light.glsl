@@ -21,7 +21,7 @@ float scatter_reach(float curvature) {
 // lobe only where the skin is oiliest (``film``); the lips (``lips``: their mask) and their wet
 // film (``wet``: the lips' film and the mucosa) their own. (Until
 // session 18 one broad lobe of weight 0.6 and roughness 0.6 lay over the whole face.)
-struct SkinLobes { vec2 weight; vec2 roughness; };
+struct SkinLobes { vec2 weight; vec2 roughness; float lip; };   // lip: how far the lips' lobes hold
 // Sebum pools on an oily T-zone: the film gathers in the skin's relief in pools a few
 // millimetres across (cells ~6 and ~2.5 mm on hm08's face UV) with drier skin between them, so
 // its highlight is broken and sharper, not one broad even glaze (kwame's "plastic" forehead,
@@ -52,6 +52,7 @@ SkinLobes skin_lobes(float oil, float film, float lips, float wet, float blotch,
     SkinLobes l;
     l.weight = vec2(mix(BROAD_LOBE_WEIGHT * uneven, LIP_LOBES.x, lip),
                     (0.08 * tzone + OIL_FILM_WEIGHT * film) * uneven + LIP_LOBES.y * wet);
+    l.lip = lip;
     l.roughness = vec2(mix(mix(0.66, TZONE_BROAD_ROUGHNESS, tzone), LIP_BROAD_ROUGHNESS, lip), mix(mix(0.48, OIL_FILM_ROUGHNESS, min(film, 1.0)), LIP_ROUGHNESS, lip));
     return l;
 }
