@@ -246,6 +246,48 @@ vec3 hair_tint() {
 }
 #endif
 
+#ifdef COILY
+// Lattices turned against each other and the head's axes (an axis-aligned one drew rows of bricks).
+const mat3 COIL_TURN_A = mat3(0.788, 0.418, -0.452, -0.360, 0.908, 0.214, 0.500, -0.017, 0.866);
+const mat3 COIL_TURN_B = mat3(0.643, -0.543, 0.540, 0.766, 0.456, -0.453, 0.000, 0.705, 0.709);
+
+// Single coils: tightly coiled hair at stimulus sizes is a surface of small round coils, each
+// a little dome with its own glint on its side toward the light and shade in the crevices round
+// it (smooth noise at that scale read as a blurred, foamy mass: "blobby afro", blind review
+// session 25). The nearest of jittered points on a lattice of COIL_CELLS_PER_DM cells (Worley's
+// F1 over the 2x2x2 cells nearest q), each a ball of its own radius, cut by the surface. Taken
+// on the neutral head in 3-D (q: v_rest, dm), not by direction from the volume's axis as the
+// clumps are: the coils are small enough that the cards' layers do not show as seams, and by
+// direction they stretched into streaks where the cards run radially. n: the volume's normal.
+// Returns the dome's normal (its slope in the tangent plane added to n) in .xyz and its height
+// (0 between coils ... 1 at its top) in .w; id: the coil's own random number; detail: 1 where
+// a coil spans a few pixels ... 0 where it is under a pixel and a half (callers fade to the mean).
+const float COIL_CELLS_PER_DM = 42.0;   // ~2.4 mm
+vec4 coil_dome(vec3 q, vec3 n, out float detail, out float id) {
+    vec3 s = COIL_TURN_A * q * COIL_CELLS_PER_DM + 11.0;
+    vec3 base = floor(s - 0.5);
+    float best = 9.0;
+    vec3 best_d = vec3(0.0);
+    float best_r = 0.6;
+    id = 0.5;
+    for (int k = 0; k < 8; ++k) {
+        vec3 cell = base + vec3(float(k & 1), float((k >> 1) & 1), float((k >> 2) & 1));
+        ivec3 c = ivec3(cell);
+        float h = hash2(ivec2(c.x + 7919 * c.z, c.y));
+        vec3 jitter = fract(h * vec3(1.0, 37.13, 91.71));
+        vec3 d = s - (cell + 0.15 + 0.7 * jitter);
+        float r = 0.5 + 0.25 * fract(h * 13.37);
+        float e = dot(d, d) / (r * r);
+        if (e < best) { best = e; best_d = d; best_r = r; id = h; }
+    }
+    float dome = sqrt(max(1.0 - best, 0.0));
+    vec3 slope = transpose(COIL_TURN_A) * best_d / best_r;
+    slope -= dot(slope, n) * n;
+    detail = clamp(3.0 - 3.0 * length(fwidth(s)), 0.0, 1.0);
+    return vec4(normalize(n * max(dome, 0.05) + 0.8 * slope), dome);
+}
+#endif
+
 #if defined(KIND_HAIR) && defined(COILY)
 // Coily hair's clumps of coils, placed on the neutral head (rest, dm) by their direction from
 // the volume's axis (at the volume's radius): the cards lie in layers a few millimetres apart,
@@ -256,8 +298,6 @@ vec3 hair_tint() {
 // head's axes (an axis-aligned one drew rows of bricks). [0, 1], mean 0.5; each faded to its
 // mean where finer than a pixel (value_noise3).
 const float COILY_BUMP_MM = 2.5;   // how far the clumps stand out of the mass at its outline
-const mat3 COIL_TURN_A = mat3(0.788, 0.418, -0.452, -0.360, 0.908, 0.214, 0.500, -0.017, 0.866);
-const mat3 COIL_TURN_B = mat3(0.643, -0.543, 0.540, 0.766, 0.456, -0.453, 0.000, 0.705, 0.709);
 vec3 coil_place(vec3 rest) {
     vec3 axis = volume_axis_point(rest, u_hair_apex_rest);
     return axis + normalize(rest - axis + vec3(0.0, 1e-5, 0.0)) * HAIR_VOLUME_RADIUS;
@@ -446,6 +486,16 @@ void main() {
         float coils = value_noise3(transpose(crop_turn) * v_rest * 35.0 + 5.0);
         strand_shade = (0.55 + 0.9 * kink) * (0.6 + 0.8 * coils);
         alpha *= smoothstep(0.3, 0.7, 0.55 * coils + 0.45 * kink + 0.35 * (dens - 0.6));
+        // Where a pixel resolves them, the mass's single coils (coil_dome): each solid, there
+        // where its rank is under the density, so the hairline ends in short coils standing
+        // apart on the skin, not in a soft dark film along a clean line (blind review session 25).
+        float detail, rank;
+        vec4 coil = coil_dome(v_rest, n, detail, rank);
+        float present = smoothstep(rank - 0.08, rank + 0.08, 1.6 * dens - 0.1);
+        float disc = clamp(0.5 + (coil.w - 0.2) / max(fwidth(coil.w), 0.05), 0.0, 1.0);
+        alpha = mix(alpha, 0.95 * present * disc, detail);
+        float coil_key = clamp(dot(coil.xyz - n, u_key_dir) + 0.5, 0.0, 1.0);
+        strand_shade = mix(strand_shade, mix(0.6, 1.2, coil.w) * (0.7 + 0.6 * coil_key) * (0.85 + 0.3 * rank), detail);
         light_hair *= 0.4;
     }
 #endif
@@ -592,6 +642,14 @@ void main() {
 #else
     if (alpha < 0.02 || (alpha >= ALPHA_CUTOFF && v_edge < 0.1 && v_cover > 0.999 && dot(n, v) >= 0.28)) discard;
 #endif
+#endif
+#ifdef COILY
+    // (the single coils under this pixel, coil_dome: its outline, its thinning and its shading)
+    float coil_detail, coil_id;
+    vec4 coil = coil_dome(v_rest, n, coil_detail, coil_id);
+    // (toward the outline the eye grazes the mass and the coils, a pixel across there, would
+    // speckle it: they fade out, and the outline is the clumps')
+    coil_detail *= smoothstep(0.2, 0.55, dot(n, v));
 #endif
     // Strand coordinates: across the strands (u) many, along them (v) few. Each noise fades
     // to its mean where it would be finer than a pixel, so small images do not shimmer.
@@ -742,7 +800,8 @@ void main() {
     // Coily hair thins in whole clumps of coils (coily_clumps), each solid, with skin between
     // them: curls finer than a pixel thinned it into a grey translucent film (the tufts over
     // the ears).
-    float thin_at = coily_clumps(coil_place(v_rest));
+    // (and the clumps' edges break into single coils, so the hairline ends in short coils)
+    float thin_at = coily_clumps(coil_place(v_rest)) - 0.3 * coil_detail * (coil.w - 0.6);
     float thin_by = 1.3 * v_cover - 0.15 - thin_at;
     alpha *= clamp(0.5 + thin_by / max(fwidth(thin_by), 0.002), 0.0, 1.0);
 #else
@@ -799,12 +858,18 @@ void main() {
         // stripes, fades to its mean; the outline's own clumps break it up)
         float seen = smoothstep(0.2, 0.55, dot(n, v));
         float bump = mix(0.5, coily_clumps(q), seen);
-        float coils = mix(0.5, value_noise3(COIL_TURN_A * q * 90.0 + 5.0), seen);
+        float coils = mix(0.5, coil_id, seen * coil_detail);
         crown = smoothstep(0.3, 0.7, bump);
         // (light hair scatters light into the hollows: grey afros' at full depth drew them as
         // blotchy camouflage)
         float light = sqrt(clamp(dot(u_color, LUMINANCE), 0.0, 1.0));
-        strand = mix(strand, mix(mix(0.55, 0.75, light), mix(1.15, 1.05, light), crown) * (0.88 + 0.24 * coils), u_coil);
+        // Each coil: its top and its side toward the key lighter, the crevices round it darker.
+        float single = seen * coil_detail;
+        float coil_key = clamp(dot(coil.xyz - n, u_key_dir) + 0.5, 0.0, 1.0);
+        // (light hair scatters light into the crevices: grey coils at full depth read as gravel)
+        float coil_shade = mix(1.0, mix(mix(0.45, 0.7, light), 1.1, coil.w) * (0.7 + 0.6 * coil_key)
+                                  * (0.85 + 0.3 * coil_id), single);
+        strand = mix(strand, mix(mix(0.55, 0.75, light), mix(1.15, 1.05, light), crown) * coil_shade, u_coil);
         // Greying coily hair mixes white, grey and dark coils (placed on the head, not in the
         // cards' mirrored UVs), finer than its clumps: clumps of white and dark drew grey afros
         // as blotchy cloud or cauliflower (blind review session 20).
@@ -914,7 +979,11 @@ void main() {
     vec3 spec = vec3(0.0);
 #endif
 #ifdef COILY
-    spec = mix(spec, coily_sheen(n, v, crown), u_coil);
+    // (each coil's own glint where its dome faces halfway between the key and the eye)
+    float glint_at = max(dot(coil.xyz, normalize(u_key_dir + v)), 0.0);
+    vec3 coil_glint = u_key_col * hair_tint() * 0.4 * exp2(24.0 * log2(max(glint_at, 1e-4)))
+                    * coil_detail * smoothstep(0.2, 0.55, dot(n, v));
+    spec = mix(spec, coily_sheen(n, v, crown) + coil_glint, u_coil);
     self_shadow = mix(self_shadow, coily_self_shadow(n, v, crown), u_coil);
 #endif
     vec3 radiance = (albedo * lit + u_sheen * key_reach * spec) * self_shadow;
