@@ -677,6 +677,7 @@ void main() {
     float px = 0.5;
     float lock = 0.5;
     float lock_flow = 0.0;
+    float parting_open = 1.0;
 #else
     // On the crown, where strands run sideways from the parting (their direction on the neutral
     // head near horizontal), long01's cards lie in rows across the strands, each row starting
@@ -693,6 +694,10 @@ void main() {
         vec3 nv = normalize(v_rest - volume_axis_point(v_rest, u_hair_apex_rest));
         vec3 meridian = cross(nv, normalize(cross(vec3(0.0, 1.0, 0.0), nv) + vec3(1e-5, 0.0, 0.0)));
         flow_share = smoothstep(0.75, 0.92, abs(dot(meridian, along_rest)));
+    } else {
+        // long hair's crown: its strands follow the flow its locks follow (flow_lock_coordinate),
+        // not each card's own tangent, which turned from card to card and drew wood grain
+        flow_share = on_head;
     }
     // (strands pointing at the eye are seen end-on: their streaks shrink to dots, which
     // speckled a fringe brushed forward; there the streaks fade to their mean)
@@ -703,7 +708,7 @@ void main() {
              : on_head > 0.999 ? mix(pixel_strands(v_rest, along_rest, 60.0), px_flow, flow_share)
              : on_head < 0.001 ? pixel_strands_uv(v_uv, vec2(40.0, 1.5), vec2(5.0, 5.0) + 2.0 * phase)
              : mix(pixel_strands_uv(v_uv, vec2(40.0, 1.5), vec2(5.0, 5.0) + 2.0 * phase),
-                   pixel_strands(v_rest, along_rest, 60.0), on_head);
+                   u_along_v > 0.5 ? px_flow : pixel_strands(v_rest, along_rest, 60.0), on_head);
     // Long hair ends above u_end_height (MakeHuman's long cards hang on through the shoulders)
     // the way a cut bob does: clumps a few millimetres across end at a little different
     // lengths, and within each the strands end one by one over the last few millimetres, so
@@ -729,7 +734,7 @@ void main() {
         alpha *= tips * step(1e-4, thinning);
     }
     float px_full = px;
-    if (u_along_v > 0.5) px = mix(0.5, px, 0.4);
+    if (u_along_v > 0.5) px = mix(0.5, px, mix(0.4, 0.8, on_head));   // (the crown's: along the flow, in place of the cards')
     // Locks: strands gather into locks a few millimetres across and several long, placed on the
     // neutral head along the strands (so they run on across the cards, as px does); the narrow
     // gaps between them lie in their neighbours' shade and their crowns catch the light, so a
@@ -742,6 +747,12 @@ void main() {
     vec3 lock_nv = normalize(v_rest - volume_axis_point(v_rest, u_hair_apex_rest));
     vec3 lock_meridian = cross(lock_nv, normalize(cross(vec3(0.0, 1.0, 0.0), lock_nv) + vec3(1e-5, 0.0, 0.0)));
     float lock_flow = smoothstep(0.6, 0.85, abs(dot(lock_meridian, along_rest)));
+    // Hair whose texture runs along v (long01, the bobs) hangs down and out from the crown as a
+    // whole: its locks follow that flow everywhere. Switched by each card's own tangent (the crown's
+    // cards lie every way), the locks and their dark partings changed pattern at every card's
+    // edge and drew the crown's cards as dark rectangles (ava's and mei's "helmet hair", blind
+    // review session 25, 26 of 26 images).
+    lock_flow = max(lock_flow, u_along_v);
     vec3 flow_lock_p = flow_lock_coordinate(v_rest);
     float smear_fade = clamp(2.5 - 1.6 * length(fwidth(lock_p)), 0.0, 1.0);
     float flow_fade = clamp(2.5 - 1.6 * length(fwidth(flow_lock_p)), 0.0, 1.0);
@@ -750,6 +761,10 @@ void main() {
         lock = mix(0.5, smeared_noise(lock_p + 19.0, 1.6 * along_rest), smear_fade);
     if (lock_flow > 0.001)
         lock = mix(lock, mix(0.5, lattice_noise3(flow_lock_p + 19.0), flow_fade), lock_flow);
+    // The partings between locks open and close along their length (a lock crosses over its
+    // neighbour, strands bridge the gap), a centimetre or two at a time: unbroken, they ran from
+    // the crown to the ends as ruled lines.
+    float parting_open = smoothstep(0.3, 0.62, lattice_noise3(flow_lock_p * vec3(1.3, 4.0, 1.3) + 53.0));
     // (long hair's crown, combed flat sideways from the parting, shows shallower gaps than its
     // hanging lengths: at full depth there its locks drew bands across the crown)
     lock = clamp(0.5 + mix(1.6, 0.8, on_head * u_along_v) * (lock - 0.5), 0.0, 1.0);
@@ -841,6 +856,18 @@ void main() {
     mid = mix(0.5, value_noise(mp, 0), along_v * clamp(2.0 - 1.4 * fwidth(mp.x), 0.0, 1.0));
     cp += 0.5 * phase;
     clump = mix(0.5, value_noise(cp, 0), along_v * clamp(2.0 - 1.5 * fwidth(cp.x), 0.0, 1.0));
+#ifndef COILY
+    // Long hair's crown: the cards' own texture and UV clumps run along each card (sideways
+    // there, a card to a row) and stop at its edge: they drew the rows as wood grain and the
+    // cards as blocks under strands and locks that follow the flow. They keep a little say.
+    {
+        float card_say = 1.0 - 0.75 * on_head * u_along_v;
+        tex.r = mix(0.5, tex.r, card_say);
+        fine = mix(0.5, fine, card_say);
+        mid = mix(0.5, mid, card_say);
+        clump = mix(0.5, clump, card_say);
+    }
+#endif
     // (px: strands and clumps a couple of pixels across, so the breakup shows at any size.)
     float strand = (0.62 + 0.76 * tex.r) * (0.7 + 0.6 * fine) * (0.6 + 0.8 * px) * (0.8 + 0.4 * mid)
                  * (0.9 + 0.2 * clump);
@@ -904,7 +931,7 @@ void main() {
     float key_reach = 1.0;
 #endif
     // the parting between two locks running down the flow (a narrow crevice: shade, little highlight)
-    float parting = smoothstep(0.7, 1.0, lock_flow) * lock_gap(lock);
+    float parting = smoothstep(0.7, 1.0, lock_flow) * lock_gap(lock) * parting_open;
     float layer = smoothstep(0.0, 0.95, v_depth);
     // (light hair's under-layers and gaps kept 0.7 and 0.85 of the light: george's and
     // margaret's grey read as a flat pale helmet without the depth a photograph shows between
