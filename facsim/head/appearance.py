@@ -298,7 +298,7 @@ DETAIL_SIZE = (2048, 1024)  # rows (v), columns (u) over assets.PAINT_UV_BOX; fi
 
 
 #: Bump when the detail recipe changes, so cached detail textures are redone.
-DETAIL_VERSION = 8  # 8: the lips' mucosa in A; 7: the age lines moved to the fold map (facsim.head.skin.fold_texture); 6: wider grooves; 5: positions upsampled cubically; 4: 2048 rows; 3: sheen on the cheekbones; 2: irregular age lines, an asymmetric nasolabial fold
+DETAIL_VERSION = 9  # 9: the beard area over the jaw and lower cheeks to the sideburns; 8: the lips' mucosa in A; 7: the age lines moved to the fold map (facsim.head.skin.fold_texture); 6: wider grooves; 5: positions upsampled cubically; 4: 2048 rows; 3: sheen on the cheekbones; 2: irregular age lines, an asymmetric nasolabial fold
 
 
 @lru_cache(maxsize=2)
@@ -367,13 +367,21 @@ def redness_density(positions: np.ndarray) -> np.ndarray:
 
 
 def beard_density(positions: np.ndarray) -> np.ndarray:
-    """A man's beard area: upper lip, chin, jaw and lower cheeks, fading up the cheek."""
+    """A man's beard area: upper lip, chin, jaw and the cheeks below the cheekbones, back to the
+    sideburns, fading up the cheek.
+
+    The cheek line runs from the nostrils' wings up and out to the sideburns in front of the ear
+    (until session 26 it fell toward the ear and stopped 7 mm short of the jaw's sides: at 448 px
+    a muzzle round the mouth, and the jaw of george, kofi and the young men as bare as a woman's).
+    """
     x, y, z = np.abs(positions[..., 0]), positions[..., 1], positions[..., 2]
-    top = 6.86 - 0.55 * np.clip(x - 0.12, 0, None)          # beard line, lower toward the ear
-    below_line = smoothstep(top + 0.05, top - 0.08, y)
-    not_neck = smoothstep(5.85, 6.05, y) * smoothstep(0.45, 0.8, z)
+    top = 6.84 - 0.3 * np.clip(x - 0.12, 0, 0.12) + 0.42 * np.clip(x - 0.26, 0, 0.46)   # the cheek line
+    below_line = smoothstep(top + 0.06, top - 0.1, y)
+    not_neck = smoothstep(5.85, 6.05, y) * smoothstep(0.5, 0.72, z)
     off_nose = 1 - _blob(positions, (0.0, 6.86, 1.6), (0.11, 0.05, 0.3))
-    return np.clip(below_line * not_neck * off_nose * smoothstep(0.72, 0.6, x), 0, 1).astype(np.float32)
+    # The ear and the skin behind it stay bare: the sideburn ends in front of the tragus.
+    off_ear = 1 - smoothstep(0.66, 0.76, x) * smoothstep(0.85, 0.7, z)
+    return np.clip(below_line * not_neck * off_nose * off_ear * smoothstep(0.84, 0.74, x), 0, 1).astype(np.float32)
 
 
 def oil_density(positions: np.ndarray) -> np.ndarray:

@@ -155,9 +155,10 @@ const float STUBBLE_GRAIN = 1.5;
 // the skin are a blue-grey shadow (DARK_STUBBLE); grey and white ones (brows as light as george's,
 // linear luminance ~0.13: the beard greys with them) a fainter, neutral one (GREY_STUBBLE). (Until
 // session 24 the dark hairs' blue-grey on every man: over george's sallow skin his lower face drew
-// lilac.)
-const vec3 DARK_STUBBLE = vec3(0.70, 0.72, 0.78);
-const vec3 GREY_STUBBLE = vec3(0.79, 0.78, 0.77);
+// lilac.) A man's shaved jaw reads at a glance (session 26: at 0.70/0.79 the chin was only 6 L*
+// darker, 4 under grey stubble, and george was taken for a woman).
+const vec3 DARK_STUBBLE = vec3(0.56, 0.59, 0.68);
+const vec3 GREY_STUBBLE = vec3(0.68, 0.68, 0.67);
 vec3 stubble_shade() {
     return mix(DARK_STUBBLE, GREY_STUBBLE, smoothstep(0.05, 0.15, dot(u_brows, LUMINANCE)));
 }
