@@ -494,10 +494,12 @@ void main() {
         // where its rank is under the density, so the hairline ends in short coils standing
         // apart on the skin, not in a soft dark film along a clean line (blind review session 25).
         float detail, rank;
-        vec4 coil = coil_dome(v_rest, n, detail, rank);
+        // (the hairline's hairs are shorter and finer than the mass's: coils 1.4 times smaller,
+        // over a little of the fine cover they grow from)
+        vec4 coil = coil_dome(v_rest * 1.4, n, detail, rank);
         float present = smoothstep(rank - 0.08, rank + 0.08, 1.6 * dens - 0.1);
         float disc = clamp(0.5 + (coil.w - 0.2) / max(fwidth(coil.w), 0.05), 0.0, 1.0);
-        alpha = mix(alpha, 0.95 * present * disc, detail);
+        alpha = mix(alpha, max(0.3 * alpha, 0.95 * present * disc), detail);
         float coil_key = clamp(dot(coil.xyz - n, u_key_dir) + 0.5, 0.0, 1.0);
         strand_shade = mix(strand_shade, mix(0.6, 1.2, coil.w) * (0.7 + 0.6 * coil_key) * (0.85 + 0.3 * rank), detail);
         light_hair *= 0.4;
@@ -985,10 +987,12 @@ void main() {
     vec3 spec = vec3(0.0);
 #endif
 #ifdef COILY
-    // (each coil's own glint where its dome faces halfway between the key and the eye)
+    // (each coil's own glint where its dome faces halfway between the key and the eye, some
+    // coils brighter than others and those on the clumps' crowns most: an even glint on every
+    // coil drew a regular lattice of dots)
     float glint_at = max(dot(coil.xyz, normalize(u_key_dir + v)), 0.0);
-    vec3 coil_glint = u_key_col * hair_tint() * 0.4 * exp2(24.0 * log2(max(glint_at, 1e-4)))
-                    * coil_detail;
+    vec3 coil_glint = u_key_col * hair_tint() * 0.5 * exp2(24.0 * log2(max(glint_at, 1e-4)))
+                    * coil_detail * (0.2 + 1.3 * coil_id * coil_id) * mix(0.3, 1.2, crown);
     spec = mix(spec, coily_sheen(n, v, crown) + coil_glint, u_coil);
     self_shadow = mix(self_shadow, coily_self_shadow(n, v, crown, v_pos.y - dome_base(u_hair_apex)), u_coil);
 #endif
