@@ -311,8 +311,12 @@ float coily_clumps(vec3 q) {
 // turned down), where it overhangs the forehead and the temples, and its clumps' hollows lie in
 // their crowns' shade (crown). Only the mass's broad shape counts, not which card is drawn
 // where: the cards' layers (v_depth) and UV noise drew the cards' shapes as dark patches in it.
-float coily_self_shadow(vec3 n, vec3 v, float crown) {
-    float underside = mix(0.45, 1.0, smoothstep(-0.55, 0.35, n.y));
+// The mass is lit more the higher it stands (height: dm over the dome's base, about the top of
+// the forehead): its top takes the key and the sky, its lower part over the forehead and the
+// temples lies deeper in the hair's own shade (one even tone from crown to temples read as a
+// helmet of foam, blind review session 25).
+float coily_self_shadow(vec3 n, vec3 v, float crown, float height) {
+    float underside = mix(0.45, 1.0, smoothstep(-0.55, 0.35, n.y)) * mix(0.72, 1.1, smoothstep(-0.5, 0.6, height));
     // (light falls off a little into the mass where the eye looks straight in)
     float facing = mix(0.9, 1.0, 1.0 - clamp(dot(n, v), 0.0, 1.0));
     return underside * facing * mix(0.85, 1.0, crown);
@@ -490,10 +494,12 @@ void main() {
         // where its rank is under the density, so the hairline ends in short coils standing
         // apart on the skin, not in a soft dark film along a clean line (blind review session 25).
         float detail, rank;
-        vec4 coil = coil_dome(v_rest, n, detail, rank);
+        // (the hairline's hairs are shorter and finer than the mass's: coils 1.4 times smaller,
+        // over a little of the fine cover they grow from)
+        vec4 coil = coil_dome(v_rest * 1.4, n, detail, rank);
         float present = smoothstep(rank - 0.08, rank + 0.08, 1.6 * dens - 0.1);
         float disc = clamp(0.5 + (coil.w - 0.2) / max(fwidth(coil.w), 0.05), 0.0, 1.0);
-        alpha = mix(alpha, 0.95 * present * disc, detail);
+        alpha = mix(alpha, max(0.3 * alpha, 0.95 * present * disc), detail);
         float coil_key = clamp(dot(coil.xyz - n, u_key_dir) + 0.5, 0.0, 1.0);
         strand_shade = mix(strand_shade, mix(0.6, 1.2, coil.w) * (0.7 + 0.6 * coil_key) * (0.85 + 0.3 * rank), detail);
         light_hair *= 0.4;
@@ -647,9 +653,9 @@ void main() {
     // (the single coils under this pixel, coil_dome: its outline, its thinning and its shading)
     float coil_detail, coil_id;
     vec4 coil = coil_dome(v_rest, n, coil_detail, coil_id);
-    // (toward the outline the eye grazes the mass and the coils, a pixel across there, would
-    // speckle it: they fade out, and the outline is the clumps')
-    coil_detail *= smoothstep(0.2, 0.55, dot(n, v));
+    // (only at the outline, where the eye grazes the mass and each card layer shows its own
+    // coils, do they fade out of the shading)
+    coil_detail *= smoothstep(0.05, 0.25, dot(n, v));
 #endif
     // Strand coordinates: across the strands (u) many, along them (v) few. Each noise fades
     // to its mean where it would be finer than a pixel, so small images do not shimmer.
@@ -816,7 +822,9 @@ void main() {
     // them: curls finer than a pixel thinned it into a grey translucent film (the tufts over
     // the ears).
     // (and the clumps' edges break into single coils, so the hairline ends in short coils)
-    float thin_at = coily_clumps(coil_place(v_rest)) - 0.3 * coil_detail * (coil.w - 0.6);
+    // (not toward the outline, where coils a pixel across would speckle it: the outline is the clumps')
+    float thin_at = coily_clumps(coil_place(v_rest))
+                  - 0.3 * coil_detail * smoothstep(0.2, 0.55, dot(n, v)) * (coil.w - 0.6);
     float thin_by = 1.3 * v_cover - 0.15 - thin_at;
     alpha *= clamp(0.5 + thin_by / max(fwidth(thin_by), 0.002), 0.0, 1.0);
 #else
@@ -885,17 +893,17 @@ void main() {
         // stripes, fades to its mean; the outline's own clumps break it up)
         float seen = smoothstep(0.2, 0.55, dot(n, v));
         float bump = mix(0.5, coily_clumps(q), seen);
-        float coils = mix(0.5, coil_id, seen * coil_detail);
+        float coils = mix(0.5, coil_id, coil_detail);
         crown = smoothstep(0.3, 0.7, bump);
         // (light hair scatters light into the hollows: grey afros' at full depth drew them as
         // blotchy camouflage)
         float light = sqrt(clamp(dot(u_color, LUMINANCE), 0.0, 1.0));
         // Each coil: its top and its side toward the key lighter, the crevices round it darker.
-        float single = seen * coil_detail;
+        float single = coil_detail;
         float coil_key = clamp(dot(coil.xyz - n, u_key_dir) + 0.5, 0.0, 1.0);
         // (light hair scatters light into the crevices: grey coils at full depth read as gravel)
         float coil_shade = mix(1.0, mix(mix(0.45, 0.7, light), 1.1, coil.w) * (0.7 + 0.6 * coil_key)
-                                  * (0.85 + 0.3 * coil_id), single);
+                                  * (0.85 + 0.3 * coil_id), single * mix(1.0, 0.7, light));
         strand = mix(strand, mix(mix(0.55, 0.75, light), mix(1.15, 1.05, light), crown) * coil_shade, u_coil);
         // Greying coily hair mixes white, grey and dark coils (placed on the head, not in the
         // cards' mirrored UVs), finer than its clumps: clumps of white and dark drew grey afros
@@ -1006,12 +1014,14 @@ void main() {
     vec3 spec = vec3(0.0);
 #endif
 #ifdef COILY
-    // (each coil's own glint where its dome faces halfway between the key and the eye)
+    // (each coil's own glint where its dome faces halfway between the key and the eye, some
+    // coils brighter than others and those on the clumps' crowns most: an even glint on every
+    // coil drew a regular lattice of dots)
     float glint_at = max(dot(coil.xyz, normalize(u_key_dir + v)), 0.0);
-    vec3 coil_glint = u_key_col * hair_tint() * 0.4 * exp2(24.0 * log2(max(glint_at, 1e-4)))
-                    * coil_detail * smoothstep(0.2, 0.55, dot(n, v));
+    vec3 coil_glint = u_key_col * hair_tint() * 0.5 * exp2(24.0 * log2(max(glint_at, 1e-4)))
+                    * coil_detail * (0.2 + 1.3 * coil_id * coil_id) * mix(0.3, 1.2, crown);
     spec = mix(spec, coily_sheen(n, v, crown) + coil_glint, u_coil);
-    self_shadow = mix(self_shadow, coily_self_shadow(n, v, crown), u_coil);
+    self_shadow = mix(self_shadow, coily_self_shadow(n, v, crown, v_pos.y - dome_base(u_hair_apex)), u_coil);
 #endif
     vec3 radiance = (albedo * lit + u_sheen * key_reach * spec) * self_shadow;
 #else
