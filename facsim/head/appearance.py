@@ -65,6 +65,9 @@ class Appearance:
         A = the lips' mucosa (their wet inner surface, :func:`facsim.head.mouth.lip_mucosa`).
     beard : float
         0 … 1: how much the beard area shows a shaved stubble shadow.
+    beard_grey : float
+        0 … 1: how grey the stubble is, from dark hairs' blue-grey shadow to grey and white
+        hairs' fainter, neutral one (it follows the scalp hair, not the brows, which grey later).
     age : float
         0 … 1: how strongly the age lines of ``folds`` show (and the skin's mottling).
     tone : (H, W, 4) uint8, optional
@@ -89,6 +92,7 @@ class Appearance:
     paint: np.ndarray | None = None
     detail: np.ndarray | None = None
     beard: float = 0.0
+    beard_grey: float = 0.0
     age: float = 0.0
     tone: np.ndarray | None = None
     freckles: float = 0.0
@@ -126,7 +130,7 @@ class Appearance:
                 value = np.asarray(value)
                 if value.ndim != 3 or value.shape[2] != 4 or value.dtype != np.uint8:
                     raise ValueError(f"{name} must be an (H, W, 4) uint8 array, got {value.dtype} {value.shape}")
-        for name, top in (("beard", 1.0), ("age", 1.0), ("freckles", 1.0), ("redness", 2.0), ("seed", 1000.0)):
+        for name, top in (("beard", 1.0), ("beard_grey", 1.0), ("age", 1.0), ("freckles", 1.0), ("redness", 2.0), ("seed", 1000.0)):
             value = float(getattr(self, name))
             if not 0.0 <= value <= top:
                 raise ValueError(f"{name} must be in [0, {top:g}], got {value}")
@@ -282,13 +286,18 @@ def character_appearance(character: Character, head, *, blush: float | None = No
         # A faint flush on the cheeks' apples, more on women (until session 20 0.35 and 0.12 of a
         # redder colour: session 19 measured the cheeks above in-vivo skin's chroma, mei C* 28).
         blush = 0.2 * (1.0 - character.gender) + 0.06
-    colors = {k: v for k, v in character_colors(character).items() if k in COLOR_NAMES}
+    every_color = character_colors(character)
+    colors = {k: v for k, v in every_color.items() if k in COLOR_NAMES}
     # A shaved beard shows as a faint blue-grey shadow on men; age lines from about 35.
     beard = float(np.clip((character.gender - 0.5) * 2, 0, 1) * np.clip((character.age - 16) / 6, 0, 1)) * 0.8
+    # The stubble greys with the scalp hair (linear luminance: dark brown ~0.03, GREY_HAIR 0.36).
+    hair_luminance = float(srgb_to_linear(np.asarray(every_color["hair"])) @ np.array([0.2126, 0.7152, 0.0722]))
+    beard_grey = float(smoothstep(0.08, 0.25, hair_luminance))
     age = float(np.clip((character.age - 32) / 45, 0, 1))
     own = complexion(character)
     return Appearance(colors=colors, paint=paint_texture(head, round(blush, 3), painted_brows),
-                      detail=detail_texture(head), beard=round(beard, 3), age=round(age, 3),
+                      detail=detail_texture(head), beard=round(beard, 3), beard_grey=round(beard_grey, 3),
+                      age=round(age, 3),
                       tone=tone_texture(head, position_map), freckles=own.freckles, redness=own.redness,
                       seed=own.seed, folds=fold_texture(head, position_map))
 

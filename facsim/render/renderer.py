@@ -455,6 +455,7 @@ class Renderer:
             for key in ("skin", "lips", "brows", "eyelid", "cheek"):
                 _set_uniform(prog, f"u_{key}", lin(key))
             _set_uniform(prog, "u_beard", appearance.beard)
+            _set_uniform(prog, "u_beard_grey", appearance.beard_grey)
             _set_uniform(prog, "u_age", appearance.age)
             _set_uniform(prog, "u_freckles", appearance.freckles)
             _set_uniform(prog, "u_redness", appearance.redness)

@@ -85,6 +85,7 @@ uniform sampler2D u_folds;   // R forehead lines + crow's feet, G under-eye line
                              // A where R and G replace the engine's furrows (facsim.head.skin)
 uniform sampler2D u_tone;    // R darker skin (eyes, mouth, temples), G translucency, B pores, A sun (facsim.head.skin)
 uniform float u_beard;       // 0..1 stubble shadow
+uniform float u_beard_grey;  // 0..1 how grey the stubble is (facsim.head.appearance.Appearance)
 uniform float u_age;         // 0..1 how much the age lines show
 uniform vec3 u_skin;
 uniform vec3 u_lips;
@@ -151,16 +152,21 @@ float pore_aggregate(vec2 p) {
 // at 1-mm cells and 3.0 the stubble drew a camouflage of blotches.)
 const vec2 STUBBLE_CELLS = vec2(700.0, 1400.0);
 const float STUBBLE_GRAIN = 1.5;
-// The stubble's shade over the skin (a multiplier where it is full): dark hairs seen in and through
-// the skin are a blue-grey shadow (DARK_STUBBLE); grey and white ones (brows as light as george's,
-// linear luminance ~0.13: the beard greys with them) a fainter, neutral one (GREY_STUBBLE). (Until
-// session 24 the dark hairs' blue-grey on every man: over george's sallow skin his lower face drew
-// lilac.) A man's shaved jaw reads at a glance (session 26: at 0.70/0.79 the chin was only 6 L*
-// darker, 4 under grey stubble, and george was taken for a woman).
+// The stubble over the skin where it is full: dark hairs seen in and through the skin are a
+// blue-grey shadow (DARK_STUBBLE, a multiplier); grey and white ones (u_beard_grey: the beard greys
+// with the scalp hair) shade the skin less (their follicles' shadow, GREY_STUBBLE_SHADE) and cover a
+// share of it (GREY_STUBBLE_COVER) in their own grey (GREY_STUBBLE, linear): a light skin greys and
+// darkens, a dark one greys, a little lighter. (Until session 24 the dark hairs' blue-grey on every
+// man: over george's sallow skin his lower face drew lilac. Until session 26 the shades were 0.70/
+// 0.72/0.78 and 0.79, a multiplier both: the chin 6 L* darker, george taken for a woman, and
+// kofi's white stubble did not show; a 0.4 cover of grey drew an ashen mask on him.)
 const vec3 DARK_STUBBLE = vec3(0.56, 0.59, 0.68);
-const vec3 GREY_STUBBLE = vec3(0.68, 0.68, 0.67);
-vec3 stubble_shade() {
-    return mix(DARK_STUBBLE, GREY_STUBBLE, smoothstep(0.05, 0.15, dot(u_brows, LUMINANCE)));
+const vec3 GREY_STUBBLE = vec3(0.22, 0.21, 0.195);
+const float GREY_STUBBLE_SHADE = 0.8;
+const float GREY_STUBBLE_COVER = 0.2;
+vec3 stubbled(vec3 albedo, float stubble) {
+    vec3 grey = mix(albedo * GREY_STUBBLE_SHADE, GREY_STUBBLE, GREY_STUBBLE_COVER);
+    return mix(albedo, mix(albedo * DARK_STUBBLE, grey, u_beard_grey), stubble);
 }
 
 // The skin's unevenness between the blotches and the regional maps (5-30 mm, what a photograph of
@@ -828,7 +834,7 @@ void main() {
     if (stubble > 0.0) {
         stubble *= clamp(1.0 + STUBBLE_GRAIN * pore_aggregate(stubble_uv, stubble_px), 0.0, 2.0);
     }
-    albedo = mix(albedo, albedo * stubble_shade(), stubble);
+    albedo = stubbled(albedo, stubble);
     // Age spots (solar lentigines): sparse, soft tan patches a few millimetres to a centimetre
     // across where the sun reaches, growing with age. (Until session 20 they were the peaks of the
     // few-mm blotches, an orange multiplier: on george's forehead a rash of small red-brown dots.)
