@@ -768,3 +768,22 @@ def test_the_upper_front_teeth_differ_by_kind(face_of):
 
     central, lateral = crown(0.0425), crown(0.1175)    # dm: the middle of each crown along the arch
     assert lateral < 0.84 * central, (lateral, central)
+
+
+@pytest.mark.parametrize("character", ["amara", "ava", "mei"])
+@pytest.mark.parametrize("expression", ["23E", "24E"])
+def test_pressed_lips_red_takes_no_skin_furrows(face_of, character, expression):
+    """Session 26: the lips' red does not buckle into the skin's compression furrows (muscles.yaml
+    `wrinkles: lips_gain`). Tightened by 23 (anger's mouth), the crease field drew a fold across amara's
+    full lower lip and wavy lines over the others' ("warped/clipping lower lip", session 25's blind
+    reviewer, amara's anger at 100 %): crease strength on the red at most 0.24-0.51 on main."""
+    from facsim.engines.muscle.net import OUTER, anatomy, mask_per_vertex
+
+    face = face_of(character)
+    anat = anatomy(face.head)
+    count = anat.skin_count
+    lips = mask_per_vertex(face.head, "lips")[:count]
+    red = (np.maximum(lips, lips[anat.mirror[:count]]) > 0.5) & (anat.kind == OUTER)
+    assert red.sum() > 100
+    strength, _ = face.deform(expression).creases()
+    assert strength[:count][red].max() < 0.02, strength[:count][red].max()

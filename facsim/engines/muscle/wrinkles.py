@@ -119,6 +119,10 @@ def build_wrinkles(anat: Anatomy, net: TensionNet, spec: dict) -> WrinkleModel:
                                                                  np.r_[edges[:, 0], edges[:, 1]])), shape=(m, n))
     # The graph Laplacian never changes, so it is factorised once; ε pins the free constant.
     integrate = spla.factorized((incidence.T @ incidence + 1e-4 * sp.identity(n)).tocsc())
+    if "lips_gain" in w:
+        red = _lips_red(anat, smooth)
+        zone_gain = zone_gain * (1.0 - (1.0 - float(w["lips_gain"])) * red)
+        across_gain = across_gain * (1.0 - (1.0 - float(w["lips_gain"])) * red)
     return WrinkleModel(
         triangles=tri, rest_inverse=inv, rest_frame=frame, to_vertex=to_vertex.tocsr(), rest=rest,
         wavelength=wavelength, zone_gain=zone_gain, threshold=threshold, across_gain=across_gain, straight=np.clip(straight * 4.0, 0.0, 1.0),
@@ -128,6 +132,16 @@ def build_wrinkles(anat: Anatomy, net: TensionNet, spec: dict) -> WrinkleModel:
         smooth=smooth.tocsr(), passes=int(w.get("smoothing", 2)),
         edges=edges, incidence=incidence, integrate=integrate,
     )
+
+
+def _lips_red(anat: Anatomy, smooth: sp.csr_matrix, passes: int = 2) -> np.ndarray:
+    """(N,) 1 on the lips' red (either lip, outer skin), fading to 0 over about a ring of points
+    beyond the vermilion border, so the crease gain there changes smoothly, not at one edge."""
+    red = ((anat.lip_half != 0) & (anat.kind == OUTER)).astype(float)
+    soft = red
+    for _ in range(passes):
+        soft = smooth @ soft
+    return np.maximum(red, np.clip(2.0 * soft, 0.0, 1.0))
 
 
 def _blob(zone, points) -> np.ndarray:
