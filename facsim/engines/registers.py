@@ -337,6 +337,9 @@ class RegisterEngine:
             reach = (register_table().get("corner_reach") or {}).get(col.pattern)
             if reach:
                 offsets = self._near_the_corner(offsets, col.side, reach)
+            ungathered = (register_table().get("brows_not_gathered") or {}).get(col.pattern)
+            if ungathered:
+                offsets = self._brows_not_gathered(offsets, ungathered)
             offsets *= (self._reach if col.sided else self._half)[:, None]
             self._columns[col] = offsets
         return self._columns[col]
@@ -469,6 +472,21 @@ class RegisterEngine:
         if passes:
             out = self._smoothed_beyond_the_lips(out, passes, (share <= 0.0) | (share >= 1.0))
         return out.astype(offsets.dtype)
+
+    def _brows_not_gathered(self, offsets: np.ndarray, spec: Mapping[str, float]) -> np.ndarray:
+        """``offsets`` (N_base_geo, 3) without their motion across the face (x) at the brows and above:
+        kept in full ``spec["full_mm"]`` or more below the inner brows' line, none from ``spec["none_mm"]``
+        below it up (``brows_not_gathered`` in the table). The motion up and down is kept."""
+        from facsim.head.landmarks import landmarks
+
+        positions = self.base_positions[self.head.base_index]
+        marks = landmarks(self.head)
+        brows = float(np.mean([positions[marks[f"inner_brow_{s}"], 1] for s in ("left", "right")]))
+        below = brows - positions[:, 1]
+        share = smoothstep(float(spec["none_mm"]) / 100.0, float(spec["full_mm"]) / 100.0, below)
+        out = np.array(offsets, copy=True)
+        out[:, 0] *= share
+        return out
 
     def _smoothed_beyond_the_lips(self, offsets: np.ndarray, passes: int, held: np.ndarray) -> np.ndarray:
         """``offsets`` (N_base_geo, 3) with the skin beyond the lips following them smoothly: its motion
