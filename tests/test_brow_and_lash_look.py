@@ -138,3 +138,19 @@ def test_older_peoples_greying_brows_still_show(name, least):
     above &= cover < 0.02
     contrast = np.median(lightness[above]) - np.median(lightness[brow])
     assert contrast > least, contrast
+
+
+@pytest.mark.parametrize("old, young", [("margaret", "ava"), ("george", "liam")])
+def test_older_peoples_lips_are_thinner(old, young):
+    """Lips thin with age (the red narrows as the lip's volume goes), a cue strangers read age by:
+    at 256 px the red of margaret's and george's lips at the midline is under 0.7 as tall as that of
+    a young face's of their sex and ancestry (ava, liam) (main 9f8b92e: 0.76 and 0.78; now 0.61
+    and 0.65: characters.yaml's mouth-upperlip-height and mouth-lowerlip-height on the older
+    presets; mouth-*lip-volume hardly changed the red seen from the front)."""
+    size = 256
+
+    def red_height(name):
+        _, cover = _coverage(preset(name).with_(symmetric=True), "lips", size=size)
+        return cover[:, size // 2 - 5:size // 2 + 5].sum(axis=0).mean()
+
+    assert red_height(old) < 0.7 * red_height(young)
