@@ -616,7 +616,7 @@ def test_the_afro_shows_single_coils_and_a_hairline_of_short_coils(face_of, name
     on the skin: session 25's mass of smooth clumps read as a "blobby afro" (blind review,
     13 notes), its hairline as a soft dark film along a clean line. At 448² on main 9f8b92e:
     grain 0.053 / 0.037 (amara / ngozi), glints 1.6 / 0.35 per 100 px, hairline 0.030 / 0.065;
-    now 0.34 / 0.11, 5.1 / 3.6, 0.14 / 0.21. (The outline, its halo and fragments are
+    now 0.28 / 0.10, 5.0 / 3.1, 0.13 / 0.21. (The outline, its halo and fragments are
     test_the_afro_is_a_dense_mass_with_coils_not_a_halo_or_fragments's.)"""
     figures = _coil_figures(face_of(name))
     assert figures["grain"] > 0.07, figures

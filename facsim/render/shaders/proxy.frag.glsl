@@ -656,6 +656,11 @@ void main() {
     // (only at the outline, where the eye grazes the mass and each card layer shows its own
     // coils, do they fade out of the shading)
     coil_detail *= smoothstep(0.05, 0.25, dot(n, v));
+    // (where a coil spans many pixels, 1024², the hairs wound in it break up its dome and its
+    // glint: smooth domes read as beads)
+    vec3 coil_hair_p = COIL_TURN_B * v_rest * 140.0;
+    float coil_hair_fade = clamp(2.0 - 1.4 * length(fwidth(coil_hair_p)), 0.0, 1.0) * coil_detail;
+    float coil_hairs = coil_hair_fade > 0.0 ? mix(1.0, 0.3 + 1.4 * lattice_noise3(coil_hair_p), coil_hair_fade) : 1.0;
 #endif
     // Strand coordinates: across the strands (u) many, along them (v) few. Each noise fades
     // to its mean where it would be finer than a pixel, so small images do not shimmer.
@@ -903,7 +908,7 @@ void main() {
         float coil_key = clamp(dot(coil.xyz - n, u_key_dir) + 0.5, 0.0, 1.0);
         // (light hair scatters light into the crevices: grey coils at full depth read as gravel)
         float coil_shade = mix(1.0, mix(mix(0.45, 0.7, light), 1.1, coil.w) * (0.7 + 0.6 * coil_key)
-                                  * (0.85 + 0.3 * coil_id), single * mix(1.0, 0.7, light));
+                                  * (0.85 + 0.3 * coil_id) * coil_hairs, single * mix(1.0, 0.7, light));
         strand = mix(strand, mix(mix(0.55, 0.75, light), mix(1.15, 1.05, light), crown) * coil_shade, u_coil);
         // Greying coily hair mixes white, grey and dark coils (placed on the head, not in the
         // cards' mirrored UVs), finer than its clumps: clumps of white and dark drew grey afros
@@ -1019,7 +1024,7 @@ void main() {
     // coil drew a regular lattice of dots)
     float glint_at = max(dot(coil.xyz, normalize(u_key_dir + v)), 0.0);
     vec3 coil_glint = u_key_col * hair_tint() * 0.5 * exp2(24.0 * log2(max(glint_at, 1e-4)))
-                    * coil_detail * (0.2 + 1.3 * coil_id * coil_id) * mix(0.3, 1.2, crown);
+                    * coil_detail * (0.2 + 1.3 * coil_id * coil_id) * mix(0.3, 1.2, crown) * coil_hairs * coil_hairs;
     spec = mix(spec, coily_sheen(n, v, crown) + coil_glint, u_coil);
     self_shadow = mix(self_shadow, coily_self_shadow(n, v, crown, v_pos.y - dome_base(u_hair_apex)), u_coil);
 #endif
