@@ -895,3 +895,49 @@ def test_a_high_softbox_key_leaves_a_soft_sheen_on_an_oily_forehead_not_a_glare(
     box = (slice(y - 25, y + 25), slice(x - 40, x + 40))       # ~5 x 8 cm of the forehead
     glare = np.percentile(gaussian_filter(specular, 1.5)[box], 99) / np.median(full[box])
     assert glare < 0.75, glare
+
+
+# --- session 26, skin: the scattered light's red is the shade's, not the lit skin's ---
+
+def _linear(image):
+    rgb = image[..., :3].astype(float) / 255
+    return np.where(rgb <= 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4)
+
+
+@pytest.mark.parametrize("name", ["ava", "liam"])
+def test_the_fill_on_lit_skin_is_not_redder_than_the_key_only_the_shade_is(face_of, marks, name):
+    """The skin's albedo already is the colour of light that has come back out of it: on open skin that
+    the key lights, the fill (a neutral light, the key the warmer one) comes back no redder than the key
+    (R/G of the light each leaves on the cheeks, linear, at 448 px; session 25's main: 1.04 for ava, 1.07
+    for liam, every lit face a little pink, "waxy"; now 0.86 and 0.89), while where the key does not
+    reach, the light that does comes out redder than the key's on the cheek (main and now 1.07-1.08)."""
+    size = 448
+    face = face_of(name)
+    camera = face.camera(size=(size, size))
+    renderer = face.renderer(size=size, body="none")
+    default = renderer.lighting
+
+    def draw():
+        return _linear(renderer.render(face.neutral, appearance=face.appearance, camera=camera,
+                                       occlusion=face.shading_occlusion))
+    full = draw()
+    renderer.lighting = dataclasses.replace(default, fill_color=(0, 0, 0), rim_color=(0, 0, 0), sky=(0, 0, 0),
+                                            ground=(0, 0, 0))
+    try:
+        key = draw()
+    finally:
+        renderer.lighting = default
+    rest = np.clip(full - key, 1e-4, None)   # the fill's, the rim's and the room's light
+    left, right = face.neutral[marks["cheek_left"]], face.neutral[marks["cheek_right"]]
+    cheeks = np.zeros((size, size), bool)
+    for point in (left + [-0.08, 0.02, 0.1], right + [0.08, 0.02, 0.1]):
+        (x, y), = project(camera, [point], size)[0].astype(int)
+        cheeks[y - 8:y + 9, x - 8:x + 9] = True
+    luminance = np.array([0.2126, 0.7152, 0.0722])
+    skin = (full.min(-1) < 0.9) & (full @ luminance > 0.02)
+    shade = skin & (key @ luminance < 0.15 * (full @ luminance))
+
+    def red_over_green(light, mask):
+        return np.median(light[mask][:, 0] / light[mask][:, 1])
+    assert red_over_green(rest, cheeks) < red_over_green(key, cheeks), (red_over_green(rest, cheeks), red_over_green(key, cheeks))
+    assert red_over_green(rest, shade) > 1.04 * red_over_green(key, cheeks)

@@ -216,6 +216,18 @@ const float MESH_FOLD_FULL = 0.1;
 // How much of each channel's diffuse light sees the scattered normal (v_scatter_normal) rather
 // than the surface's own: red travels furthest under the skin, blue least.
 const vec3 SCATTER_SOFTNESS = vec3(0.6, 0.3, 0.12);
+// The shade's light comes out of the skin redder and more saturated (see main): SHADE_SCATTER_TINT
+// multiplies the light other than the key's where it is most of the light, over SHADE_TINT_FROM to
+// SHADE_TINT_FULL of it (the key's own shade: the nose's and jaw's undersides, the sides turned from it).
+// On open skin the key lights (the fill there ~1/4 of the light) the albedo already is the colour of
+// light that has come back out of the skin: tinting the fill there too made every lit face pinker
+// (session 25: at 448 px the lit cheeks' fill light 4-7 % redder, R/G, than the key's, which is the
+// warmer light; the cheeks at CIELAB C* 24-27, hue 49-52, above skin's 17-23 measured in vivo:
+// "waxy" ava and mei, "plastic" liam). Green loses less than blue, as light filtered twice by the
+// skin's own colour does (albedo squared: R/G up ~1.7 times as much as G/B), not a pink.
+const vec3 SHADE_SCATTER_TINT = vec3(1.14, 0.93, 0.82);   // (0.92, 0.84 in G and B until session 26)
+const float SHADE_TINT_FROM = 0.35;
+const float SHADE_TINT_FULL = 0.8;
 // The lips' sheen (skin_lobes): the vermilion's dry, lined surface gives only a faint broad lobe
 // (weight LIP_LOBES.x, roughness LIP_BROAD_ROUGHNESS); the moist film, smoother than the skin's
 // oil, a narrow one (LIP_ROUGHNESS) of weight LIP_LOBES.y where it is wet, broken by the furrows
@@ -1089,7 +1101,9 @@ void main() {
     // where skin in shadow is a deeper red-brown and never the grey of a painted surface.
     // (Melanin absorbs much of the scattered light in dark skin: less reddening there.)
     float scatter = (1.0 - hair) * smoothstep(0.03, 0.3, dot(u_skin, LUMINANCE));
-    lit = key_part + (lit - key_part) * mix(vec3(1.0), vec3(1.14, 0.92, 0.84), scatter);
+    float shade_share = 1.0 - dot(key_part, LUMINANCE) / max(dot(lit, LUMINANCE), 1e-4);   // (the fill's, rim's, room's)
+    lit = key_part + (lit - key_part) * mix(vec3(1.0), SHADE_SCATTER_TINT,
+                                            scatter * smoothstep(SHADE_TINT_FROM, SHADE_TINT_FULL, shade_share));
 #ifdef USE_PORES
     lit.gb = mix(lit.gb, diffuse_light(bumped, 0.5 * wrap, contact).gb, 0.6);
 #endif
