@@ -627,7 +627,9 @@ def test_4_furrows_the_glabella_upright_and_leaves_the_nose_to_9(face_of, head, 
     horizontal line at the root of the nose; the nose wrinkles only with 9. Session 15's blind
     reviewer read anger as disgust for a "sculpted nose wrinkle": 4's glabella drew horizontal
     lines and the root of the nose creased as deeply under 4+5+7+23 as under 9 (90th percentile
-    0.33 vs 0.35 on ava)."""
+    0.33 vs 0.35 on ava). (Session 26 doubled the root's crease gain, 3 -> 6, for 9's lines under the
+    higher key: both fields doubled, anger's bridge 0.17-0.20 -> 0.31-0.35 and 9's 0.34-0.36 -> 0.65-0.71
+    on these four, so anger's bound is its share of 9's, 0.6 - 0.50-0.54 on main, 0.94 in session 15.)"""
     engine = face_of(character).engine
     skin, bridge, glabella = _nose_and_glabella(head)
 
@@ -637,8 +639,8 @@ def test_4_furrows_the_glabella_upright_and_leaves_the_nose_to_9(face_of, head, 
 
     anger, phase = creases("4+5+7+23")
     nose_wrinkler, _ = creases("9")
-    assert np.percentile(anger[bridge], 90) < 0.22
     assert np.percentile(nose_wrinkler[bridge], 90) > 0.24
+    assert np.percentile(anger[bridge], 90) < 0.6 * np.percentile(nose_wrinkler[bridge], 90)
     assert anger[glabella].max() > 0.5   # the glabellar furrows themselves
     # The renderer draws a furrow at each whole phase: it climbs more sideways than upward, so the
     # furrows run up or obliquely (on session 15's main it climbed 2.5 times as fast upward).
