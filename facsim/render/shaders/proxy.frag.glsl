@@ -502,9 +502,9 @@ void main() {
         // Where a pixel resolves them, the mass's single coils (coil_dome): each solid, there
         // where its rank is under the density, so the hairline ends in short coils standing
         // apart on the skin, not in a soft dark film along a clean line (blind review session 25).
-        float detail, rank;
         // (the hairline's hairs are shorter and finer than the mass's: coils 1.4 times smaller,
         // over a little of the fine cover they grow from)
+        float detail, rank;
         vec4 coil = coil_dome(v_rest * 1.4, n, detail, rank);
         float present = smoothstep(rank - 0.08, rank + 0.08, 1.6 * dens - 0.1);
         float disc = clamp(0.5 + (coil.w - 0.2) / max(fwidth(coil.w), 0.05), 0.0, 1.0);
@@ -659,7 +659,7 @@ void main() {
 #endif
 #endif
 #ifdef COILY
-    // (the single coils under this pixel, coil_dome: its outline, its thinning and its shading)
+    // (the single coils under this pixel, coil_dome: the mass's thinning and its shading)
     float coil_detail, coil_id;
     vec4 coil = coil_dome(v_rest, n, coil_detail, coil_id);
     // (only at the outline, where the eye grazes the mass and each card layer shows its own
@@ -828,8 +828,8 @@ void main() {
     // Coily hair thins in whole clumps of coils (coily_clumps), each solid, with skin between
     // them: curls finer than a pixel thinned it into a grey translucent film (the tufts over
     // the ears).
-    // (and the clumps' edges break into single coils, so the hairline ends in short coils)
-    // (not toward the outline, where coils a pixel across would speckle it: the outline is the clumps')
+    // (and the clumps' edges break into single coils, so the hairline ends in short coils; not
+    // toward the outline, where coils a pixel across would speckle it: the outline is the clumps')
     float thin_at = coily_clumps(coil_place(v_rest))
                   - 0.3 * coil_detail * smoothstep(0.2, 0.55, dot(n, v)) * (coil.w - 0.6);
     float thin_by = 1.3 * v_cover - 0.15 - thin_at;
@@ -909,11 +909,10 @@ void main() {
         // blotchy camouflage)
         float light = sqrt(clamp(dot(u_color, LUMINANCE), 0.0, 1.0));
         // Each coil: its top and its side toward the key lighter, the crevices round it darker.
-        float single = coil_detail;
         float coil_key = clamp(dot(coil.xyz - n, u_key_dir) + 0.5, 0.0, 1.0);
         // (light hair scatters light into the crevices: grey coils at full depth read as gravel)
         float coil_shade = mix(1.0, mix(mix(0.45, 0.7, light), 1.1, coil.w) * (0.7 + 0.6 * coil_key)
-                                  * (0.85 + 0.3 * coil_id) * coil_hairs, single * mix(1.0, 0.7, light));
+                                  * (0.85 + 0.3 * coil_id) * coil_hairs, coil_detail * mix(1.0, 0.7, light));
         strand = mix(strand, mix(mix(0.55, 0.75, light), mix(1.15, 1.05, light), crown) * coil_shade, u_coil);
         // Greying coily hair mixes white, grey and dark coils (placed on the head, not in the
         // cards' mirrored UVs), finer than its clumps: clumps of white and dark drew grey afros
