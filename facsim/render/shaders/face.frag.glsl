@@ -265,6 +265,14 @@ const vec2 PORE_CELLS = vec2(1000.0, 2000.0);
 const mat2 GRAIN_TURN = mat2(0.839, 0.545, -0.545, 0.839);
 const float PORE_TONE = 0.3;
 const float PORE_SHEEN = 2.5;
+// Where the pores are largest (tone.b: the nose and the cheeks beside it) the skin carries the most
+// sebum (a pore's size follows its gland's output): its broad sheen is stronger there, up to
+// PORE_SKIN_SHEEN more over PORE_SKIN_RANGE of tone.b, and broken by those pores (PORE_SHEEN), as a
+// studio photograph shows the nose and the inner cheeks: a stippled sheen that says skin. (Until
+// session 26 the nose's specular light at 448 px was 3 % of its light on ava, 9 % on kwame: a matte
+// paint, with the face's only sheen on the forehead.)
+const float PORE_SKIN_SHEEN = 1.2;
+const vec2 PORE_SKIN_RANGE = vec2(0.45, 0.85);
 // The sheen sees the skin's micro-relief (the grain's height below) SHEEN_RELIEF times as steep as
 // the diffuse light does: light reflected at the surface sees every facet of the relief sharp,
 // while light that scattered a millimetre or so under the skin before leaving sees it softened.
@@ -1163,6 +1171,7 @@ void main() {
     // Lobe weights (broad, tight); the fill is too weak to show: key and rim only.
     SkinLobes lobes = skin_lobes(oil, film, lips, wet, blotch, patches);
     vec2 weight = lobes.weight;
+    weight.x *= 1.0 + PORE_SKIN_SHEEN * smoothstep(PORE_SKIN_RANGE.x, PORE_SKIN_RANGE.y, tone.b) * (1.0 - lobes.lip);
     vec2 roughness = lobes.roughness;
     // The key's lobes spread by its softbox's size (softbox_roughness), except on the wet lips: their
     // film's beads and furrows curve within a millimetre or two and mirror the box as small glints.
