@@ -241,6 +241,29 @@ const float LIP_ROUGHNESS = 0.3;
 // at the border on hm08's lips.
 const float LIP_BORDER_LOD = 4.5;
 const float LIP_BORDER_SOFTNESS = 0.6;
+// The lips' deeper lines (session 26): at 448 px the fine furrows (~1.3 mm apart) are finer than a
+// pixel and fade to their mean, and the red was one even surface, its sheen one glossy band ("rubbery
+// lips or mouth", 18 of session 25's blind reviewer's notes). Lips at that size still show their deeper
+// lines: fissures every LIP_FISSURE_SPACING of v (hm08's face UV, ~700 mm per v: ~3.5 mm), each its own
+// depth (some barely there), bent by the blotches and broken along their length by the grain.
+const float LIP_FISSURE_SPACING = 1.0 / 200.0;
+const float LIP_FISSURE_SHADE = 0.3;   // how much darker a fissure's floor is
+// A fissure is a fine groove (its profile cos^(2k), k = LIP_FISSURE_SHARPNESS: ~0.4 mm across); where
+// that is finer than a pixel it is drawn as wide as the pixel and as much fainter (k lowered, the
+// profile's area kept), so it still shows at 448 px, as the fine line it is, without aliasing.
+// Returns (the groove's depth 0..1, how much of LIP_FISSURE_SHADE it takes): its relief shades it where
+// it is resolved; where it is about a pixel wide or less, too fine for the relief to show, its shade
+// stands for it (in close-ups a shaded floor as well drew each fissure as a dark band).
+const float LIP_FISSURE_SHARPNESS = 24.0;
+vec2 lip_fissures(float v, float bend, float grain) {
+    float s = v / LIP_FISSURE_SPACING + 0.5 * bend;
+    float pixel = max(fwidth(s), 1e-4);
+    float k = min(LIP_FISSURE_SHARPNESS, 0.28 / (pixel * pixel));   // the profile at least a pixel wide
+    float depth = hash2(ivec2(int(floor(s + 0.5)), 13));
+    float line = pow(0.5 + 0.5 * cos(2.0 * PI * s), k) * sqrt(k / LIP_FISSURE_SHARPNESS);
+    line *= smoothstep(0.25, 0.9, depth) * (0.5 + 0.5 * grain);
+    return vec2(mix(0.05, line, clamp(1.6 - 3.0 * pixel, 0.0, 1.0)), smoothstep(0.02, 0.08, pixel));
+}
 // Ambient occlusion of the skin's hollows (see main): none where the surface curves inward less
 // than CONCAVE_FROM dm^-1 (a 2-dm radius), CONCAVE_SHADE of the contact light lost at CONCAVE_FULL
 // (a 2.5-cm radius: an eye socket's side, a nasolabial fold) and beyond.
@@ -886,15 +909,19 @@ void main() {
                    * (0.25 + 0.75 * hash2(ivec2(int(floor(lip_s + 0.5)), 7)))    // uneven furrows,
                    * (0.3 + 0.7 * lip_grain);                                     // broken along their length
     lip_line = mix(0.1, lip_line, clamp(1.6 - 3.0 * fwidth(lip_s), 0.0, 1.0));
+    vec2 fissures = lip_fissures(v_uv.y, blotch, lip_grain);
+    float fissure = fissures.x;
     // Inside the wet-dry line the lips roll into their mucosa (detail.a, facsim.head.mouth.
     // lip_mucosa): smooth (no furrows), wet, a deeper and more bluish red than the vermilion
     // (unpigmented: pink-red on dark lips too). Hidden where the closed lips touch, it is the
     // band an open mouth shows between the lips' red and the dark inside.
     float mucosa = detail.a;
     lip_line *= 1.0 - mucosa;
+    fissure *= 1.0 - mucosa;
     float lip_core = smoothstep(0.45, 0.95, lips);
     float border = lips * (1.0 - lips) * 4.0;
-    vec3 lip_col = u_lips * (0.92 + 0.16 * blotch) * (1.0 - (0.16 + 0.16 * u_age) * lip_line * lip_core);
+    vec3 lip_col = u_lips * (0.92 + 0.16 * blotch) * (1.0 - (0.16 + 0.16 * u_age) * lip_line * lip_core)
+                 * (1.0 - LIP_FISSURE_SHADE * fissures.y * fissure * lip_core);
     // Toward the vermilion border the red thins into the skin's own colour (a painted-on
     // colour with an even edge read as a rubber mask).
     lip_col = mix(mix(albedo, u_lips, 0.6), lip_col, lip_core);
@@ -1057,7 +1084,7 @@ void main() {
     // The lips' furrows are grooves (~0.1 mm deep), not only darker lines: their slopes catch
     // the key on one flank and break the lips' sheen into short strokes, so the red reads as
     // soft, lined tissue rather than smooth rubber.
-    float lip_h = -0.0012 * (1.0 + 0.5 * u_age) * lip_line * lip_core;
+    float lip_h = -0.0012 * (1.0 + 0.5 * u_age) * max(lip_line, fissure) * lip_core;
     vec3 lip_grad = sign(det) * (dFdx(lip_h) * r1 + dFdy(lip_h) * r2);
     bumped = normalize(abs(det) * bumped - lip_grad);
     sheen_n = normalize(abs(det) * sheen_n - lip_grad);
@@ -1167,7 +1194,7 @@ void main() {
     // highlight breaks into strokes between the furrows rather than one band.
     // (Off the lips, nearly all pixels, the noise is skipped.)
     float moist = lips > 0.0 ? smoothstep(0.3, 0.75, value_noise(skin_uv * vec2(260.0, 520.0) + 31.0, 0)) : 0.0;
-    float wet = max(lips * (1.0 - lip_line) * (1.0 - lip_line) * (0.25 + 0.75 * moist) * (0.55 + 0.45 * blotch), mucosa);
+    float wet = max(lips * (1.0 - lip_line) * (1.0 - lip_line) * (1.0 - fissure) * (0.25 + 0.75 * moist) * (0.55 + 0.45 * blotch), mucosa);
     // Lobe weights (broad, tight); the fill is too weak to show: key and rim only.
     SkinLobes lobes = skin_lobes(oil, film, lips, wet, blotch, patches);
     vec2 weight = lobes.weight;
