@@ -440,9 +440,10 @@ def test_9_narrows_the_eye_from_above_as_well_as_below(face_of, marks, character
         assert upper > -0.005
     else:
         assert upper < -0.01, upper
-    # With 5 (HapFACS anger's 5+7+9+...) the levator holds the lid up against the push.
+    # With 5 (HapFACS anger's 5+7+9+...) the levator holds the lid up against the push. (george's
+    # lid, lifted at rest to 3.7 mm since session 26, takes 9's push to brow_push's 4 mm: 0.35 mm.)
     glare = engine.deform(activations(parse("5+9"))).positions - engine.deform(activations(parse("5"))).positions
-    assert glare[marks["upper_lid_left"], Y] > -0.003
+    assert glare[marks["upper_lid_left"], Y] > (-0.004 if character == "george" else -0.003)
 
 
 def test_9_raises_the_upper_lip_in_an_inverted_u(engine, marks):
@@ -487,7 +488,9 @@ def test_sad_upper_lids_droop_where_fear_and_anger_keep_theirs_up(face_of, marks
     assert lid(ava, _emotion_moved(ava, "fear", level)) > -0.005
     assert lid(ava, _moved(ava, "1+2+4")) > -0.006
     assert lid(ava, _emotion_moved(ava, "anger", level)) > 0.0
-    assert lid(george, _emotion_moved(george, "sadness", level)) > -0.008     # the brows alone: 0.6 mm
+    # The brows alone: 0.6 mm; since session 26 george's lid rests lifted to 3.7 mm over the iris
+    # (lids.yaml most_cover_mm), and 4's push takes it to brow_push's 4 mm: 0.3 mm more.
+    assert lid(george, _emotion_moved(george, "sadness", level)) > -0.0095
 
 
 @pytest.mark.parametrize("level", [1.0, 0.5])

@@ -476,17 +476,22 @@ const float IRIS_CAUSTIC = 0.3;    // how much brighter the iris's lower rim is 
 // with the fill's at 0.6, two large bright patches read as glossy doll's eyes.)
 // (At 0.17 x 0.14, an even plate of ~1.1 mm² with a crisp edge, it still sat on the iris like a
 // sticker: now a ~30-cm box at 1.2 m, ~0.5 mm² on the cornea, brightest in its middle, its rim
-// fading out.)
-const vec2 SOFTBOX = vec2(0.1, 0.085);
-// The key softbox is tall: the cornea mirrors its lower part, near the eyes' level, rather
-// than the key's middle 38 degrees up, whose reflection lies under the upper lid. (At ~16
-// degrees up it still lay under the relaxed lids of most presets: george, kwame, liam and noah
-// showed no catch-light at 448², dead eyes; now about level with the eyes, as with the flash of
-// stimulus photographs.)
-// (0.55 until session 25, when the key rose from ~32 to 38 degrees: the box's lower part, which
-// the cornea mirrors, stays at the eyes' level; the catch-light's direction is unchanged.)
-const float SOFTBOX_DROP = 0.64;
-const float KEY_REFLECTION = 1.6;   // (0.65 for a box 2.8 times the area: the same light from a smaller box is brighter)
+// fading out; 0.1 x 0.085 until session 26.)
+const vec2 SOFTBOX = vec2(0.07, 0.085);
+// Where the key's catch-light lies: the softbox's part that the cornea mirrors into view.
+// The box is tall and stands to the side: seen from the eyes its lower, outer part lies at
+// about 45 degrees to the side and 12 up (the key's centre: 28 and 38), so the catch-light sits
+// on the iris at about 10 or 2 o'clock, half-way out, clear of the pupil.
+// (Level with the eyes and 28 degrees out (SOFTBOX_DROP 0.64, no SOFTBOX_SIDE, sessions 24-25)
+// it sat on the pupil's rim, half on the black disc: the painted highlight of a doll's or a
+// cartoon's eye, issue 13 "glassy, doll eyes". Higher, it lay under the relaxed lids: on the
+// hooded presets lids.yaml's most_cover_mm keeps it in view.)
+const float SOFTBOX_DROP = 0.52;    // taken off the key direction's height (unit vector) ...
+const float SOFTBOX_SIDE = 1.9;     // ... and its sideways part scaled by this
+vec3 catch_light_direction(vec3 key_dir) {
+    return normalize(key_dir * vec3(SOFTBOX_SIDE, 1.0, 1.0) - vec3(0.0, SOFTBOX_DROP, 0.0));
+}
+const float KEY_REFLECTION = 1.9;   // (0.65 for a box 2.8 times the area, 1.6 for one 1.06 times: the same light from a smaller box is brighter)
 // The fill is a broad bounce card to the side: a larger, dimmer reflection (it shows where
 // a lowered lid hides the key's, as in photographs).
 const vec2 FILL_BOX = vec2(0.2, 0.3);
@@ -1406,9 +1411,12 @@ void main() {
     float ndv = max(dot(nc, v), 0.0);
     float fres = schlick(0.025, ndv) / 0.025;
     vec3 room = mix(u_ground_col, u_sky_col, 0.5 + 0.5 * refl.y) * ROOM_REFLECTION;
-    vec3 boxes = softbox(refl, normalize(u_key_dir - vec3(0.0, SOFTBOX_DROP, 0.0)), SOFTBOX) * u_key_col
-               + softbox(refl, u_fill_dir, FILL_BOX) * u_fill_col * FILL_REFLECTION;
-    vec3 spec = (boxes * KEY_REFLECTION + room) * fres * mix(0.45, 1.0, cornea);
+    // The boxes are mirrored by the cornea alone: the normals blended across the limbus swept
+    // through the key's reflection and drew a second highlight on its rim, beside the iris.
+    vec3 refl_cornea = reflect(-v, eye_rot * corneal);
+    vec3 boxes = (softbox(refl_cornea, catch_light_direction(u_key_dir), SOFTBOX) * u_key_col * KEY_REFLECTION
+                  + softbox(refl_cornea, u_fill_dir, FILL_BOX) * u_fill_col * FILL_REFLECTION) * cornea;
+    vec3 spec = (boxes + room * mix(0.45, 1.0, cornea)) * fres;
     // The sclera and the lid's wet rim are wet too but less smooth (a broad sheen), and the
     // tear meniscus catches a thin bright line of the key.
     spec += specular_light(n, v, 40.0) * 0.03 + tear * u_key_col * TEAR_SHINE;
