@@ -1146,12 +1146,13 @@ def test_9_lowers_the_inner_brows_without_gathering_them(face_of, marks, charact
     assert _spread_change(engine, marks, activations(parse("4"))) < -0.04
 
 
-def test_sad_brows_are_drawn_together_by_4_not_further_by_1(face_of, marks):
-    """FACS 1+4 (sadness's brows): the inner brows raised and drawn together - the drawing together
-    is 4's, 1 raises. 1's MakeHuman unit slid the inner brows together as well, so sadness (1+4+15)
-    gathered them 7.9 mm on ava, more than 4 alone (6.0) and as much as fear; now 1 alone does not
-    gather them and 1+4 no more than 4."""
+@pytest.mark.parametrize("brows", ["1+4+15", "1+2+4"])
+def test_sad_and_fearful_brows_are_drawn_together_by_4_not_further_by_1(face_of, marks, brows):
+    """FACS 1+4 (sadness) and 1+2+4 (fear): the inner brows raised and drawn together - the drawing
+    together is 4's, 1 raises; in 1+2+4 "not as close together as in AU 4 alone" (FACS 2002). 1's
+    MakeHuman unit slid the inner brows together as well, so sadness (1+4+15) and fear's brows gathered
+    them 7.9 mm on ava, more than 4 alone (6.0); now 1 alone does not gather them, 1+4 and 1+2+4 5.7 mm."""
     engine = face_of("ava").engine
     assert _spread_change(engine, marks, activations(parse("1"))) > -0.002
-    sad = _spread_change(engine, marks, activations(parse("1+4+15")))
-    assert _spread_change(engine, marks, activations(parse("4"))) - 0.002 < sad < -0.03
+    gathered = _spread_change(engine, marks, activations(parse(brows)))
+    assert _spread_change(engine, marks, activations(parse("4"))) - 0.002 < gathered < -0.03
