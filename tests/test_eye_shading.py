@@ -165,6 +165,37 @@ def test_the_catch_light_is_a_small_bright_reflection_not_a_sticker(name):
         assert core.sum() / px_per_mm ** 2 < 1.4, core.sum() / px_per_mm ** 2
 
 
+def test_the_catch_light_lies_on_the_iris_clear_of_the_pupil():
+    """The key (to the image's left and above) is mirrored on the cornea at about 10 o'clock,
+    half-way out across the iris, with iris between it and the pupil, as in studio portraits.
+    Level with the pupil's centre and ~2 mm out it sat on the pupil's rim (0-0.3 mm from it on
+    ava and mei at 768 px, 9f8b92e), half on the black disc: the painted highlight of a doll's
+    eye (issue 13, "glassy, doll eyes")."""
+    from scipy import ndimage
+
+    size = 768
+    ava = preset("ava")
+    renders = {}
+    for key, colours in (("normal", {}), ("cornea", {"iris": "#ff0000", "pupil": "#ff0000"}), ("pupil", {"pupil": "#00ff00"})):
+        with Face(ava.with_(colors={**ava.colors, **colours})) as face:
+            renders[key] = face.render("", size=size, antialias=1, background=(1.0, 1.0, 1.0))[..., :3].astype(int)
+    image = renders["normal"]
+    # (Filled: a catch-light near white is near white in both renders.)
+    cornea = ndimage.binary_fill_holes(np.abs(renders["cornea"] - image).sum(-1) > 60)
+    pupil = ndimage.binary_fill_holes(np.abs(renders["pupil"] - image).sum(-1) > 60)
+    lum = _luminance(image)
+    for side in (slice(0, size // 2), slice(size // 2, size)):
+        eye, own_pupil = np.zeros_like(cornea), np.zeros_like(pupil)
+        eye[:, side], own_pupil[:, side] = cornea[:, side], pupil[:, side]
+        px_per_mm = (np.ptp(np.flatnonzero(eye.any(axis=0))) + 1) / 11.7
+        core = eye & (lum > (lum[eye].max() + np.median(lum[eye])) / 2)
+        gap = ndimage.distance_transform_edt(~own_pupil)[core].min() / px_per_mm
+        (cy, cx), (py, px) = (np.mean(np.nonzero(mask), axis=1) for mask in (core, own_pupil))
+        assert gap > 0.45, gap                          # iris between it and the pupil
+        assert (cx - px) / px_per_mm < -2.5             # on the key's side
+        assert (py - cy) / px_per_mm > 0.2              # above the pupil's centre
+
+
 @pytest.mark.parametrize("name", ["george", "kwame"])
 def test_a_relaxed_or_hooded_lid_leaves_the_catch_light_in_view(name):
     """At rest the upper lid covers 2 mm or more of the iris's top (lids.yaml), and on hooded

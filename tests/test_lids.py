@@ -5,11 +5,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from facsim._data import load_yaml
 from facsim.engines.lids import RestLids, rest_table, spherical
 from facsim.facs.activations import Activations
 
 #: amara's sculpted upper lid covers only ~1.5 mm of the iris (relaxed lids lower it);
-#: noah's and george's cover 4-5 mm already (hooded: they get nothing, so they do not look sleepy).
+#: noah's and george's cover 4-5 mm already (hooded: lifted to `most_cover_mm`, so they do not look sleepy).
 HIGH_LID, COVERED = "amara", ("noah", "george")
 
 
@@ -42,11 +43,16 @@ def test_a_high_upper_lid_rests_over_the_top_of_the_iris(face_of, engine):
 
 
 @pytest.mark.parametrize("name", COVERED)
-def test_hooded_lids_are_left_as_they_are(face_of, name):
+def test_hooded_lids_are_lifted_to_a_relaxed_cover(face_of, name):
+    """Hooded lids keep their fold but their margin rests no lower than `most_cover_mm` over the
+    iris: sculpted 4-5 mm over it (to the pupil) they got nothing until session 26, and the blind
+    reviewer saw "sleepy, dead eyes" on kwame and george at rest, the key's catch-light under the lid."""
     face = face_of(name)
-    assert face.engine.rest_lids.weights == {"left": 0.0, "right": 0.0}
-    for side in ("left", "right"):     # the upper lid over the pupil (the lower lid's rest lifts the corners a hair)
-        assert _cover_mm(face, face.neutral, side) == pytest.approx(_cover_mm(face, face.engine.sculpted, side), abs=0.02)
+    most = float(rest_table()["most_cover_mm"])
+    assert face.engine.rest_lids.weights["left"] < 0.0
+    for side in ("left", "right"):      # (george's, 5.4 mm, rises by max_lift's 1.6 mm)
+        sculpted, rest = _cover_mm(face, face.engine.sculpted, side), _cover_mm(face, face.neutral, side)
+        assert most - 0.4 < rest < sculpted - 1.2, (sculpted, rest)
 
 
 def _lower_sag_mm(face, positions, side="left") -> float:
@@ -106,12 +112,15 @@ def test_5E_bares_the_sclera_above_the_iris_on_every_preset(face_of, name):
     not let the lid's skin fold under the hood, holds kwame's at 2.5 and george's at 1.6).
     Session 19: fitted to 3.5 iris-mm, ava's, mei's and amara's margins stood 3.3-3.5 mm over the
     iris and the wide-open eyes read as bulging; open lids rise to 2.5 mm (2.3-2.6), hooded ones
-    keep 3.5 (their fold hides the margin)."""
+    keep 3.5 (their fold hides the margin). Session 26: the skin guard had held kwame's short of
+    that, at 2.5; lifted at rest (most_cover_mm) it reaches 3.1, and shows 0.5 mm of white over
+    the iris at 512 px (none before)."""
     face = face_of(name)
     centre, radius = face.head.eye_pivot(face.base_positions, "left")
     iris_mm = 100.0 * float(rest_table()["iris_radius"]) * radius / (0.5 * float(rest_table()["iris_mm"]))
     over_iris = -_cover_mm(face, face.deform("5E").positions) / iris_mm
-    assert 1.2 < over_iris < 3.0
+    hooded = float(load_yaml("lids.yaml")["raise"]["hooded"]["bare_mm"])
+    assert 1.2 < over_iris < (hooded if name in ("kwame", "george") else 3.0)
     assert -_cover_mm(face, face.neutral) < 0.0                 # at rest the lid covers the iris's top
 
 

@@ -440,9 +440,10 @@ def test_9_narrows_the_eye_from_above_as_well_as_below(face_of, marks, character
         assert upper > -0.005
     else:
         assert upper < -0.01, upper
-    # With 5 (HapFACS anger's 5+7+9+...) the levator holds the lid up against the push.
+    # With 5 (HapFACS anger's 5+7+9+...) the levator holds the lid up against the push. (george's
+    # lid, lifted at rest to 3.7 mm since session 26, takes 9's push to brow_push's 4 mm: 0.35 mm.)
     glare = engine.deform(activations(parse("5+9"))).positions - engine.deform(activations(parse("5"))).positions
-    assert glare[marks["upper_lid_left"], Y] > -0.003
+    assert glare[marks["upper_lid_left"], Y] > (-0.004 if character == "george" else -0.003)
 
 
 def test_9_raises_the_upper_lip_in_an_inverted_u(engine, marks):
@@ -487,7 +488,9 @@ def test_sad_upper_lids_droop_where_fear_and_anger_keep_theirs_up(face_of, marks
     assert lid(ava, _emotion_moved(ava, "fear", level)) > -0.005
     assert lid(ava, _moved(ava, "1+2+4")) > -0.006
     assert lid(ava, _emotion_moved(ava, "anger", level)) > 0.0
-    assert lid(george, _emotion_moved(george, "sadness", level)) > -0.008     # the brows alone: 0.6 mm
+    # The brows alone: 0.6 mm; since session 26 george's lid rests lifted to 3.7 mm over the iris
+    # (lids.yaml most_cover_mm), and 4's push takes it to brow_push's 4 mm: 0.3 mm more.
+    assert lid(george, _emotion_moved(george, "sadness", level)) > -0.0095
 
 
 @pytest.mark.parametrize("level", [1.0, 0.5])
@@ -627,7 +630,9 @@ def test_4_furrows_the_glabella_upright_and_leaves_the_nose_to_9(face_of, head, 
     horizontal line at the root of the nose; the nose wrinkles only with 9. Session 15's blind
     reviewer read anger as disgust for a "sculpted nose wrinkle": 4's glabella drew horizontal
     lines and the root of the nose creased as deeply under 4+5+7+23 as under 9 (90th percentile
-    0.33 vs 0.35 on ava)."""
+    0.33 vs 0.35 on ava). (Session 26 doubled the root's crease gain, 3 -> 6, for 9's lines under the
+    higher key: both fields doubled, anger's bridge 0.17-0.20 -> 0.31-0.35 and 9's 0.34-0.36 -> 0.65-0.71
+    on these four, so anger's bound is its share of 9's, 0.6 - 0.50-0.54 on main, 0.94 in session 15.)"""
     engine = face_of(character).engine
     skin, bridge, glabella = _nose_and_glabella(head)
 
@@ -637,8 +642,8 @@ def test_4_furrows_the_glabella_upright_and_leaves_the_nose_to_9(face_of, head, 
 
     anger, phase = creases("4+5+7+23")
     nose_wrinkler, _ = creases("9")
-    assert np.percentile(anger[bridge], 90) < 0.22
     assert np.percentile(nose_wrinkler[bridge], 90) > 0.24
+    assert np.percentile(anger[bridge], 90) < 0.6 * np.percentile(nose_wrinkler[bridge], 90)
     assert anger[glabella].max() > 0.5   # the glabellar furrows themselves
     # The renderer draws a furrow at each whole phase: it climbs more sideways than upward, so the
     # furrows run up or obliquely (on session 15's main it climbed 2.5 times as fast upward).
@@ -1141,12 +1146,13 @@ def test_9_lowers_the_inner_brows_without_gathering_them(face_of, marks, charact
     assert _spread_change(engine, marks, activations(parse("4"))) < -0.04
 
 
-def test_sad_brows_are_drawn_together_by_4_not_further_by_1(face_of, marks):
-    """FACS 1+4 (sadness's brows): the inner brows raised and drawn together - the drawing together
-    is 4's, 1 raises. 1's MakeHuman unit slid the inner brows together as well, so sadness (1+4+15)
-    gathered them 7.9 mm on ava, more than 4 alone (6.0) and as much as fear; now 1 alone does not
-    gather them and 1+4 no more than 4."""
+@pytest.mark.parametrize("brows", ["1+4+15", "1+2+4"])
+def test_sad_and_fearful_brows_are_drawn_together_by_4_not_further_by_1(face_of, marks, brows):
+    """FACS 1+4 (sadness) and 1+2+4 (fear): the inner brows raised and drawn together - the drawing
+    together is 4's, 1 raises; in 1+2+4 "not as close together as in AU 4 alone" (FACS 2002). 1's
+    MakeHuman unit slid the inner brows together as well, so sadness (1+4+15) and fear's brows gathered
+    them 7.9 mm on ava, more than 4 alone (6.0); now 1 alone does not gather them, 1+4 and 1+2+4 5.7 mm."""
     engine = face_of("ava").engine
     assert _spread_change(engine, marks, activations(parse("1"))) > -0.002
-    sad = _spread_change(engine, marks, activations(parse("1+4+15")))
-    assert _spread_change(engine, marks, activations(parse("4"))) - 0.002 < sad < -0.03
+    gathered = _spread_change(engine, marks, activations(parse(brows)))
+    assert _spread_change(engine, marks, activations(parse("4"))) - 0.002 < gathered < -0.03

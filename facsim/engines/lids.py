@@ -23,7 +23,8 @@ Examples
 :class:`RestLids` is the relaxed aperture both engines start from (``lids.yaml``):
 MakeHuman's sculpted lids stare, so each eye's upper lid is lowered by the share of
 the closing target that brings its margin over the top of the iris, measured on
-the character (none where the lid already covers it, as on hooded older lids).
+the character (none where the lid already covers it; hooded lids that cover more than
+``most_cover_mm`` take a negative share, which lifts them to it).
 """
 from __future__ import annotations
 
@@ -211,7 +212,9 @@ def rest_lid_weight(lids: EyeLids, rest: np.ndarray, closing: np.ndarray, radius
     The margin over the pupil (upper margin points within ``ahead_degrees`` of straight
     ahead) should sit ``cover_mm`` below the iris's top (``iris_radius`` eyeball radii above
     the centre). Heights change linearly with the share, so it is solved directly, then
-    clipped to ``[0, max_weight]``: 0 where the sculpted lid already covers that much.
+    clipped to ``[0, max_weight]``: 0 where the sculpted lid already covers that much. A lid
+    sculpted more than ``most_cover_mm`` over the iris (hooded) takes the negative share that
+    lifts it to that (at most ``max_lift``).
 
     Parameters
     ----------
@@ -227,10 +230,15 @@ def rest_lid_weight(lids: EyeLids, rest: np.ndarray, closing: np.ndarray, radius
         return 0.0
     upper, height = _margin_over_pupil(lids, rest, float(spec["ahead_degrees"]))
     drop = -float(np.mean(closing[upper, 1]))           # dm per unit share
-    target = float(spec["iris_radius"]) * radius - 0.01 * float(spec["cover_mm"])
+    iris_top = float(spec["iris_radius"]) * radius
     if drop <= 1e-9:
         return 0.0
-    return float(np.clip((height - target) / drop, 0.0, float(spec["max_weight"])))
+    lowered = (height - (iris_top - 0.01 * float(spec["cover_mm"]))) / drop
+    if lowered > 0.0:
+        return float(min(lowered, float(spec["max_weight"])))
+    # A lid sculpted lower than `most_cover_mm` (hooded) is lifted to it: a negative share.
+    lifted = (height - (iris_top - 0.01 * float(spec.get("most_cover_mm", np.inf)))) / drop
+    return float(np.clip(lifted, -float(spec.get("max_lift", 0.0)), 0.0))
 
 
 def rest_lower_weight(lids: EyeLids, rest: np.ndarray, raising: np.ndarray, radius: float,

@@ -216,6 +216,18 @@ const float MESH_FOLD_FULL = 0.1;
 // How much of each channel's diffuse light sees the scattered normal (v_scatter_normal) rather
 // than the surface's own: red travels furthest under the skin, blue least.
 const vec3 SCATTER_SOFTNESS = vec3(0.6, 0.3, 0.12);
+// The shade's light comes out of the skin redder and more saturated (see main): SHADE_SCATTER_TINT
+// multiplies the light other than the key's where it is most of the light, over SHADE_TINT_FROM to
+// SHADE_TINT_FULL of it (the key's own shade: the nose's and jaw's undersides, the sides turned from it).
+// On open skin the key lights (the fill there ~1/4 of the light) the albedo already is the colour of
+// light that has come back out of the skin: tinting the fill there too made every lit face pinker
+// (session 25: at 448 px the lit cheeks' fill light 4-7 % redder, R/G, than the key's, which is the
+// warmer light; the cheeks at CIELAB C* 24-27, hue 49-52, above skin's 17-23 measured in vivo:
+// "waxy" ava and mei, "plastic" liam). Green loses less than blue, as light filtered twice by the
+// skin's own colour does (albedo squared: R/G up ~1.7 times as much as G/B), not a pink.
+const vec3 SHADE_SCATTER_TINT = vec3(1.14, 0.93, 0.82);   // (0.92, 0.84 in G and B until session 26)
+const float SHADE_TINT_FROM = 0.35;
+const float SHADE_TINT_FULL = 0.8;
 // The lips' sheen (skin_lobes): the vermilion's dry, lined surface gives only a faint broad lobe
 // (weight LIP_LOBES.x, roughness LIP_BROAD_ROUGHNESS); the moist film, smoother than the skin's
 // oil, a narrow one (LIP_ROUGHNESS) of weight LIP_LOBES.y where it is wet, broken by the furrows
@@ -229,6 +241,29 @@ const float LIP_ROUGHNESS = 0.3;
 // at the border on hm08's lips.
 const float LIP_BORDER_LOD = 4.5;
 const float LIP_BORDER_SOFTNESS = 0.6;
+// The lips' deeper lines (session 26): at 448 px the fine furrows (~1.3 mm apart) are finer than a
+// pixel and fade to their mean, and the red was one even surface, its sheen one glossy band ("rubbery
+// lips or mouth", 18 of session 25's blind reviewer's notes). Lips at that size still show their deeper
+// lines: fissures every LIP_FISSURE_SPACING of v (hm08's face UV, ~700 mm per v: ~3.5 mm), each its own
+// depth (some barely there), bent by the blotches and broken along their length by the grain.
+const float LIP_FISSURE_SPACING = 1.0 / 200.0;
+const float LIP_FISSURE_SHADE = 0.3;   // how much darker a fissure's floor is
+// A fissure is a fine groove (its profile cos^(2k), k = LIP_FISSURE_SHARPNESS: ~0.4 mm across); where
+// that is finer than a pixel it is drawn as wide as the pixel and as much fainter (k lowered, the
+// profile's area kept), so it still shows at 448 px, as the fine line it is, without aliasing.
+// Returns (the groove's depth 0..1, how much of LIP_FISSURE_SHADE it takes): its relief shades it where
+// it is resolved; where it is about a pixel wide or less, too fine for the relief to show, its shade
+// stands for it (in close-ups a shaded floor as well drew each fissure as a dark band).
+const float LIP_FISSURE_SHARPNESS = 24.0;
+vec2 lip_fissures(float v, float bend, float grain) {
+    float s = v / LIP_FISSURE_SPACING + 0.5 * bend;
+    float pixel = max(fwidth(s), 1e-4);
+    float k = min(LIP_FISSURE_SHARPNESS, 0.28 / (pixel * pixel));   // the profile at least a pixel wide
+    float depth = hash2(ivec2(int(floor(s + 0.5)), 13));
+    float line = pow(0.5 + 0.5 * cos(2.0 * PI * s), k) * sqrt(k / LIP_FISSURE_SHARPNESS);
+    line *= smoothstep(0.25, 0.9, depth) * (0.5 + 0.5 * grain);
+    return vec2(mix(0.05, line, clamp(1.6 - 3.0 * pixel, 0.0, 1.0)), smoothstep(0.02, 0.08, pixel));
+}
 // Ambient occlusion of the skin's hollows (see main): none where the surface curves inward less
 // than CONCAVE_FROM dm^-1 (a 2-dm radius), CONCAVE_SHADE of the contact light lost at CONCAVE_FULL
 // (a 2.5-cm radius: an eye socket's side, a nasolabial fold) and beyond.
@@ -253,6 +288,14 @@ const vec2 PORE_CELLS = vec2(1000.0, 2000.0);
 const mat2 GRAIN_TURN = mat2(0.839, 0.545, -0.545, 0.839);
 const float PORE_TONE = 0.3;
 const float PORE_SHEEN = 2.5;
+// Where the pores are largest (tone.b: the nose and the cheeks beside it) the skin carries the most
+// sebum (a pore's size follows its gland's output): its broad sheen is stronger there, up to
+// PORE_SKIN_SHEEN more over PORE_SKIN_RANGE of tone.b, and broken by those pores (PORE_SHEEN), as a
+// studio photograph shows the nose and the inner cheeks: a stippled sheen that says skin. (Until
+// session 26 the nose's specular light at 448 px was 3 % of its light on ava, 9 % on kwame: a matte
+// paint, with the face's only sheen on the forehead.)
+const float PORE_SKIN_SHEEN = 1.2;
+const vec2 PORE_SKIN_RANGE = vec2(0.45, 0.85);
 // The sheen sees the skin's micro-relief (the grain's height below) SHEEN_RELIEF times as steep as
 // the diffuse light does: light reflected at the surface sees every facet of the relief sharp,
 // while light that scattered a millimetre or so under the skin before leaving sees it softened.
@@ -433,17 +476,22 @@ const float IRIS_CAUSTIC = 0.3;    // how much brighter the iris's lower rim is 
 // with the fill's at 0.6, two large bright patches read as glossy doll's eyes.)
 // (At 0.17 x 0.14, an even plate of ~1.1 mm² with a crisp edge, it still sat on the iris like a
 // sticker: now a ~30-cm box at 1.2 m, ~0.5 mm² on the cornea, brightest in its middle, its rim
-// fading out.)
-const vec2 SOFTBOX = vec2(0.1, 0.085);
-// The key softbox is tall: the cornea mirrors its lower part, near the eyes' level, rather
-// than the key's middle 38 degrees up, whose reflection lies under the upper lid. (At ~16
-// degrees up it still lay under the relaxed lids of most presets: george, kwame, liam and noah
-// showed no catch-light at 448², dead eyes; now about level with the eyes, as with the flash of
-// stimulus photographs.)
-// (0.55 until session 25, when the key rose from ~32 to 38 degrees: the box's lower part, which
-// the cornea mirrors, stays at the eyes' level; the catch-light's direction is unchanged.)
-const float SOFTBOX_DROP = 0.64;
-const float KEY_REFLECTION = 1.6;   // (0.65 for a box 2.8 times the area: the same light from a smaller box is brighter)
+// fading out; 0.1 x 0.085 until session 26.)
+const vec2 SOFTBOX = vec2(0.07, 0.085);
+// Where the key's catch-light lies: the softbox's part that the cornea mirrors into view.
+// The box is tall and stands to the side: seen from the eyes its lower, outer part lies at
+// about 45 degrees to the side and 12 up (the key's centre: 28 and 38), so the catch-light sits
+// on the iris at about 10 or 2 o'clock, half-way out, clear of the pupil.
+// (Level with the eyes and 28 degrees out (SOFTBOX_DROP 0.64, no SOFTBOX_SIDE, sessions 24-25)
+// it sat on the pupil's rim, half on the black disc: the painted highlight of a doll's or a
+// cartoon's eye, issue 13 "glassy, doll eyes". Higher, it lay under the relaxed lids: on the
+// hooded presets lids.yaml's most_cover_mm keeps it in view.)
+const float SOFTBOX_DROP = 0.52;    // taken off the key direction's height (unit vector) ...
+const float SOFTBOX_SIDE = 1.9;     // ... and its sideways part scaled by this
+vec3 catch_light_direction(vec3 key_dir) {
+    return normalize(key_dir * vec3(SOFTBOX_SIDE, 1.0, 1.0) - vec3(0.0, SOFTBOX_DROP, 0.0));
+}
+const float KEY_REFLECTION = 1.9;   // (0.65 for a box 2.8 times the area, 1.6 for one 1.06 times: the same light from a smaller box is brighter)
 // The fill is a broad bounce card to the side: a larger, dimmer reflection (it shows where
 // a lowered lid hides the key's, as in photographs).
 const vec2 FILL_BOX = vec2(0.2, 0.3);
@@ -866,15 +914,19 @@ void main() {
                    * (0.25 + 0.75 * hash2(ivec2(int(floor(lip_s + 0.5)), 7)))    // uneven furrows,
                    * (0.3 + 0.7 * lip_grain);                                     // broken along their length
     lip_line = mix(0.1, lip_line, clamp(1.6 - 3.0 * fwidth(lip_s), 0.0, 1.0));
+    vec2 fissures = lip_fissures(v_uv.y, blotch, lip_grain);
+    float fissure = fissures.x;
     // Inside the wet-dry line the lips roll into their mucosa (detail.a, facsim.head.mouth.
     // lip_mucosa): smooth (no furrows), wet, a deeper and more bluish red than the vermilion
     // (unpigmented: pink-red on dark lips too). Hidden where the closed lips touch, it is the
     // band an open mouth shows between the lips' red and the dark inside.
     float mucosa = detail.a;
     lip_line *= 1.0 - mucosa;
+    fissure *= 1.0 - mucosa;
     float lip_core = smoothstep(0.45, 0.95, lips);
     float border = lips * (1.0 - lips) * 4.0;
-    vec3 lip_col = u_lips * (0.92 + 0.16 * blotch) * (1.0 - (0.16 + 0.16 * u_age) * lip_line * lip_core);
+    vec3 lip_col = u_lips * (0.92 + 0.16 * blotch) * (1.0 - (0.16 + 0.16 * u_age) * lip_line * lip_core)
+                 * (1.0 - LIP_FISSURE_SHADE * fissures.y * fissure * lip_core);
     // Toward the vermilion border the red thins into the skin's own colour (a painted-on
     // colour with an even edge read as a rubber mask).
     lip_col = mix(mix(albedo, u_lips, 0.6), lip_col, lip_core);
@@ -1037,7 +1089,7 @@ void main() {
     // The lips' furrows are grooves (~0.1 mm deep), not only darker lines: their slopes catch
     // the key on one flank and break the lips' sheen into short strokes, so the red reads as
     // soft, lined tissue rather than smooth rubber.
-    float lip_h = -0.0012 * (1.0 + 0.5 * u_age) * lip_line * lip_core;
+    float lip_h = -0.0012 * (1.0 + 0.5 * u_age) * max(lip_line, fissure) * lip_core;
     vec3 lip_grad = sign(det) * (dFdx(lip_h) * r1 + dFdy(lip_h) * r2);
     bumped = normalize(abs(det) * bumped - lip_grad);
     sheen_n = normalize(abs(det) * sheen_n - lip_grad);
@@ -1089,7 +1141,9 @@ void main() {
     // where skin in shadow is a deeper red-brown and never the grey of a painted surface.
     // (Melanin absorbs much of the scattered light in dark skin: less reddening there.)
     float scatter = (1.0 - hair) * smoothstep(0.03, 0.3, dot(u_skin, LUMINANCE));
-    lit = key_part + (lit - key_part) * mix(vec3(1.0), vec3(1.14, 0.92, 0.84), scatter);
+    float shade_share = 1.0 - dot(key_part, LUMINANCE) / max(dot(lit, LUMINANCE), 1e-4);   // (the fill's, rim's, room's)
+    lit = key_part + (lit - key_part) * mix(vec3(1.0), SHADE_SCATTER_TINT,
+                                            scatter * smoothstep(SHADE_TINT_FROM, SHADE_TINT_FULL, shade_share));
 #ifdef USE_PORES
     lit.gb = mix(lit.gb, diffuse_light(bumped, 0.5 * wrap, contact).gb, 0.6);
 #endif
@@ -1145,10 +1199,11 @@ void main() {
     // highlight breaks into strokes between the furrows rather than one band.
     // (Off the lips, nearly all pixels, the noise is skipped.)
     float moist = lips > 0.0 ? smoothstep(0.3, 0.75, value_noise(skin_uv * vec2(260.0, 520.0) + 31.0, 0)) : 0.0;
-    float wet = max(lips * (1.0 - lip_line) * (1.0 - lip_line) * (0.25 + 0.75 * moist) * (0.55 + 0.45 * blotch), mucosa);
+    float wet = max(lips * (1.0 - lip_line) * (1.0 - lip_line) * (1.0 - fissure) * (0.25 + 0.75 * moist) * (0.55 + 0.45 * blotch), mucosa);
     // Lobe weights (broad, tight); the fill is too weak to show: key and rim only.
     SkinLobes lobes = skin_lobes(oil, film, lips, wet, blotch, patches);
     vec2 weight = lobes.weight;
+    weight.x *= 1.0 + PORE_SKIN_SHEEN * smoothstep(PORE_SKIN_RANGE.x, PORE_SKIN_RANGE.y, tone.b) * (1.0 - lobes.lip);
     vec2 roughness = lobes.roughness;
     // The key's lobes spread by its softbox's size (softbox_roughness), except on the wet lips: their
     // film's beads and furrows curve within a millimetre or two and mirror the box as small glints.
@@ -1356,9 +1411,12 @@ void main() {
     float ndv = max(dot(nc, v), 0.0);
     float fres = schlick(0.025, ndv) / 0.025;
     vec3 room = mix(u_ground_col, u_sky_col, 0.5 + 0.5 * refl.y) * ROOM_REFLECTION;
-    vec3 boxes = softbox(refl, normalize(u_key_dir - vec3(0.0, SOFTBOX_DROP, 0.0)), SOFTBOX) * u_key_col
-               + softbox(refl, u_fill_dir, FILL_BOX) * u_fill_col * FILL_REFLECTION;
-    vec3 spec = (boxes * KEY_REFLECTION + room) * fres * mix(0.45, 1.0, cornea);
+    // The boxes are mirrored by the cornea alone: the normals blended across the limbus swept
+    // through the key's reflection and drew a second highlight on its rim, beside the iris.
+    vec3 refl_cornea = reflect(-v, eye_rot * corneal);
+    vec3 boxes = (softbox(refl_cornea, catch_light_direction(u_key_dir), SOFTBOX) * u_key_col * KEY_REFLECTION
+                  + softbox(refl_cornea, u_fill_dir, FILL_BOX) * u_fill_col * FILL_REFLECTION) * cornea;
+    vec3 spec = (boxes + room * mix(0.45, 1.0, cornea)) * fres;
     // The sclera and the lid's wet rim are wet too but less smooth (a broad sheen), and the
     // tear meniscus catches a thin bright line of the key.
     spec += specular_light(n, v, 40.0) * 0.03 + tear * u_key_col * TEAR_SHINE;

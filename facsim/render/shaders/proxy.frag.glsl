@@ -42,11 +42,15 @@ out vec4 f_color;
 // Greying hair: the fraction of white strands wanders from clump to clump (clump: clump
 // coordinates), so grey hair shows darker and lighter locks, salt and pepper at the scale
 // of clumps, rather than one flat grey; where clumps are finer than a pixel, the mean colour.
+// (grey_clump: the clump's noise, [0, 1]; unresolved: 1 where clumps are finer than a pixel)
+vec3 grey_clump_colour(float grey_clump, float unresolved) {
+    float local = clamp(u_grey + 0.6 * (grey_clump - 0.5), 0.0, 1.0);
+    return mix(mix(u_pigment, u_white, local), u_color, unresolved);
+}
 vec3 hair_colour(vec2 clump) {
     if (u_grey <= 0.0) return u_color;
-    float local = clamp(u_grey + 0.6 * (value_noise(clump, 0) - 0.5), 0.0, 1.0);
-    vec3 c = mix(u_pigment, u_white, local);
-    return mix(c, u_color, clamp(0.5 * max(fwidth(clump.x), fwidth(clump.y)) - 0.25, 0.0, 1.0));
+    return grey_clump_colour(value_noise(clump, 0),
+                             clamp(0.5 * max(fwidth(clump.x), fwidth(clump.y)) - 0.25, 0.0, 1.0));
 }
 
 // Value noise in 3D on the integer lattice, [0, 1] (callers pick or fade the octave).
@@ -147,8 +151,13 @@ float flow_strands(vec3 rest, float cells_per_dm, float stretch) {
     vec2 out_dir = rest.xz - u_hair_apex_rest.xz;
     out_dir /= max(length(out_dir), 1e-4);
     float along = length(rest - u_hair_apex_rest);
-    vec3 p = vec3(out_dir.x, 0.0, out_dir.y) * (HAIR_VOLUME_RADIUS * cells_per_dm)
-           + vec3(0.0, along * cells_per_dm / stretch, 0.0);
+    vec3 across = vec3(out_dir.x, 0.0, out_dir.y) * (HAIR_VOLUME_RADIUS * cells_per_dm);
+    // (each streak starts and ends at its own place along the flow, and the lattice lies at 45
+    // degrees to the head's axes: on the lattice as it was, neighbouring streaks ended level
+    // with one another, in rows of bricks over light hair)
+    float stagger = 3.0 * lattice_noise3(across * 0.7 + 5.0);
+    vec3 p = vec3(0.7071 * (across.x + across.z), along * cells_per_dm / stretch + stagger,
+                  0.7071 * (across.z - across.x));
     float cells = max(length(fwidth(p)), 1e-5);
     vec2 octave = strand_octave(cells);
     float n0 = octave.y < 0.999 ? lattice_noise3(p * octave.x + 3.0) : 0.5;
@@ -493,9 +502,9 @@ void main() {
         // Where a pixel resolves them, the mass's single coils (coil_dome): each solid, there
         // where its rank is under the density, so the hairline ends in short coils standing
         // apart on the skin, not in a soft dark film along a clean line (blind review session 25).
-        float detail, rank;
         // (the hairline's hairs are shorter and finer than the mass's: coils 1.4 times smaller,
         // over a little of the fine cover they grow from)
+        float detail, rank;
         vec4 coil = coil_dome(v_rest * 1.4, n, detail, rank);
         float present = smoothstep(rank - 0.08, rank + 0.08, 1.6 * dens - 0.1);
         float disc = clamp(0.5 + (coil.w - 0.2) / max(fwidth(coil.w), 0.05), 0.0, 1.0);
@@ -650,12 +659,17 @@ void main() {
 #endif
 #endif
 #ifdef COILY
-    // (the single coils under this pixel, coil_dome: its outline, its thinning and its shading)
+    // (the single coils under this pixel, coil_dome: the mass's thinning and its shading)
     float coil_detail, coil_id;
     vec4 coil = coil_dome(v_rest, n, coil_detail, coil_id);
     // (only at the outline, where the eye grazes the mass and each card layer shows its own
     // coils, do they fade out of the shading)
     coil_detail *= smoothstep(0.05, 0.25, dot(n, v));
+    // (where a coil spans many pixels, 1024², the hairs wound in it break up its dome and its
+    // glint: smooth domes read as beads)
+    vec3 coil_hair_p = COIL_TURN_B * v_rest * 140.0;
+    float coil_hair_fade = clamp(2.0 - 1.4 * length(fwidth(coil_hair_p)), 0.0, 1.0) * coil_detail;
+    float coil_hairs = coil_hair_fade > 0.0 ? mix(1.0, 0.3 + 1.4 * lattice_noise3(coil_hair_p), coil_hair_fade) : 1.0;
 #endif
     // Strand coordinates: across the strands (u) many, along them (v) few. Each noise fades
     // to its mean where it would be finer than a pixel, so small images do not shimmer.
@@ -685,36 +699,29 @@ void main() {
     float lock_flow = 0.0;
     float parting_open = 1.0;
 #else
-    // On the crown, where strands run sideways from the parting (their direction on the neutral
-    // head near horizontal), long01's cards lie in rows across the strands, each row starting
-    // its strands afresh at the same texture coordinates: in the cards' coordinates the strands
-    // drew the rows as horizontal bands across the crown. There they are placed on the head,
-    // running on from row to row; hanging lengths keep the cards' unbroken root-to-tip strands.
+    // Hair whose texture runs along v (u_along_v: long01, the bobs) hangs down and out from the
+    // crown as a whole: its pixel-scale strands follow that flow everywhere (flow_strands), as do
+    // its locks (below), the same pattern on every card. (On the crown its cards lie in rows
+    // across the sideways strands, and strands in the cards' coordinates drew the rows as bands;
+    // switched between the cards' coordinates and the head's by each card's own tangent, the
+    // pattern changed at every card's edge: the crown's cards drew as blocks and wood grain,
+    // "helmet hair", blind review session 25.)
     vec3 along_rest = normalize(v_rest_tangent + vec3(0.0, 1e-4, 0.0));
-    float on_head = mix(1.0, 1.0 - smoothstep(0.55, 0.8, abs(along_rest.y)), u_along_v);
-    // Where the strands run down and out from the crown (most of a short style's mass), they are
-    // streaks along that flow (flow_strands); where they turn away from it (a fringe falling over
-    // the forehead, hair brushed sideways), short smears along their own direction (pixel_strands).
-    float flow_share = 0.0;
+    // Short styles: where the strands run down and out from the crown (most of the mass), they
+    // are streaks along that flow (flow_strands); where they turn away from it (a fringe falling
+    // over the forehead, hair brushed sideways), short smears along their own direction (pixel_strands).
+    float flow_share = 1.0;
     if (u_along_v < 0.5) {
         vec3 nv = normalize(v_rest - volume_axis_point(v_rest, u_hair_apex_rest));
         vec3 meridian = cross(nv, normalize(cross(vec3(0.0, 1.0, 0.0), nv) + vec3(1e-5, 0.0, 0.0)));
         flow_share = smoothstep(0.75, 0.92, abs(dot(meridian, along_rest)));
-    } else {
-        // long hair's crown: its strands follow the flow its locks follow (flow_lock_coordinate),
-        // not each card's own tangent, which turned from card to card and drew wood grain
-        flow_share = on_head;
     }
     // (strands pointing at the eye are seen end-on: their streaks shrink to dots, which
     // speckled a fringe brushed forward; there the streaks fade to their mean)
     float tv = dot(normalize(v_tangent), normalize(u_cam_pos - v_pos));
     float seen_along = smoothstep(0.45, 0.8, sqrt(max(1.0 - tv * tv, 0.0)));
     float px_flow = flow_share > 0.001 ? mix(0.5, flow_strands(v_rest, 60.0, 8.0), seen_along) : 0.5;
-    float px = flow_share > 0.999 ? px_flow
-             : on_head > 0.999 ? mix(pixel_strands(v_rest, along_rest, 60.0), px_flow, flow_share)
-             : on_head < 0.001 ? pixel_strands_uv(v_uv, vec2(40.0, 1.5), vec2(5.0, 5.0) + 2.0 * phase)
-             : mix(pixel_strands_uv(v_uv, vec2(40.0, 1.5), vec2(5.0, 5.0) + 2.0 * phase),
-                   u_along_v > 0.5 ? px_flow : pixel_strands(v_rest, along_rest, 60.0), on_head);
+    float px = flow_share > 0.999 ? px_flow : mix(pixel_strands(v_rest, along_rest, 60.0), px_flow, flow_share);
     // Long hair ends above u_end_height (MakeHuman's long cards hang on through the shoulders)
     // the way a cut bob does: clumps a few millimetres across end at a little different
     // lengths, and within each the strands end one by one over the last few millimetres, so
@@ -740,7 +747,7 @@ void main() {
         alpha *= tips * step(1e-4, thinning);
     }
     float px_full = px;
-    if (u_along_v > 0.5) px = mix(0.5, px, mix(0.4, 0.8, on_head));   // (the crown's: along the flow, in place of the cards')
+    if (u_along_v > 0.5) px = mix(0.5, px, 0.8);
     // Locks: strands gather into locks a few millimetres across and several long, placed on the
     // neutral head along the strands (so they run on across the cards, as px does); the narrow
     // gaps between them lie in their neighbours' shade and their crowns catch the light, so a
@@ -771,9 +778,9 @@ void main() {
     // neighbour, strands bridge the gap), a centimetre or two at a time: unbroken, they ran from
     // the crown to the ends as ruled lines.
     float parting_open = smoothstep(0.3, 0.62, lattice_noise3(flow_lock_p * vec3(1.3, 4.0, 1.3) + 53.0));
-    // (long hair's crown, combed flat sideways from the parting, shows shallower gaps than its
-    // hanging lengths: at full depth there its locks drew bands across the crown)
-    lock = clamp(0.5 + mix(1.6, 0.8, on_head * u_along_v) * (lock - 0.5), 0.0, 1.0);
+    // (long hair's locks show shallower gaps than a short style's: at full depth they drew
+    // bands across the crown)
+    lock = clamp(0.5 + mix(1.6, 0.8, u_along_v) * (lock - 0.5), 0.0, 1.0);
 #endif
     // The hair's outline: where the volume turns away from the eye, its outer strands stand
     // apart, so the outline breaks into strands and clumps with the background between them
@@ -821,8 +828,8 @@ void main() {
     // Coily hair thins in whole clumps of coils (coily_clumps), each solid, with skin between
     // them: curls finer than a pixel thinned it into a grey translucent film (the tufts over
     // the ears).
-    // (and the clumps' edges break into single coils, so the hairline ends in short coils)
-    // (not toward the outline, where coils a pixel across would speckle it: the outline is the clumps')
+    // (and the clumps' edges break into single coils, so the hairline ends in short coils; not
+    // toward the outline, where coils a pixel across would speckle it: the outline is the clumps')
     float thin_at = coily_clumps(coil_place(v_rest))
                   - 0.3 * coil_detail * smoothstep(0.2, 0.55, dot(n, v)) * (coil.w - 0.6);
     float thin_by = 1.3 * v_cover - 0.15 - thin_at;
@@ -867,9 +874,12 @@ void main() {
 #ifndef COILY
     // Long hair's crown: the cards' own texture and UV clumps run along each card (sideways
     // there, a card to a row) and stop at its edge: they drew the rows as wood grain and the
-    // cards as blocks under strands and locks that follow the flow. They keep a little say.
+    // cards as blocks under strands and locks that follow the flow. They keep a little say there
+    // (the crown: over the hair volume's dome, placed on the head, not by each card's tangent);
+    // the hanging lengths' cards run down with their strands and keep theirs.
     {
-        float card_say = 1.0 - 0.75 * on_head * u_along_v;
+        float crown = smoothstep(-0.3, 0.1, v_rest.y - dome_base(u_hair_apex_rest));
+        float card_say = 1.0 - 0.75 * u_along_v * crown;
         tex.r = mix(0.5, tex.r, card_say);
         fine = mix(0.5, fine, card_say);
         mid = mix(0.5, mid, card_say);
@@ -899,11 +909,10 @@ void main() {
         // blotchy camouflage)
         float light = sqrt(clamp(dot(u_color, LUMINANCE), 0.0, 1.0));
         // Each coil: its top and its side toward the key lighter, the crevices round it darker.
-        float single = coil_detail;
         float coil_key = clamp(dot(coil.xyz - n, u_key_dir) + 0.5, 0.0, 1.0);
         // (light hair scatters light into the crevices: grey coils at full depth read as gravel)
         float coil_shade = mix(1.0, mix(mix(0.45, 0.7, light), 1.1, coil.w) * (0.7 + 0.6 * coil_key)
-                                  * (0.85 + 0.3 * coil_id), single * mix(1.0, 0.7, light));
+                                  * (0.85 + 0.3 * coil_id) * coil_hairs, coil_detail * mix(1.0, 0.7, light));
         strand = mix(strand, mix(mix(0.55, 0.75, light), mix(1.15, 1.05, light), crown) * coil_shade, u_coil);
         // Greying coily hair mixes white, grey and dark coils (placed on the head, not in the
         // cards' mirrored UVs), finer than its clumps: clumps of white and dark drew grey afros
@@ -912,7 +921,16 @@ void main() {
         albedo = (u_grey > 0.0 ? mix(u_pigment, u_white, white) : u_color) * strand;
     }
 #else
-    albedo = hair_colour(v_uv * vec2(45.0, 1.2) + 7.0 + 0.5 * phase) * strand;
+    vec3 clump_colour;
+    // (long hair: greying clumps along the flow too; in the cards' UVs each card of the crown
+    // was its own patch of white or grey)
+    if (u_grey > 0.0 && u_along_v > 0.5) {
+        vec3 q = flow_lock_p * vec3(2.0, 4.0, 2.0) + 29.0;   // ~3 mm across, several cm along
+        clump_colour = grey_clump_colour(lattice_noise3(q), clamp(0.5 * length(fwidth(q)) - 0.25, 0.0, 1.0));
+    } else {
+        clump_colour = hair_colour(v_uv * vec2(45.0, 1.2) + 7.0 + 0.5 * phase);
+    }
+    albedo = clump_colour * strand;
     // Greying hair: white, grey and dark strands side by side at the pixel scale too (the
     // clump-scale mix above fades to one flat grey at stimulus sizes).
     if (u_grey > 0.0)
@@ -1019,7 +1037,7 @@ void main() {
     // coil drew a regular lattice of dots)
     float glint_at = max(dot(coil.xyz, normalize(u_key_dir + v)), 0.0);
     vec3 coil_glint = u_key_col * hair_tint() * 0.5 * exp2(24.0 * log2(max(glint_at, 1e-4)))
-                    * coil_detail * (0.2 + 1.3 * coil_id * coil_id) * mix(0.3, 1.2, crown);
+                    * coil_detail * (0.2 + 1.3 * coil_id * coil_id) * mix(0.3, 1.2, crown) * coil_hairs * coil_hairs;
     spec = mix(spec, coily_sheen(n, v, crown) + coil_glint, u_coil);
     self_shadow = mix(self_shadow, coily_self_shadow(n, v, crown, v_pos.y - dome_base(u_hair_apex)), u_coil);
 #endif
