@@ -49,6 +49,14 @@ upper teeth's top run of pixels, its mean luminance; the 10th and 90th percentil
 the middle half of the row (crowns, their shaded flanks and the embrasures: a flat strip has
 them close), and the row's outer sixths' mean over its middle third's (the buccal corridor).
 
+The catch-light and the iris (``--iris``), at rest, front, per eye: at 768 px without
+anti-aliasing the catch-light's core (over half-way from the iris's median to its peak)
+against the pupil: the gap between them, its centre's offset from the pupil's centre to the
+image's right and upward (mm, from the iris's 11.7 mm), its area (mm²); at 448 px (4x MSAA), on
+the iris's lower half (clear of the lid's shade and the catch-light), the ciliary zone's spread
+(std over mean luminance: its streaks) and the pupillary zone's mean luminance over the ciliary
+zone's (a darker ring round the pupil reads as a target's).
+
 Usage::
 
     python3 scripts/eyes_mouth_figures.py [CHARACTER ...]      (default: amara liam mei george)
@@ -58,6 +66,7 @@ Usage::
     python3 scripts/eyes_mouth_figures.py --lips [--engine muscle] [CHARACTER ...]
     python3 scripts/eyes_mouth_figures.py --teeth [--engine muscle] [CHARACTER ...]
     python3 scripts/eyes_mouth_figures.py --sclera [--engine muscle] [CHARACTER ...]
+    python3 scripts/eyes_mouth_figures.py --iris [CHARACTER ...]
 """
 from __future__ import annotations
 
@@ -347,6 +356,47 @@ def sclera_figures(character, expression, size=448, engine="registers") -> dict:
             "pupil_over_iris_width": ratios}
 
 
+def iris_figures(character) -> dict:
+    """The catch-light against the pupil at 768 px and the iris's streaks and pupillary ring at
+    448 px (module docstring, ``--iris``), per eye, left to right."""
+    figures = {"catch_gap_mm": [], "catch_right_mm": [], "catch_up_mm": [], "catch_mm2": [],
+               "ciliary_spread": [], "pupillary_over_ciliary": []}
+    size = 768
+    image, cornea_marked, pupil_marked = _renders(character, "", [{"iris": "#ff0000", "pupil": "#ff0000"},
+                                                                  {"pupil": "#00ff00"}], size=size, antialias=1)
+    cornea = ndimage.binary_fill_holes(_changed(cornea_marked, image))
+    pupil = ndimage.binary_fill_holes(_changed(pupil_marked, image))
+    luminance = image @ LUMINANCE
+    for side in (slice(0, size // 2), slice(size // 2, size)):
+        eye, own_pupil = np.zeros_like(cornea), np.zeros_like(pupil)
+        eye[:, side], own_pupil[:, side] = cornea[:, side], pupil[:, side]
+        px_per_mm = (np.ptp(np.flatnonzero(eye.any(axis=0))) + 1) / IRIS_DIAMETER_MM
+        core = eye & (luminance > (luminance[eye].max() + np.median(luminance[eye])) / 2)
+        (cy, cx), (py, px) = (np.mean(np.nonzero(mask), axis=1) for mask in (core, own_pupil))
+        figures["catch_gap_mm"].append(round(float(ndimage.distance_transform_edt(~own_pupil)[core].min() / px_per_mm), 2))
+        figures["catch_right_mm"].append(round(float((cx - px) / px_per_mm), 2))
+        figures["catch_up_mm"].append(round(float((py - cy) / px_per_mm), 2))
+        figures["catch_mm2"].append(round(float(core.sum() / px_per_mm ** 2), 2))
+    size = 448
+    image, iris_marked, pupil_marked = _renders(character, "", [{"iris": "#ff0000"}, {"pupil": "#00ff00"}], size=size)
+    iris = ndimage.binary_erosion(_changed(iris_marked, image))
+    pupil = ndimage.binary_fill_holes(_changed(pupil_marked, image))
+    luminance = image @ LUMINANCE
+    for side in (slice(0, size // 2), slice(size // 2, size)):
+        eye, own_pupil = np.zeros_like(iris), np.zeros_like(pupil)
+        eye[:, side], own_pupil[:, side] = iris[:, side], pupil[:, side]
+        ys, xs = np.nonzero(eye)
+        py, px = np.nonzero(own_pupil)
+        radius, pupil_radius = (np.ptp(xs) + 1) / 2, (np.ptp(px) + 1) / 2
+        t = (np.hypot(ys - py.mean(), xs - (xs.max() + xs.min()) / 2) - pupil_radius) / (radius - pupil_radius)
+        below = ys > py.mean()
+        ciliary = luminance[ys, xs][below & (t > 0.35) & (t < 0.8)]
+        pupillary = luminance[ys, xs][below & (t > 0.05) & (t < 0.3)]
+        figures["ciliary_spread"].append(round(float(ciliary.std() / ciliary.mean()), 3))
+        figures["pupillary_over_ciliary"].append(round(float(pupillary.mean() / ciliary.mean()), 2))
+    return figures
+
+
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("characters", nargs="*", default=["amara", "liam", "mei", "george"])
@@ -358,11 +408,16 @@ def main(argv=None) -> None:
                         help="sclera bared above and below the iris at rest, 5E, surprise and fear only")
     parser.add_argument("--lips", action="store_true", help="the lips' red heights at the midline, per expression")
     parser.add_argument("--teeth", action="store_true", help="the smile's upper teeth along the row at 448 px")
+    parser.add_argument("--iris", action="store_true",
+                        help="the catch-light against the pupil (768 px) and the iris's streaks (448 px), at rest")
     parser.add_argument("--sclera", action="store_true",
                         help="the sclera's and iris's luminance against the cheek's, and the pupil's width, at 448 px")
     args = parser.parse_args(argv)
     for name in args.characters:
         character = preset(name)
+        if args.iris:
+            print(name, "neutral", "  ".join(f"{k} {v}" for k, v in iris_figures(character).items()), flush=True)
+            continue
         if args.sclera:
             for expression in ("", "1+2+5+26", "1+2+4+5+20+26"):
                 figures = sclera_figures(character, expression, engine=args.engine)

@@ -261,6 +261,40 @@ def test_the_two_irises_are_not_one_pattern_twice():
         assert best < 0.7, (flip, best)
 
 
+def test_at_448_px_the_iris_is_streaked_not_a_target():
+    """At the blind review's size (448 px) an iris is ~22 px across: its fibres have faded into
+    their mean, and what is left must still read as a streaked, mottled iris. On 9f8b92e its
+    ciliary zone varied by 7-8 % of its light (ava) and a darker pupillary zone ringed the pupil
+    (0.91-0.92 of the ciliary zone's light): a smooth disc with the rings of a target, glass
+    (issue 13, "glassy eyes"). Measured on the lower half, clear of the lid's shade and the
+    catch-light."""
+    from scipy import ndimage
+
+    size = 448
+    ava = preset("ava").with_(symmetric=True)
+    renders = {}
+    for key, colours in (("normal", {}), ("iris", {"iris": "#ff0000"}), ("pupil", {"pupil": "#00ff00"})):
+        with Face(ava.with_(colors={**ava.colors, **colours})) as face:
+            renders[key] = face.render("", size=size, background=(1.0, 1.0, 1.0))[..., :3].astype(float)
+    image = renders["normal"]
+    iris = ndimage.binary_erosion(np.abs(renders["iris"] - image).sum(-1) > 60)   # (not its anti-aliased rim)
+    pupil = ndimage.binary_fill_holes(np.abs(renders["pupil"] - image).sum(-1) > 60)
+    lum = _luminance(image)
+    spreads = []
+    for side in (slice(0, size // 2), slice(size // 2, size)):
+        eye, own_pupil = np.zeros_like(iris), np.zeros_like(pupil)
+        eye[:, side], own_pupil[:, side] = iris[:, side], pupil[:, side]
+        ys, xs = np.nonzero(eye)
+        py, px = np.nonzero(own_pupil)
+        radius, pupil_radius = (np.ptp(xs) + 1) / 2, (np.ptp(px) + 1) / 2
+        t = (np.hypot(ys - py.mean(), xs - (xs.max() + xs.min()) / 2) - pupil_radius) / (radius - pupil_radius)
+        below = ys > py.mean()
+        ciliary, pupillary = lum[ys, xs][below & (t > 0.35) & (t < 0.8)], lum[ys, xs][below & (t > 0.05) & (t < 0.3)]
+        spreads.append(ciliary.std() / ciliary.mean())
+        assert pupillary.mean() / ciliary.mean() > 0.94
+    assert np.mean(spreads) > 0.095, spreads
+
+
 def test_the_rim_of_a_raised_upper_lid_is_skin_not_a_teal_band():
     """Where 5 raises the upper lid (fear, 1+2+4+5+20+26) its rim over the eyeball faces the key
     while the normal averaged over a centimetre runs down into the socket; red light, which sees

@@ -471,6 +471,13 @@ const vec2 CARUNCLE = vec2(0.46, 0.56);   // nasal e.x where the caruncle begins
 const float SCLERA_MOTTLE = 0.1;    // the sclera's patchiness (relative, about its mean)
 const float IRIS_SECTORS = 0.22;   // how much lighter or darker the iris's broad sectors are (about its mean)
 const float IRIS_CAUSTIC = 0.3;    // how much brighter the iris's lower rim is (the key is above; 0.5 glowed as in a glass marble)
+// The iris at 448-512 px, where its fibres have faded: the coarse bundles' share (0.3 until
+// session 26, when its streaks were 4.6 % of its light on ava at 448 px: a smooth disc of glass),
+// the collarette's zigzag (fraction of the annulus; 0.05 drew a round ring) and how much darker
+// the pupillary zone inside it is (0.6 drew the dark ring of a target round the pupil).
+const float IRIS_BUNDLES_ALONE = 0.85;
+const float COLLARETTE_WAVE = 0.12;
+const float PUPILLARY_ZONE = 0.3;
 // The key's reflection in the cornea: the softbox's half-size (radians, across and up) and
 // strength; the room's faint reflection over the whole cornea. (Issue 13: at 0.22 x 0.19
 // with the fill's at 0.6, two large bright patches read as glossy doll's eyes.)
@@ -1282,11 +1289,11 @@ void main() {
     fibre = mix(0.425, fibre, fibre_detail);
     float bundle_detail = clamp(1.6 - 0.6 * fwidth(turns * 0.25), 0.0, 1.0);
     float bundle = mix(0.5, value_noise(vec2(turns * 0.25, t * 6.0 + 11.0 + iris_seed), IRIS_FIBRES / 4), bundle_detail);
-    fibre += 0.075 + mix(0.3, 0.15, fibre_detail) * (bundle - 0.5);
+    fibre += 0.075 + mix(IRIS_BUNDLES_ALONE, 0.15, fibre_detail) * (bundle - 0.5);
     // The collarette, a third of the way out, is a wavy ridge (it zigzags around the iris):
     // inside it the pupillary zone is darker and warmer, outside it the ciliary zone is
     // broken by darker crypts; a dark ruff rims the pupil and a dark limbal ring the iris.
-    float wave = 0.05 * (value_noise(vec2(turns * 0.33, 0.5 + iris_seed), IRIS_FIBRES / 3) - 0.5);
+    float wave = COLLARETTE_WAVE * (value_noise(vec2(turns * 0.33, 0.5 + iris_seed), IRIS_FIBRES / 3) - 0.5);
     float collar_t = t - COLLARETTE - wave;
     float inner = 1.0 - smoothstep(-0.03, 0.03, collar_t);
     float ridge = exp(-pow(collar_t / 0.035, 2.0));
@@ -1302,7 +1309,7 @@ void main() {
     vec3 base_iris = mix(u_iris, vec3(iris_grey), mix(0.3, 0.62, smoothstep(0.03, 0.12, iris_grey)));
     vec3 iris = base_iris * (0.42 + 1.05 * fibre);
     iris = mix(iris, vec3(iris_grey) * vec3(1.05, 1.0, 0.92) * (0.35 + 1.1 * fibre), 0.35 * smoothstep(0.45, 0.8, fibre) * fibre_detail);
-    iris *= mix(vec3(1.0), vec3(0.72, 0.64, 0.52), 0.6 * inner);      // darker, warmer pupillary zone
+    iris *= mix(vec3(1.0), vec3(0.72, 0.64, 0.52), PUPILLARY_ZONE * inner);   // darker, warmer pupillary zone
     iris *= 1.0 - 0.3 * ridge * fibre_detail;                          // the collarette's dark fold
     iris *= 1.0 - 0.3 * crypt;
     // Broad sectors, a few around the iris, lighter or darker and a little warmer where darker
