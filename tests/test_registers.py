@@ -1156,3 +1156,52 @@ def test_sad_and_fearful_brows_are_drawn_together_by_4_not_further_by_1(face_of,
     assert _spread_change(engine, marks, activations(parse("1"))) > -0.002
     gathered = _spread_change(engine, marks, activations(parse(brows)))
     assert _spread_change(engine, marks, activations(parse("4"))) - 0.002 < gathered < -0.03
+
+
+# Session 26 (jaw): surprise's slack open mouth and disgust's raised upper lip, as the FACS manual describes them.
+def _lower_teeth_shown(face, expression):
+    """How far (dm) the lower incisors' edge stands above the lower lip's inner edge at the midline:
+    the band of lower teeth a viewer sees over the lip (negative: the lip covers them)."""
+    from facsim.speech.mouth import mouth_shape
+
+    mouth_shape(face, positions=face.neutral)          # builds face._mouth_gauge
+    gauge = face._mouth_gauge
+    rest = np.asarray(face.neutral, np.float64)
+    front = gauge.lower_teeth[np.abs(rest[gauge.lower_teeth, 0]) < 0.03]
+    edge = front[np.argmax(rest[front, 1])]
+    moved = np.asarray(face.deform(expression).positions, np.float64)
+    return moved[edge, Y] - moved[gauge.lower_lip, Y]
+
+
+@pytest.mark.parametrize("character", ["ava", "george", "kwame", "mei"])
+def test_26_hangs_the_lower_lip_over_the_lower_teeth(face_of, character):
+    """FACS 26: the jaw drops and the lips part relaxed - the slack lower lip lies over the lower teeth
+    (the upper teeth's edges may show); drawing the lower lip down off them is 16's, and stretched wide
+    over them fear's (20+26). On main fb62a7c the lower incisors stood 2.2-3.1 mm above the lower lip at
+    26E and 1.7-3.3 mm in surprise at 100 % (ava, george, kwame, mei; FER2013 read surprise as fear);
+    now at most 0.9 mm (1.2 at 50 %), and fear still shows them (4.5 mm or more)."""
+    from facsim.facs.emotions import emotion
+
+    face = face_of(character)
+    for expression in ("26E", emotion("surprise"), emotion("surprise", intensity=0.5)):
+        assert _lower_teeth_shown(face, expression) < 0.015, (character, expression)
+    assert _lower_teeth_shown(face, emotion("fear")) > 0.035
+
+
+@pytest.mark.parametrize("character", ["ava", "george", "mei"])
+@pytest.mark.parametrize("level", [1.0, 0.5])
+def test_surprise_opens_in_a_rounded_oval_fear_in_a_wide_slot(face_of, character, level):
+    """Surprise's relaxed lips hang from the dropped jaw and draw the corners in, an oval as tall as it is
+    half wide; fear's lips are stretched out sideways (20). On main fb62a7c surprise's mouth was 3.1-3.3 mm
+    narrower than at rest at 100 % and 1.9 at 50 %; now 5.9-6.9 and 3.6-3.9, fear 9.7 mm wider."""
+    from facsim.facs.emotions import emotion
+    from facsim.speech.mouth import mouth_shape
+
+    face = face_of(character)
+    rest = mouth_shape(face, positions=face.neutral)
+    surprise = mouth_shape(face, positions=face.deform(emotion("surprise", intensity=level)).positions)
+    fear = mouth_shape(face, positions=face.deform(emotion("fear", intensity=level)).positions)
+    assert surprise.width < rest.width - 5.0 * level          # mm: the slack corners drawn in
+    assert surprise.gap > 0.45 * surprise.width * level        # the opening's height against its width
+    assert fear.width > rest.width + 8.0 * level
+
