@@ -26,7 +26,14 @@
    and encoding (the pipe to ffmpeg), plus start-up (imports, face build, first frame's
    shaders) and ffmpeg's finish.
 
+3. **Per draw call** (``--draws``), in a fresh process with one llvmpipe thread, each draw call
+   waited for: CPU milliseconds per drawn frame of each draw group (the skin's shader variant,
+   each proxy kind's alpha-tested and blended passes, the head's depth pre-pass, the shadow
+   map, FXAA), over the serial video's frames after the first, and in how many frames the
+   still hair was kept as pixels. It tells which shader a speed-up has to make cheaper.
+
     python benchmarks/bench_video.py [--repeats 5] [--character ava] [--baseline-rev REV] [--muscle] [--nice -20]
+    python benchmarks/bench_video.py --draws [--character ava] [--emotion happiness]
 """
 from __future__ import annotations
 
@@ -120,6 +127,73 @@ def stages(args) -> dict:
     return {"frames": len(frames), "drawn": len(drawn), "laps": laps, "ffmpeg_cpu": children.ru_utime + children.ru_stime}
 
 
+def draw_calls(args) -> dict:
+    """CPU seconds of each draw group over the serial video's drawn frames after the first (which
+    compiles the shaders), each draw call waited for (``finish``) so its work is its own."""
+    import moderngl
+
+    from facsim.face import Face
+    from facsim.head.character import resolve_character
+    from facsim.pipeline import _frames_drawn, deformations, frame_sources
+    from facsim.timeline.builders import stimulus_timeline
+    from facsim.timeline.sampling import sample_frames
+
+    os.environ["FACSIM_SERIAL_FRAMES"] = "1"
+    face = Face(resolve_character(args.character))
+    frames = sample_frames(stimulus_timeline(args.emotion, 1.0, 1.0, 1.0, FPS), FPS)
+    sources = frame_sources(face, frames, frame_bytes=args.size * args.size * 4)
+    drawn = [act for i, act in enumerate(frames) if sources[i] == i]
+    options = dict(size=args.size, antialias="fxaa")
+    renderer = face.renderer(**options)
+    ctx = renderer._ctx
+    names: dict[int, str] = {}
+    cpu: dict[str, float] = {}
+    timing = [False]
+    render = moderngl.VertexArray.render
+
+    def timed_render(vao, *a, **k):
+        if not timing[0]:
+            return render(vao, *a, **k)
+        ctx.finish()
+        start = time.process_time()
+        render(vao, *a, **k)
+        ctx.finish()
+        name = names.get(id(vao), "other")
+        cpu[name] = cpu.get(name, 0.0) + time.process_time() - start
+
+    def name_vertex_arrays():  # (variants compile as frames need them: named again each frame)
+        names.update({id(vao): f"face: {name}" for name, vao in renderer._vaos.items()})
+        if renderer._depth_vao is not None:
+            names[id(renderer._depth_vao)] = "head depth pre-pass"
+        for mesh, layer in renderer._proxy_layers.items():
+            names.update({id(vao): f"{mesh.kind}: {stage}" for stage, vao in layer.vaos.items()})
+        if renderer._downsample is not None:
+            names[id(renderer._downsample)] = "anti-aliasing (FXAA)"
+        shadow = renderer._key_shadow
+        if shadow is not None:
+            names[id(shadow._vao)] = "shadow map: head"
+            names.update({id(vao): "shadow map: hair cards" for vao in shadow._card_vaos.values()})
+
+    moderngl.VertexArray.render = timed_render
+    count, kept = 0, 0
+    try:
+        with renderer.sequence(), deformations(face, drawn) as stream:
+            def draw(deformation):
+                nonlocal count, kept
+                name_vertex_arrays()
+                timing[0] = count > 0
+                image = face.render(deformation=deformation, **options)
+                kept += count > 0 and renderer._hair_moving is not None
+                count += 1
+                return image
+
+            for _ in _frames_drawn(sources, stream, draw):
+                pass
+    finally:
+        moderngl.VertexArray.render = render
+    return {"frames": count - 1, "kept": kept, "cpu": cpu}
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--repeats", type=int, default=5)
@@ -135,11 +209,31 @@ def main(argv=None) -> int:
                         help="also the muscle engine's video, before and now (its ratio is against its own before)")
     parser.add_argument("--stages-only", action="store_true", help="only the per-stage figures (JSON; internal)")
     parser.add_argument("--no-stages", action="store_true", help="only the end-to-end figures")
+    parser.add_argument("--draws", action="store_true",
+                        help="only the CPU per draw group, one llvmpipe thread (a fresh process; see 3. above)")
+    parser.add_argument("--draws-only", action="store_true", help=argparse.SUPPRESS)  # (JSON; internal)
     args = parser.parse_args(argv)
     global NICE
     NICE = args.nice
     if args.stages_only:
         print(json.dumps(stages(args)))
+        return 0
+    if args.draws_only:
+        print(json.dumps(draw_calls(args)))
+        return 0
+    if args.draws:
+        cmd = [sys.executable, __file__, "--draws-only", "--character", args.character, "--emotion", args.emotion,
+               "--size", str(args.size)]
+        done = subprocess.run(cmd, cwd=ROOT, env=dict(os.environ, PYTHONPATH=str(ROOT), LP_NUM_THREADS="1"),
+                              check=True, capture_output=True, text=True)
+        result = json.loads(done.stdout.strip().splitlines()[-1])
+        n = max(result["frames"], 1)
+        print(f"CPU per draw group, {args.emotion} on {args.character}, {args.size}² FXAA, one llvmpipe thread, "
+              f"each draw call waited for; over the {result['frames']} drawn frames after the first "
+              f"(still hair kept as pixels in {result['kept']} of them):")
+        for name, seconds in sorted(result["cpu"].items(), key=lambda item: -item[1]):
+            print(f"  {name:32s} {seconds / n * 1000:7.1f} ms/frame")
+        print(f"  {'all draw calls':32s} {sum(result['cpu'].values()) / n * 1000:7.1f} ms/frame")
         return 0
 
     with baseline_tree(args.baseline_rev, "bench-video-") as (tmp, base_tree):
