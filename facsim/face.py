@@ -117,14 +117,14 @@ class Face:
 
         from facsim.head.assets import cache_dir
         from facsim.head.proxies import bind_scalp, hair_table, hair_volume
-        from facsim.head.scalp import CROP_EDGE, CROP_ROUNDING, VERSION
+        from facsim.head.scalp import CROP_EDGE, CROP_ROUNDING, HAIRLINE_RISE, HAIRLINE_THINNING, RISE_FIT_WEIGHT, VERSION
 
         hair = [b for b in self.proxies if b.proxy.kind == "hair"]
         if not hair:
             return None
         # Cached on disk like the occlusion bake: by the head's shape, the style and its table.
         shape = self.character.with_(name="", description="", colors={}, hair="", brows="", lashes="")
-        key = hashlib.sha256(repr((VERSION, shape, hair[0].proxy.name,
+        key = hashlib.sha256(repr((VERSION, HAIRLINE_THINNING, HAIRLINE_RISE, RISE_FIT_WEIGHT, shape, hair[0].proxy.name,
                                    (hair[0].crop, hair_table()["crops"][hair[0].crop], CROP_ROUNDING, CROP_EDGE)
                                    if hair[0].crop else "", hair_table().get("scalp"),
                                    hair_volume(hair[0].proxy.name), hair_table().get("snug")))

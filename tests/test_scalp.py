@@ -369,3 +369,39 @@ def test_the_hairline_is_hair_in_the_open_not_a_dark_brim(face_of):
     band, columns = bench_hair_texture().hairline_band(with_hair, mask)
     assert columns > 50
     assert band > 1.15, band
+
+
+def _front_hairline_strands(layer) -> tuple[np.ndarray, np.ndarray]:
+    """Over the scalp layer's triangles on the forehead within 5 mm above the hairline: each one's
+    strand direction (dP/dv, unit) against the direction hair grows out of the hairline (|cos|),
+    and its mean density."""
+    p = np.asarray(layer.neutral, np.float64)
+    t = layer.proxy.triangles
+    uv = np.asarray(layer.proxy.uv, np.float64)
+    e1, e2 = p[t[:, 1]] - p[t[:, 0]], p[t[:, 2]] - p[t[:, 0]]
+    n = np.cross(e1, e2)
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    d1, d2 = uv[t[:, 1]] - uv[t[:, 0]], uv[t[:, 2]] - uv[t[:, 0]]
+    along = -d2[:, :1] * e1 + d1[:, :1] * e2   # dP/dv up to the determinant's scale and sign
+    along /= np.linalg.norm(along, axis=1, keepdims=True)
+    above = np.asarray(layer.hairline)[t].mean(axis=1)
+    front = (n[:, 2] > 0.6) & (np.abs(p[t].mean(axis=1)[:, 0]) < 0.3) & (above > 0.0) & (above < 0.5)
+    rise = np.abs(np.einsum("ij,ij->i", along, scalp.rising_directions(n)))
+    return rise[front], np.asarray(layer.shade)[t].mean(axis=1)[front]
+
+
+def test_the_hairline_s_hairs_rise_from_it_and_thin_not_a_headband(face_of):
+    """The fine hairs just above long hair's forehead hairline took the cards' strands' direction,
+    which runs along the forehead on long01, at full density: a flat band of hair colour along
+    the forehead under the cards' edge, a headband. They now rise from the hairline up and back
+    and thin toward it over a few millimetres. On ava's layer within 5 mm above the front
+    hairline: the strands' |cos| with up-and-back was 0.13, now 0.95; the density 0.67, now 0.37."""
+    rise, density = _front_hairline_strands(face_of("ava").scalp)
+    assert len(rise) >= 8
+    assert rise.mean() > 0.6, rise.mean()
+    assert density.mean() < 0.5, density.mean()
+    # up and back: over the forehead up, tilted back over the crown, none along the skin's normal
+    n = np.array([[0.0, 0.0, 1.0], [0.0, np.sqrt(0.5), np.sqrt(0.5)], [1.0, 0.0, 0.0]])
+    up = scalp.rising_directions(n)
+    assert np.allclose(np.einsum("ij,ij->i", up, n), 0.0, atol=1e-6)
+    assert up[0, 1] > 0.99 and up[1, 1] > 0.5 and up[1, 2] < -0.5 and up[2, 1] > 0.8 and up[2, 2] < -0.3

@@ -42,8 +42,17 @@ HAIRLINE_WIDTH = 0.06
 #: Height (dm) of the layer over the skin: enough not to fight it in the depth buffer.
 LIFT = 0.004
 #: Bump when the layer a character gets changes (its disk cache is keyed by it).
-VERSION = 13  # 2: afro01's cards stand off the skull (volume_mm in hair.yaml); 12: crops' anatomical, rounded hairline;
-#   13: every layer carries its height above the hairline
+VERSION = 18  # 2: afro01's cards stand off the skull (volume_mm in hair.yaml); 12: crops' anatomical, rounded hairline;
+#   13: every layer carries its height above the hairline; 18: the hairline's hairs rise from it, thinning
+#: Under a hairstyle's cards: the width (dm) over which the hair thins from full cover at the
+#: hairline (:func:`hairline_height`) to bare skin ...
+HAIRLINE_THINNING = 0.05
+#: ... and the band (dm above the hairline) over which its hairs turn from rising straight off
+#: it, up and back, to the cards' own flow.
+HAIRLINE_RISE = (0.1, 0.25)
+#: How much more the rising hairs' direction counts in the strand coordinates' fit than the
+#: cards' flow under them (:func:`strand_coordinates`).
+RISE_FIT_WEIGHT = 8.0
 #: Close crops (:func:`crop_hairline`): the radius (dm) over which the hairline is rounded off
 #: (the skin's vertices lie about a centimetre apart: an edge along them runs in steps) ...
 CROP_ROUNDING = 0.07
@@ -133,7 +142,7 @@ def scalp_density(skin: np.ndarray, normals: np.ndarray, cards: np.ndarray, tria
 
 
 def flow_directions(skin: np.ndarray, normals: np.ndarray, cards: np.ndarray, card_triangles: np.ndarray,
-                    card_uv: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+                    card_uv: np.ndarray, triangles: np.ndarray, *, rise=None) -> np.ndarray:
     """(N, 3) unit direction the hair runs over each skin vertex, in the skin's tangent plane.
 
     Taken from the nearest cards' strands (dP/dv: MakeHuman's hair textures run along v)
@@ -141,6 +150,12 @@ def flow_directions(skin: np.ndarray, normals: np.ndarray, cards: np.ndarray, ca
     (``triangles`` over the N vertices) and then given one sense by walking the mesh, each
     vertex agreeing with the one it was reached from: strand coordinates need directions
     that agree locally, whichever way the hair is combed.
+
+    ``rise``: optional (N,) weight (0 … 1) of the direction hair grows out of the hairline
+    (:func:`rising_directions`) over the cards' flow where that runs more than about 30° off
+    it. Near the hairline the cards' strands may run along it (long01's run sideways over the
+    whole front), and the fine hairs taking them lay parallel to the forehead as a band of hair
+    colour, a headband under the cards' edge.
     """
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import breadth_first_order, connected_components
@@ -166,6 +181,14 @@ def flow_directions(skin: np.ndarray, normals: np.ndarray, cards: np.ndarray, ca
     proj = np.eye(3)[None] - np.einsum("ni,nj->nij", normals, normals)
     tensor = proj @ tensor @ proj
     t = np.linalg.eigh(tensor)[1][:, :, -1]                             # the principal axis
+    if rise is not None:
+        up = rising_directions(normals)
+        cos = np.einsum("ij,ij->i", t, up)
+        t *= np.where(cos < 0, -1.0, 1.0)[:, None]  # the axis's sense nearer the rise
+        # Cards whose strands already rise from the hairline (short hair combed back, fanning
+        # out over the temples) keep their flow; those running along it turn to rise.
+        turn = np.asarray(rise, np.float64) * smoothstep(0.5, 0.85, np.sqrt(np.clip(1.0 - cos * cos, 0.0, 1.0)))
+        t = t + turn[:, None] * (up - t)
     # One sense: walk each connected piece of the layer, agreeing with the predecessor.
     _, piece = connected_components(adjacency, directed=False)
     for k in np.unique(piece):
@@ -177,11 +200,27 @@ def flow_directions(skin: np.ndarray, normals: np.ndarray, cards: np.ndarray, ca
     return (t / (np.linalg.norm(t, axis=1, keepdims=True) + 1e-12)).astype(np.float32)
 
 
+def rising_directions(normals: np.ndarray) -> np.ndarray:
+    """(N, 3) unit direction in the skin's tangent plane (outward ``normals`` (N, 3)) in which
+    hair grows out of the hairline: up and back (over the forehead and temples the hairs rise
+    off the skin toward the crown, under a fringe or a parting alike)."""
+    n = np.asarray(normals, np.float64)
+    up_back = np.array([0.0, 1.0, -0.5])
+    t = up_back[None, :] - np.einsum("ij,j->i", n, up_back)[:, None] * n
+    # skin facing up (the crown) has no "up" in its plane: back along it
+    t += 1e-3 * (np.array([0.0, 0.0, -1.0])[None, :] + n[:, 2:3] * n)
+    return t / (np.linalg.norm(t, axis=1, keepdims=True) + 1e-12)
+
+
 def strand_coordinates(points: np.ndarray, normals: np.ndarray, flow: np.ndarray,
-                       triangles: np.ndarray) -> np.ndarray:
+                       triangles: np.ndarray, *, weight=None) -> np.ndarray:
     """(N, 2) coordinates (dm) across and along the strands whose gradients best follow
     ``flow`` (least squares over the mesh's edges, as a stripe pattern is fitted to a
-    direction field), so a texture tiled in them lies along the hair."""
+    direction field), so a texture tiled in them lies along the hair.
+
+    ``weight``: optional (N,) weight of each vertex's edges in the fit. A flow that turns
+    (rising from the hairline, then along the cards) has no exact fit; where it shows, the
+    hairline, the fit should follow it and leave the error under the cards."""
     from scipy.sparse import coo_matrix, vstack
     from scipy.sparse.linalg import lsqr
 
@@ -193,13 +232,13 @@ def strand_coordinates(points: np.ndarray, normals: np.ndarray, flow: np.ndarray
     i, j = edges[:, 0], edges[:, 1]
     e = np.asarray(points, np.float64)[j] - np.asarray(points, np.float64)[i]
     rows = np.arange(len(edges))
-    d = coo_matrix((np.r_[-np.ones(len(edges)), np.ones(len(edges))], (np.r_[rows, rows], np.r_[i, j])),
-                   shape=(len(edges), n))
+    w = np.ones(len(edges)) if weight is None else 0.5 * (np.asarray(weight, np.float64)[i] + np.asarray(weight, np.float64)[j])
+    d = coo_matrix((np.r_[-w, w], (np.r_[rows, rows], np.r_[i, j])), shape=(len(edges), n))
     tie = coo_matrix((np.full(n, 1e-3), (np.arange(n), np.arange(n))), shape=(n, n))  # fixes the offsets
     a = vstack([d, tie]).tocsr()
     out = np.empty((n, 2), np.float32)
     for k, axis in enumerate((b, t)):
-        target = np.einsum("ij,ij->i", e, 0.5 * (axis[i] + axis[j]))
+        target = w * np.einsum("ij,ij->i", e, 0.5 * (axis[i] + axis[j]))
         out[:, k] = lsqr(a, np.r_[target, np.zeros(n)], atol=1e-8, btol=1e-8, iter_lim=4000)[0]
     return out
 
@@ -403,16 +442,29 @@ def scalp_layer(head, neutral_geometry: np.ndarray, cards: np.ndarray, card_tria
         above = np.clip(np.minimum(above, 10.0 * (ears - 0.5)), -6.0, 6.0).astype(np.float32)
         density = smoothstep(0.0, 1.0, above).astype(np.float32)
         keep = tris[(above[tris] > -3.0).any(axis=1)]   # the band, and room for it to wander
+        rise = None
     else:
+        # The hair thins toward the hairline over a few millimetres (it was full cover up to the
+        # first row of skin above it, a band of hair colour along the forehead) ...
+        density = density * smoothstep(0.0, HAIRLINE_THINNING / CROP_EDGE, above)
         keep = tris[(density[tris] > 0.0).any(axis=1)]
+        # ... and over the forehead its hairs rise from it up and back, under the cards, rather
+        # than running along it as the cards' strands may. Only where the skin faces forward:
+        # at the temples the hairline runs up and down, and hair swept back there already grows
+        # away from it (george's fan); at the nape hair hangs down.
+        rise = ((1.0 - smoothstep(HAIRLINE_RISE[0] / CROP_EDGE, HAIRLINE_RISE[1] / CROP_EDGE, above))
+                * smoothstep(0.25, 0.55, normals[:, 2]))
     if not len(keep):
         return None
     vertices = np.unique(keep)
     local = np.full(n_skin, -1, np.int64)
     local[vertices] = np.arange(len(vertices))
     triangles = local[keep]
-    flow = flow_directions(skin[vertices], normals[vertices], cards, card_triangles, card_uv, triangles)
-    uv = strand_coordinates(skin[vertices], normals[vertices], flow, triangles) / np.asarray(TILE, np.float32)
+    flow = flow_directions(skin[vertices], normals[vertices], cards, card_triangles, card_uv, triangles,
+                           rise=None if rise is None else rise[vertices])
+    uv = strand_coordinates(skin[vertices], normals[vertices], flow, triangles,
+                            weight=None if rise is None else 1.0 + RISE_FIT_WEIGHT * rise[vertices])
+    uv /= np.asarray(TILE, np.float32)
     return ScalpLayer(vertices=vertices, triangles=triangles.astype(np.int32), density=density[vertices],
                       uv=uv.astype(np.float32), normals=normals[vertices].astype(np.float32),
                       hairline=above[vertices])
