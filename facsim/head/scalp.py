@@ -42,11 +42,11 @@ HAIRLINE_WIDTH = 0.06
 #: Height (dm) of the layer over the skin: enough not to fight it in the depth buffer.
 LIFT = 0.004
 #: Bump when the layer a character gets changes (its disk cache is keyed by it).
-VERSION = 18  # 2: afro01's cards stand off the skull (volume_mm in hair.yaml); 12: crops' anatomical, rounded hairline;
-#   13: every layer carries its height above the hairline; 18: the hairline's hairs rise from it, thinning
+VERSION = 14  # 2: afro01's cards stand off the skull (volume_mm in hair.yaml); 12: crops' anatomical, rounded hairline;
+#   13: every layer carries its height above the hairline; 14: the hairline's hairs rise from it, thinning
 #: Under a hairstyle's cards: the width (dm) over which the hair thins from full cover at the
 #: hairline (:func:`hairline_height`) to bare skin ...
-HAIRLINE_THINNING = 0.05
+HAIRLINE_THINNING = 0.04
 #: ... and the band (dm above the hairline) over which its hairs turn from rising straight off
 #: it, up and back, to the cards' own flow.
 HAIRLINE_RISE = (0.1, 0.25)
