@@ -158,10 +158,12 @@ def draw_calls(args) -> dict:
         start = time.process_time()
         render(vao, *a, **k)
         ctx.finish()
+        if id(vao) not in names:  # a variant compiled in this frame's render
+            name_vertex_arrays()
         name = names.get(id(vao), "other")
         cpu[name] = cpu.get(name, 0.0) + time.process_time() - start
 
-    def name_vertex_arrays():  # (variants compile as frames need them: named again each frame)
+    def name_vertex_arrays():  # (variants compile as frames need them: named when first drawn)
         names.update({id(vao): f"face: {name}" for name, vao in renderer._vaos.items()})
         if renderer._depth_vao is not None:
             names[id(renderer._depth_vao)] = "head depth pre-pass"
@@ -180,7 +182,6 @@ def draw_calls(args) -> dict:
         with renderer.sequence(), deformations(face, drawn) as stream:
             def draw(deformation):
                 nonlocal count, kept
-                name_vertex_arrays()
                 timing[0] = count > 0
                 image = face.render(deformation=deformation, **options)
                 kept += count > 0 and renderer._hair_moving is not None
