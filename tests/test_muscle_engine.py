@@ -154,7 +154,7 @@ SPILL = 0.25
 #: half is drawn toward the acting corner (L20 on noah, settled: the corner 10.5 mm, the other
 #: half of the lips 3.0 mm, the other corner 1.4 mm). Since session 26 zygomaticus major also
 #: stretches the upper lip's outer part up over the teeth, and L12 draws the upper lip toward the
-#: smiling side (noah: the acting side's lip 23.7 mm, the other half's 6.8; before, 21.3 and 4.6).
+#: smiling side (noah: the acting side's lip 23.5 mm, the other half's 6.8; before, 21.3 and 4.6).
 LIP_SPILL = {20: 0.3, 12: 0.3}
 
 
