@@ -1020,15 +1020,6 @@ def _lerp_drive(a: Drive, b: Drive, t: float) -> Drive:
                                                          (b.muscle, b.pressure, b.lip_pressure, b.tongue))))
 
 
-def _symmetrised(model: Model, x: np.ndarray, mirrored: np.ndarray) -> np.ndarray:
-    """``x`` (3, B, N) with configurations ``mirrored`` (B,) made mirror-symmetric about the midline."""
-    rest = model.rest.T[:, None, :]
-    moved = x[:, mirrored] - rest
-    x = x.copy()
-    x[:, mirrored] = rest + 0.5 * (moved + moved[:, :, model.node_mirror] * _FLIP)
-    return x
-
-
 def solve(model: Model, state: State, target: Drive, *, steps: int = 3, iterations: int = 12,
           residual: float = 0.0, settle: bool = True) -> State:
     """Apply the change from ``state.drive`` to ``target`` in ``steps`` increments.
@@ -1065,7 +1056,10 @@ def solve(model: Model, state: State, target: Drive, *, steps: int = 3, iteratio
         known = (ld, e, g)
         mirrored = symmetric_drive(model, d) if settle else np.zeros(0, bool)
         if mirrored.any():  # a symmetric drive moves the face symmetrically: drop the round-off that breaks it
-            x = _symmetrised(model, x, mirrored)
+            rest = model.rest.T[:, None, :]
+            moved = x[:, mirrored] - rest
+            x = x.copy()
+            x[:, mirrored] = rest + 0.5 * (moved + moved[:, :, model.node_mirror] * _FLIP)
             known = None
         age, jaw = age + 1, ld.jaw
         if settle:  # the flesh may have slid onto other bone: settle on it (the sites follow: repeat)
@@ -1077,10 +1071,5 @@ def solve(model: Model, state: State, target: Drive, *, steps: int = 3, iteratio
                     break
                 # (Only the configurations still through a floor: each settles as it would alone.)
                 x = np.where(through[None, :, None], project_contacts(model, x, floors)[0], x)
-            # A point on the midline may settle on a bone site beside it and step off the midline
-            # (session 26: 12's slip into the upper lip pressed noah's subnasal skin onto the maxilla
-            # and it went 0.4 mm to one side); the settled face of a symmetric drive is symmetric too.
-            if mirrored.any():
-                x = _symmetrised(model, x, mirrored)
             known = None
     return State(x, target, ld.jaw, memory, floors, age, known)
