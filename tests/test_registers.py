@@ -1193,7 +1193,7 @@ def test_26_hangs_the_lower_lip_over_the_lower_teeth(face_of, character):
 def test_surprise_opens_in_a_rounded_oval_fear_in_a_wide_slot(face_of, character, level):
     """Surprise's relaxed lips hang from the dropped jaw and draw the corners in, an oval as tall as it is
     half wide; fear's lips are stretched out sideways (20). On main fb62a7c surprise's mouth was 3.1-3.3 mm
-    narrower than at rest at 100 % and 1.9 at 50 %; now 5.9-6.9 and 3.6-3.9, fear 9.7 mm wider."""
+    narrower than at rest at 100 % and 1.9 at 50 %; now 5.2-5.5 and 3.2-3.3, fear 9.7 mm wider."""
     from facsim.facs.emotions import emotion
     from facsim.speech.mouth import mouth_shape
 
