@@ -245,12 +245,16 @@ def test_teeth_are_about_as_light_as_the_lit_skin_beside_them(face_of, expressio
 def test_open_mouths_show_teeth_brighter_than_the_cavity(face_of, expression):
     face = face_of("ava")
     image, teeth, cavity = _mouth_pixels(face, "registers", expression)
-    assert teeth.sum() > 40 and cavity.sum() > 40
+    # Session 26: in 26 without 16 or 20 the slack lower lip lies over the lower teeth (FACS 26), so
+    # surprise (1+2+5+26) shows only the upper crowns' edges under the upper lip: 29-32 px, was 104
+    # with a band of lower teeth under the opening; those edges lie in the lip's shade (median 98.6).
+    surprise = expression == "1+2+5+26"
+    assert teeth.sum() > (20 if surprise else 40) and cavity.sum() > 40
     # (Lit about as the skin beside them, not brighter: test_teeth_are_about_as_light_...)
     # Since session 23 the upper incisors rest 3.5 mm under hm08's, so the open mouth shows
     # their edges right under the upper lip, in its shade (ava 1+2+5+26: 104 px at a median
     # of 118, was 61 px at 174; 16+26 120, 22+25 122); teeth in the mouth's dark read under 60.
-    assert np.median(_luminance(image[teeth])) > 100
+    assert np.median(_luminance(image[teeth])) > (90 if surprise else 100)
     # 22+25's "cavity" is 54 px, mostly the funnelled lips' inner faces: 0.5998 of the teeth's
     # median on c657c64, 0.603 since the lower lip turns with the chin (registers.yaml
     # `mandible.lower_lip`, 25's jaw share drops its outer part 0.2 mm); 26's cavity is 0.1.

@@ -1193,7 +1193,7 @@ def test_26_hangs_the_lower_lip_over_the_lower_teeth(face_of, character):
 def test_surprise_opens_in_a_rounded_oval_fear_in_a_wide_slot(face_of, character, level):
     """Surprise's relaxed lips hang from the dropped jaw and draw the corners in, an oval as tall as it is
     half wide; fear's lips are stretched out sideways (20). On main fb62a7c surprise's mouth was 3.1-3.3 mm
-    narrower than at rest at 100 % and 1.9 at 50 %; now 5.9-6.9 and 3.6-3.9, fear 9.7 mm wider."""
+    narrower than at rest at 100 % and 1.9 at 50 %; now 5.2-5.5 and 3.2-3.3, fear 9.7 mm wider."""
     from facsim.facs.emotions import emotion
     from facsim.speech.mouth import mouth_shape
 
@@ -1205,3 +1205,40 @@ def test_surprise_opens_in_a_rounded_oval_fear_in_a_wide_slot(face_of, character
     assert surprise.gap > 0.45 * surprise.width * level        # the opening's height against its width
     assert fear.width > rest.width + 8.0 * level
 
+
+def _upper_border_rise(face, expression, shares):
+    """The upper lip's red border (its top edge) rise (dm) at ``shares`` of the way from the midline to the
+    corners, both sides' mean: the highest sixth of the red's points in each column."""
+    from facsim.head.landmarks import landmarks
+
+    red, lip, _ = _lips_red(face)
+    rest = np.asarray(face.neutral, np.float64)
+    moved = np.asarray(face.deform(expression).positions, np.float64)
+    marks = landmarks(face.head)
+    half = abs(rest[marks["lip_corner_left"], 0] - rest[marks["lip_corner_right"], 0]) / 2
+    upper = np.flatnonzero(red & (lip == 1))
+    rises = []
+    for share in shares:
+        column = upper[np.abs(np.abs(rest[upper, 0]) - share * half) < 0.03 * half + 0.0015]
+        top = column[np.argsort(rest[column, 1])[-max(2, len(column) // 6):]]
+        rises.append(float((moved[top, 1] - rest[top, 1]).mean()))
+    return rises
+
+
+@pytest.mark.parametrize("character", ["ava", "george"])
+@pytest.mark.parametrize("expression", ["10E", "9E", "disgust"])
+def test_the_raised_upper_lips_border_is_an_inverted_u(face_of, character, expression):
+    """FACS 10 (and 9's raise of the upper lip): the centre of the upper lip is drawn straight up, its
+    outer parts less - an angular inverted U. The lips' inner edge bent so since session 19, but the
+    red's top border (ARKit's mouthUpperUp and MakeHuman's lip elevation both peak halfway to the
+    corners) rose most over the canines: on main fb62a7c 6.6 mm halfway against 4.6 at the centre in
+    10E, 5.3 against 3.2 in disgust (9+15+16), a flat-topped box over bared teeth that FER2013 read as
+    anger. Now the centre rises as far as anything and the outer part 1.5 mm or more less (10E 6.8 / 6.4 /
+    4.1 mm at the centre / halfway / 0.7 of the way on ava, disgust 5.5 / 5.4 / 3.0)."""
+    from facsim.facs.emotions import emotion, emotion_names
+
+    face = face_of(character)
+    text = emotion(expression) if expression in emotion_names() else expression
+    centre, halfway, outer = _upper_border_rise(face, text, (0.0, 0.5, 0.7))
+    assert centre > 0.025
+    assert halfway < centre + 0.002 and outer < centre - 0.015, (centre, halfway, outer)
