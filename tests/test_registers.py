@@ -325,7 +325,10 @@ def test_skin_guard_unfolds_a_fold_and_lifts_skin_off_the_eye(engine, head, mark
     """The guard itself: a lid point pushed into the eyeball and a folded triangle are repaired."""
     p = engine.neutral.copy()
     centre, radius = head.eye_pivot(engine.base_positions, "left")
-    lid = np.argmin(np.linalg.norm(p[: head.skin_vertex_count] - (centre + [0, 0, radius]), axis=1))
+    # the skin point nearest the cornea's front among those outside the eye at rest (the lid's
+    # inner surface lies just inside it; lifted at rest, a hooded lid brings one nearest)
+    outside = geometry_check.outside[0]
+    lid = outside[np.argmin(np.linalg.norm(p[outside] - (centre + [0, 0, radius]), axis=1))]
     p[lid] = centre + 0.5 * (p[lid] - centre)          # halfway to the eye's centre
     centroid = p[geometry_check.triangles].mean(axis=1)
     a, b, c = geometry_check.triangles[np.argmin(np.linalg.norm(centroid - p[marks["cheek_left"]], axis=1))]
