@@ -100,12 +100,19 @@ def run(base_url: str, n: int = 50, *, size: int = 96, pid: int | None = None, t
     kinds = [clean(status, payload, hdrs) for status, _, payload, hdrs in results]
     served = [t for (_, t, _, _), k in zip(results, kinds) if k == "served"]
     refused = [t for (_, t, _, _), k in zip(results, kinds) if k == "refused"]
-    try:
-        with urllib.request.urlopen(urllib.request.Request(f"{base_url}/api/health", headers=headers),
-                                    timeout=30) as response:
-            health = json.loads(response.read())
-    except OSError as exc:
-        health = {"ok": False, "error": str(exc)}
+    # The server counts a render done once its response is sent, which may be just after the client
+    # has it (seen under load: pending 1): health is read until nothing is pending, for up to 10 s.
+    settle = time.perf_counter() + 10.0
+    while True:
+        try:
+            with urllib.request.urlopen(urllib.request.Request(f"{base_url}/api/health", headers=headers),
+                                        timeout=30) as response:
+                health = json.loads(response.read())
+        except OSError as exc:
+            health = {"ok": False, "error": str(exc)}
+        if not health.get("ok") or not health.get("pending") or time.perf_counter() > settle:
+            break
+        time.sleep(0.1)
 
     def stats(times):
         return {"median": statistics.median(times), "max": max(times)} if times else None
