@@ -356,6 +356,29 @@ def sclera_figures(character, expression, size=448, engine="registers") -> dict:
             "pupil_over_iris_width": ratios}
 
 
+def per_eye(size, *masks):
+    """Yield, the image's left eye then its right, copies of the (size, size) ``masks`` kept to
+    that half of the image."""
+    for side in (slice(0, size // 2), slice(size // 2, size)):
+        own = [np.zeros_like(mask) for mask in masks]
+        for kept, mask in zip(own, masks):
+            kept[:, side] = mask[:, side]
+        yield own
+
+
+def iris_zones(luminance, iris, pupil):
+    """One eye's ``luminance`` (H, W) over its ciliary zone (0.35-0.8 of the way from the pupil's
+    rim to the limbus) and its pupillary zone (0.05-0.3), on the iris's lower half (clear of the
+    lid's shade and the catch-light); ``iris`` and ``pupil`` are that eye's masks."""
+    ys, xs = np.nonzero(iris)
+    py, px = np.nonzero(pupil)
+    radius, pupil_radius = (np.ptp(xs) + 1) / 2, (np.ptp(px) + 1) / 2
+    t = (np.hypot(ys - py.mean(), xs - (xs.max() + xs.min()) / 2) - pupil_radius) / (radius - pupil_radius)
+    below = ys > py.mean()
+    zone = luminance[ys, xs]
+    return zone[below & (t > 0.35) & (t < 0.8)], zone[below & (t > 0.05) & (t < 0.3)]
+
+
 def iris_figures(character) -> dict:
     """The catch-light against the pupil at 768 px and the iris's streaks and pupillary ring at
     448 px (module docstring, ``--iris``), per eye, left to right."""
@@ -367,9 +390,7 @@ def iris_figures(character) -> dict:
     cornea = ndimage.binary_fill_holes(_changed(cornea_marked, image))
     pupil = ndimage.binary_fill_holes(_changed(pupil_marked, image))
     luminance = image @ LUMINANCE
-    for side in (slice(0, size // 2), slice(size // 2, size)):
-        eye, own_pupil = np.zeros_like(cornea), np.zeros_like(pupil)
-        eye[:, side], own_pupil[:, side] = cornea[:, side], pupil[:, side]
+    for eye, own_pupil in per_eye(size, cornea, pupil):
         px_per_mm = (np.ptp(np.flatnonzero(eye.any(axis=0))) + 1) / IRIS_DIAMETER_MM
         core = eye & (luminance > (luminance[eye].max() + np.median(luminance[eye])) / 2)
         (cy, cx), (py, px) = (np.mean(np.nonzero(mask), axis=1) for mask in (core, own_pupil))
@@ -382,16 +403,8 @@ def iris_figures(character) -> dict:
     iris = ndimage.binary_erosion(_changed(iris_marked, image))
     pupil = ndimage.binary_fill_holes(_changed(pupil_marked, image))
     luminance = image @ LUMINANCE
-    for side in (slice(0, size // 2), slice(size // 2, size)):
-        eye, own_pupil = np.zeros_like(iris), np.zeros_like(pupil)
-        eye[:, side], own_pupil[:, side] = iris[:, side], pupil[:, side]
-        ys, xs = np.nonzero(eye)
-        py, px = np.nonzero(own_pupil)
-        radius, pupil_radius = (np.ptp(xs) + 1) / 2, (np.ptp(px) + 1) / 2
-        t = (np.hypot(ys - py.mean(), xs - (xs.max() + xs.min()) / 2) - pupil_radius) / (radius - pupil_radius)
-        below = ys > py.mean()
-        ciliary = luminance[ys, xs][below & (t > 0.35) & (t < 0.8)]
-        pupillary = luminance[ys, xs][below & (t > 0.05) & (t < 0.3)]
+    for eye, own_pupil in per_eye(size, iris, pupil):
+        ciliary, pupillary = iris_zones(luminance, eye, own_pupil)
         figures["ciliary_spread"].append(round(float(ciliary.std() / ciliary.mean()), 3))
         figures["pupillary_over_ciliary"].append(round(float(pupillary.mean() / ciliary.mean()), 2))
     return figures

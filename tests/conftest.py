@@ -70,16 +70,22 @@ def background_mask(image: np.ndarray, background=(255, 255, 255)) -> np.ndarray
 
 
 @functools.lru_cache(maxsize=None)
-def bench_hair_texture():
-    """benchmarks/bench_hair_texture.py as a module: its figures are what the hair tests measure."""
+def repo_module(path: str):
+    """A script of the repository (``path`` from its root, e.g. ``"benchmarks/bench_hair_texture.py"``)
+    as a module: the figures a test asserts are those its script prints."""
     import importlib.util
     from pathlib import Path
 
-    path = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_hair_texture.py"
-    spec = importlib.util.spec_from_file_location("bench_hair_texture", path)
+    full = Path(__file__).resolve().parents[1] / path
+    spec = importlib.util.spec_from_file_location(full.stem, full)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
+
+
+def bench_hair_texture():
+    """benchmarks/bench_hair_texture.py as a module: its figures are what the hair tests measure."""
+    return repo_module("benchmarks/bench_hair_texture.py")
 
 
 def hair_renders(face, size: int):

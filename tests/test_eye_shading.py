@@ -8,6 +8,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from conftest import repo_module
+
 from facsim.face import Face
 from facsim.head.character import preset
 
@@ -279,17 +281,11 @@ def test_at_448_px_the_iris_is_streaked_not_a_target():
     image = renders["normal"]
     iris = ndimage.binary_erosion(np.abs(renders["iris"] - image).sum(-1) > 60)   # (not its anti-aliased rim)
     pupil = ndimage.binary_fill_holes(np.abs(renders["pupil"] - image).sum(-1) > 60)
+    figures = repo_module("scripts/eyes_mouth_figures.py")   # its --iris figures: the same zones
     lum = _luminance(image)
     spreads = []
-    for side in (slice(0, size // 2), slice(size // 2, size)):
-        eye, own_pupil = np.zeros_like(iris), np.zeros_like(pupil)
-        eye[:, side], own_pupil[:, side] = iris[:, side], pupil[:, side]
-        ys, xs = np.nonzero(eye)
-        py, px = np.nonzero(own_pupil)
-        radius, pupil_radius = (np.ptp(xs) + 1) / 2, (np.ptp(px) + 1) / 2
-        t = (np.hypot(ys - py.mean(), xs - (xs.max() + xs.min()) / 2) - pupil_radius) / (radius - pupil_radius)
-        below = ys > py.mean()
-        ciliary, pupillary = lum[ys, xs][below & (t > 0.35) & (t < 0.8)], lum[ys, xs][below & (t > 0.05) & (t < 0.3)]
+    for eye, own_pupil in figures.per_eye(size, iris, pupil):
+        ciliary, pupillary = figures.iris_zones(lum, eye, own_pupil)
         spreads.append(ciliary.std() / ciliary.mean())
         assert pupillary.mean() / ciliary.mean() > 0.94
     assert np.mean(spreads) > 0.095, spreads

@@ -755,6 +755,13 @@ def _specular_light(face, size):
     return np.clip(full - 2 * (full - half), 0, None), full, camera
 
 
+def _forehead_box(face, marks, camera, size):
+    """(rows, columns) slices of ~5 x 8 cm of the forehead above the glabella in a ``size`` px render."""
+    forehead = face.neutral[marks["glabella"]] + np.array([0.0, 0.25, -0.03])
+    (x, y), = project(camera, [forehead], size)[0].astype(int)
+    return slice(y - 25, y + 25), slice(x - 40, x + 40)
+
+
 def test_an_oily_forehead_shows_a_sharp_broken_highlight_not_one_broad_glaze(face_of, marks):
     """Sebum lies in pools a few millimetres across with drier skin between them, so the forehead's
     highlight is sharp and broken, and most of the forehead stays matte; the T-zone still shines
@@ -768,10 +775,9 @@ def test_an_oily_forehead_shows_a_sharp_broken_highlight_not_one_broad_glaze(fac
     face = face_of("kwame")
     size = 448
     specular, full, camera = _specular_light(face, size)
-    forehead = face.neutral[marks["glabella"]] + np.array([0.0, 0.25, -0.03])
+    box = _forehead_box(face, marks, camera, size)
     cheek = face.neutral[marks["cheek_left"]] + np.array([-0.08, 0.05, 0.1])
-    (x, y), (cx, cy) = project(camera, [forehead, cheek], size)[0].astype(int)
-    box = (slice(y - 25, y + 25), slice(x - 40, x + 40))       # ~5 x 8 cm of the forehead
+    (cx, cy), = project(camera, [cheek], size)[0].astype(int)
     highlight = gaussian_filter(specular, 1.5)[box]
     assert np.mean(highlight > 0.5 * np.median(full[box])) < 0.06
     share = specular[box].sum() / full[box].sum()
@@ -788,9 +794,7 @@ def test_a_dark_foreheads_sheen_is_not_a_white_glaze(face_of, marks):
     face = face_of("kwame")
     size = 448
     specular, full, camera = _specular_light(face, size)
-    forehead = face.neutral[marks["glabella"]] + np.array([0.0, 0.25, -0.03])
-    (x, y), = project(camera, [forehead], size)[0].astype(int)
-    box = (slice(y - 25, y + 25), slice(x - 40, x + 40))       # ~5 x 8 cm of the forehead
+    box = _forehead_box(face, marks, camera, size)
     glare = np.percentile(gaussian_filter(specular, 1.5)[box], 99) / np.median(full[box])
     assert glare < 0.75, glare
 
@@ -858,9 +862,7 @@ def test_an_oily_foreheads_sheen_breaks_on_the_skins_relief_not_one_smooth_lobe(
     face = face_of("kwame")
     size = 448
     specular, _, camera = _specular_light(face, size)
-    forehead = face.neutral[marks["glabella"]] + np.array([0.0, 0.25, -0.03])
-    (x, y), = project(camera, [forehead], size)[0].astype(int)
-    box = (slice(y - 25, y + 25), slice(x - 40, x + 40))       # ~5 x 8 cm of the forehead
+    box = _forehead_box(face, marks, camera, size)
     sheen, smooth = specular[box], gaussian_filter(specular, 2.0)[box]
     brightest = smooth > np.percentile(smooth, 67)
     fine = np.abs(sheen - smooth)[brightest].sum() / sheen[brightest].sum()
@@ -895,9 +897,7 @@ def test_a_high_softbox_key_leaves_a_soft_sheen_on_an_oily_forehead_not_a_glare(
         specular, full, camera = _specular_light(face, 448)
     finally:
         renderer.lighting = default
-    forehead = face.neutral[marks["glabella"]] + np.array([0.0, 0.25, -0.03])
-    (x, y), = project(camera, [forehead], 448)[0].astype(int)
-    box = (slice(y - 25, y + 25), slice(x - 40, x + 40))       # ~5 x 8 cm of the forehead
+    box = _forehead_box(face, marks, camera, 448)
     glare = np.percentile(gaussian_filter(specular, 1.5)[box], 99) / np.median(full[box])
     assert glare < 0.75, glare
 
